@@ -1,0 +1,74 @@
+// Typed errors of the hairgen library and the process exit codes they map to.
+//
+// Library code never prints and never exits: it throws one of the errors below, each carrying an
+// optional file location, and the command-line front end catches it once and turns it into one line
+// on stderr and an exit code.
+#pragma once
+
+#include <stdexcept>
+#include <string>
+
+namespace hairgen {
+
+// The process exit codes, the same for every command (DESIGN §3).
+enum class ExitCode : int {
+  kSuccess = 0,      // the command did what was asked
+  kWorkFailed = 1,   // the work itself failed: I/O while writing, a numerical failure
+  kBadInput = 2,     // bad usage or bad input: config, mesh, cache, command line
+  kNoDevice = 3,     // no rendering device could be opened
+  kDiffFailed = 4,   // `hairgen diff` found the images beyond its thresholds
+};
+
+// Where in a text file something was found. line == 0 means "the file as a whole".
+struct FileLoc {
+  std::string file;
+  int line = 0;
+
+  // "file:line", "file", or "" when nothing is known.
+  std::string str() const;
+};
+
+// Base of every error the library throws. what() is "FILE:LINE: message" (or just the message).
+class Error : public std::runtime_error {
+ public:
+  Error(ExitCode code, FileLoc where, const std::string& message);
+
+  ExitCode code() const { return code_; }
+  const FileLoc& where() const { return where_; }
+  const std::string& message() const { return message_; }
+
+ private:
+  ExitCode code_;
+  FileLoc where_;
+  std::string message_;
+};
+
+// Something a user gave is wrong: a config value, a mesh, a cache file, an argument. Exit code 2.
+class InputError : public Error {
+ public:
+  explicit InputError(const std::string& message) : Error(ExitCode::kBadInput, {}, message) {}
+  InputError(FileLoc where, const std::string& message)
+      : Error(ExitCode::kBadInput, std::move(where), message) {}
+};
+
+// Reading or writing failed for a reason outside the input's content (disk full, permissions). Exit 1.
+class IoError : public Error {
+ public:
+  explicit IoError(const std::string& message) : Error(ExitCode::kWorkFailed, {}, message) {}
+  IoError(FileLoc where, const std::string& message)
+      : Error(ExitCode::kWorkFailed, std::move(where), message) {}
+};
+
+// A computation produced a non-finite or otherwise unusable result. Exit code 1.
+class NumericError : public Error {
+ public:
+  explicit NumericError(const std::string& message) : Error(ExitCode::kWorkFailed, {}, message) {}
+};
+
+// No rendering device could be opened. Exit code 3.
+class DeviceError : public Error {
+ public:
+  explicit DeviceError(const std::string& message) : Error(ExitCode::kNoDevice, {}, message) {}
+};
+
+}  // namespace hairgen

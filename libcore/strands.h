@@ -1,0 +1,68 @@
+// Hair strands as flat arrays: the guides `grow` makes, the coupe `interpolate` makes, and whatever a
+// .hair or glTF cache holds.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+namespace hairgen {
+
+// Where a cache came from, stored in it so a farm script can tell two caches apart.
+struct Provenance {
+  std::string producer;      // "hairgen 0.1.0"; empty for files made elsewhere
+  std::string stage;         // "grow", "interpolate", "shade", "convert", ...
+  uint64_t seed = 0;
+  std::string configDigest;  // hex digest of the effective configuration, or ""
+
+  bool empty() const { return producer.empty() && stage.empty() && configDigest.empty() && seed == 0; }
+  bool operator==(const Provenance&) const = default;
+};
+
+// A set of polyline strands. Strand s owns points [firstPoint[s], firstPoint[s+1]).
+//
+// Every optional array is either empty or has exactly its documented size; validate() checks it.
+// Units: metres, unit vectors, widths as diameters in metres (DESIGN §2).
+struct Strands {
+  std::vector<glm::vec3> points;
+  std::vector<uint32_t> firstPoint{0};  // strandCount() + 1 offsets, firstPoint[0] == 0
+
+  // Per point (size points.size() or empty).
+  std::vector<glm::vec3> tangents;      // unit
+  std::vector<glm::vec3> normals;       // unit shading normals
+  std::vector<glm::vec3> colors;        // linear RGB
+  std::vector<float> thickness;         // diameter, metres
+  std::vector<float> transparency;      // 0 = opaque
+
+  // Per strand (size strandCount() or empty).
+  std::vector<uint32_t> strandId;
+  std::vector<uint32_t> rootTriangle;   // wick triangle the root lies on
+  std::vector<glm::vec3> rootBary;      // barycentrics of the root on that triangle
+  std::vector<glm::vec2> rootUv;
+  std::vector<glm::uvec3> guideIds;     // the three guides a strand follows
+  std::vector<glm::vec3> guideWeights;  // their weights at the root
+
+  // cyHair header defaults, used where the per-point arrays are absent.
+  float defaultThickness = 7.0e-5f;     // metres
+  float defaultTransparency = 0.0f;
+  glm::vec3 defaultColor{0.45f, 0.25f, 0.0f};
+
+  Provenance provenance;
+
+  size_t strandCount() const { return firstPoint.empty() ? 0 : firstPoint.size() - 1; }
+  size_t pointCount() const { return points.size(); }
+  uint32_t pointsOf(size_t strand) const { return firstPoint[strand + 1] - firstPoint[strand]; }
+
+  // Appends a strand's points; the optional arrays are left to the caller.
+  void addStrand(const std::vector<glm::vec3>& strandPoints);
+
+  // Throws InputError (naming `source`) if an array has the wrong size, an offset is out of order, or
+  // a value is not finite.
+  void validate(const std::string& source) const;
+
+  bool operator==(const Strands&) const = default;
+};
+
+}  // namespace hairgen
