@@ -1,0 +1,89 @@
+#include "cli/common.h"
+
+#include <iostream>
+
+#include <tbb/global_control.h>
+#include <tbb/info.h>
+
+#include "libcore/config.h"
+#include "libcore/error.h"
+#include "libcore/file_util.h"
+
+namespace hairgen::cli {
+
+void addCommonFlags(CLI::App& command, CommonOptions& options, bool configFlags) {
+  command.add_option("--threads", options.threads, "Worker threads; 0 uses every core (output is identical for any value)")
+      ->default_val(0)
+      ->check(CLI::Range(0, 4096));
+  command.add_flag("--quiet,-q", options.quiet, "Print nothing but errors");
+  command.add_option("--stats", options.statsFile, "Write timings and counts as JSON to FILE (for farm scripts)")
+      ->type_name("FILE.json");
+  if (!configFlags) return;
+  command.add_option("--seed", options.seed, "Seed of every random number (overrides Hairstyle.Seed)")->type_name("N");
+  command
+      .add_option("--set", options.sets,
+                  "Override a config value without editing files, e.g. --set Hairstyle.HairDensity=160 "
+                  "(repeatable; sections Setup, Hairstyle, Collision, Visuality, Render; a repeatable key such as "
+                  "Collision.Sphere replaces all its lines)")
+      ->type_name("Section.Key=VALUE")
+      ->take_all()
+      ->allow_extra_args(false);
+}
+
+std::vector<Override> parseOverrides(const CommonOptions& options) {
+  std::vector<Override> overrides;
+  for (const std::string& text : options.sets) overrides.push_back(parseOverride(text));
+  if (options.seed) overrides.push_back(parseOverride("Hairstyle.Seed=" + std::to_string(*options.seed)));
+  return overrides;
+}
+
+Stats::Stats(std::string command) : start_(std::chrono::steady_clock::now()) {
+  json_["command"] = std::move(command);
+  json_["version"] = HAIRGEN_VERSION;
+  json_["seconds"] = nlohmann::ordered_json::object();
+  json_["counts"] = nlohmann::ordered_json::object();
+}
+
+void Stats::setOverrides(const std::vector<Override>& overrides) {
+  nlohmann::ordered_json list = nlohmann::ordered_json::array();
+  for (const Override& o : overrides) list.push_back(o.text);
+  json_["overrides"] = list;
+}
+
+void Stats::write(const CommonOptions& options) {
+  json_["seconds"]["total"] = std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
+  if (!options.statsFile.empty()) writeFileAtomic(options.statsFile, json_.dump(2) + "\n");
+}
+
+int runCommand(const std::string& command, const CommonOptions& options, const std::function<void()>& body) {
+  try {
+    int threads = options.threads > 0 ? options.threads : static_cast<int>(tbb::info::default_concurrency());
+    tbb::global_control limit(tbb::global_control::max_allowed_parallelism, static_cast<size_t>(threads));
+    body();
+    return static_cast<int>(ExitCode::kSuccess);
+  } catch (const Error& e) {
+    std::cerr << "hairgen " << command << ": error: " << e.what() << "\n";
+    return static_cast<int>(e.code());
+  } catch (const std::bad_alloc&) {
+    std::cerr << "hairgen " << command << ": error: out of memory\n";
+    return static_cast<int>(ExitCode::kWorkFailed);
+  } catch (const std::exception& e) {
+    std::cerr << "hairgen " << command << ": error: internal: " << e.what() << "\n";
+    return static_cast<int>(ExitCode::kWorkFailed);
+  }
+}
+
+void note(const CommonOptions& options, const std::string& line) {
+  if (!options.quiet) std::cerr << line << "\n";
+}
+
+std::string exitCodeHelp() {
+  return "Exit codes:\n"
+         "  0  success\n"
+         "  1  the work failed (I/O while writing, a numerical failure)\n"
+         "  2  bad usage or bad input (config, mesh, cache, command line)\n"
+         "  3  no rendering device could be opened\n"
+         "  4  `hairgen diff` found the images beyond the thresholds\n";
+}
+
+}  // namespace hairgen::cli

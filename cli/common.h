@@ -1,0 +1,57 @@
+// What every hairgen command shares: the common flags, --stats, and the one place errors become
+// exit codes.
+#pragma once
+
+#include <chrono>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include <CLI/CLI.hpp>
+#include <nlohmann/json.hpp>
+
+#include "libcore/params.h"
+
+namespace hairgen::cli {
+
+struct CommonOptions {
+  int threads = 0;                     // 0 = every core
+  std::optional<uint64_t> seed;        // overrides Hairstyle.Seed
+  std::vector<std::string> sets;       // --set Section.Key=VALUE, as given
+  bool quiet = false;
+  std::string statsFile;               // --stats FILE.json
+};
+
+// Registers --threads, --quiet and --stats; with `configFlags` also --seed and --set.
+void addCommonFlags(CLI::App& command, CommonOptions& options, bool configFlags);
+
+// Parses the --set arguments (and --seed) into overrides. Throws InputError.
+std::vector<Override> parseOverrides(const CommonOptions& options);
+
+// Collects timings and counts for --stats.
+class Stats {
+ public:
+  explicit Stats(std::string command);
+  void time(const std::string& phase, double seconds) { json_["seconds"][phase] = seconds; }
+  nlohmann::ordered_json& counts() { return json_["counts"]; }
+  nlohmann::ordered_json& json() { return json_; }
+  void setOverrides(const std::vector<Override>& overrides);
+  // Adds the total time and writes the file (atomically) if one was asked for.
+  void write(const CommonOptions& options);
+
+ private:
+  std::chrono::steady_clock::time_point start_;
+  nlohmann::ordered_json json_;
+};
+
+// Runs one command body with the thread limit applied, catching every error once: prints
+// "hairgen CMD: error: FILE:LINE: message" and returns the documented exit code.
+int runCommand(const std::string& command, const CommonOptions& options, const std::function<void()>& body);
+
+// Progress and notes on stderr unless --quiet.
+void note(const CommonOptions& options, const std::string& line);
+
+// The exit-code table shown in --help.
+std::string exitCodeHelp();
+
+}  // namespace hairgen::cli

@@ -1,0 +1,42 @@
+// hairgen: grows, styles, caches and renders hair. This file only parses the command line and hands
+// over to one command; everything else lives in libcore/ and stages/.
+#include <iostream>
+
+#include <CLI/CLI.hpp>
+
+#include "cli/commands.h"
+#include "cli/common.h"
+
+int main(int argc, char** argv) {
+  using namespace hairgen::cli;
+  CLI::App app{"hairgen " HAIRGEN_VERSION
+               ": grows, styles, caches and renders hair for CG characters (Super-Helix guides, "
+               "interpolation, Kajiya-Kay shading with deep opacity maps).",
+               "hairgen"};
+  app.footer(exitCodeHelp());
+  app.require_subcommand(1);
+  app.set_version_flag("--version", "hairgen " HAIRGEN_VERSION);
+
+  int exitCode = 0;
+  registerInfo(app, exitCode);
+  registerConvert(app, exitCode);
+  registerCheck(app, exitCode);
+  registerAssets(app, exitCode);
+
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::CallForHelp& e) {
+    return app.exit(e);
+  } catch (const CLI::CallForAllHelp& e) {
+    return app.exit(e);
+  } catch (const CLI::CallForVersion& e) {
+    return app.exit(e);
+  } catch (const CLI::ParseError& e) {
+    std::string where = "hairgen";
+    for (const CLI::App* sub : app.get_subcommands()) where += " " + sub->get_name();
+    std::cerr << where << ": error: " << e.what() << "\n"
+              << "Run '" << where << " --help' for usage.\n";
+    return 2;
+  }
+  return exitCode;
+}
