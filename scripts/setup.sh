@@ -1,0 +1,40 @@
+#!/usr/bin/env bash
+# Installs every Debian package hairgen's build, tests and tools need, then configures and builds.
+# Idempotent: when everything is present it only (re)builds, and `apt-get update` runs only when a
+# package is missing. Usage: scripts/setup.sh [--no-build]
+set -euo pipefail
+cd "$(dirname "$0")/.."
+
+packages=(
+  build-essential cmake ninja-build pkg-config git
+  libglm-dev libcli11-dev libtinyobjloader-dev libtinygltf-dev nlohmann-json3-dev libstb-dev
+  libopenexr-dev openexr libopenimageio-dev openimageio-tools libtbb-dev zlib1g-dev
+  libegl-dev libgl-dev libegl1 libopengl0 libegl-mesa0 libgl1-mesa-dri libgbm1
+  libgtest-dev libgmock-dev libbenchmark-dev
+)
+# Node.js with npm runs the glTF validator; the image may ship its own Node (then Debian's npm conflicts).
+command -v npm >/dev/null 2>&1 || packages+=(nodejs npm)
+
+missing=()
+for p in "${packages[@]}"; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+done
+if ((${#missing[@]})); then
+  echo "setup: installing ${missing[*]}" >&2
+  sudo=""
+  [ "$(id -u)" -eq 0 ] || sudo="sudo"
+  export DEBIAN_FRONTEND=noninteractive
+  $sudo apt-get update -qq
+  $sudo apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
+fi
+
+# The Khronos glTF validator (npm package gltf-validator), used by the test suite.
+if [ ! -f tools/node_modules/gltf-validator/package.json ]; then
+  echo "setup: installing gltf-validator (npm)" >&2
+  mkdir -p tools
+  npm install --silent --no-audit --no-fund --prefix tools gltf-validator@2.0.0-dev.3.10 >/dev/null
+fi
+
+[ "${1:-}" = "--no-build" ] && exit 0
+cmake -S . -B build -G Ninja -DCMAKE_BUILD_TYPE=Release >/dev/null
+cmake --build build

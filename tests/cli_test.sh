@@ -1,0 +1,79 @@
+#!/usr/bin/env bash
+# End-to-end checks of the hairgen command line: exit codes, messages, no partial output.
+# Usage: cli_test.sh HAIRGEN SOURCE_DIR CASE
+set -u
+hairgen=$1 src=$2 case=$3
+real="$src/../shared/testdata/real"
+tmp=$(mktemp -d)
+trap 'rm -rf "$tmp"' EXIT
+fail() { echo "FAIL ($case): $*"; exit 1; }
+expect_rc() { # expected-rc command...
+  local want=$1; shift
+  "$@" >"$tmp/out" 2>"$tmp/err"; local rc=$?
+  [ "$rc" -eq "$want" ] || { cat "$tmp/out" "$tmp/err"; fail "'$*' exited $rc, expected $want"; }
+}
+
+case "$case" in
+help)
+  expect_rc 0 "$hairgen" --help
+  grep -q "Exit codes" "$tmp/out" || fail "--help lists no exit codes"
+  for cmd in info convert check assets; do
+    grep -q "^  $cmd" "$tmp/out" || fail "--help does not list $cmd"
+  done
+  for cmd in info convert check assets; do
+    expect_rc 0 "$hairgen" "$cmd" --help
+    for flag in --threads --quiet --stats; do grep -q -- "$flag" "$tmp/out" || fail "$cmd --help lacks $flag"; done
+    grep -q "Exit codes" "$tmp/out" || fail "$cmd --help lists no exit codes"
+  done
+  for flag in --set --seed; do
+    "$hairgen" check --help | grep -q -- "$flag" || fail "check --help lacks $flag"
+  done
+  ;;
+usage)
+  expect_rc 2 "$hairgen"
+  expect_rc 2 "$hairgen" frobnicate
+  expect_rc 2 "$hairgen" info
+  expect_rc 2 "$hairgen" convert a.hair
+  expect_rc 2 "$hairgen" info "$tmp/missing.hair"
+  grep -q "hairgen info: error: $tmp/missing.hair" "$tmp/err" || fail "missing file not named: $(cat "$tmp/err")"
+  ;;
+config_errors)
+  expect_rc 0 "$hairgen" check "$src/configs/default/setup.txt" --set Hairstyle.HairDensity=160 --stats "$tmp/s.json"
+  grep -q '"Hairstyle.HairDensity=160"' "$tmp/s.json" || fail "--stats does not report the override"
+  expect_rc 2 "$hairgen" check "$src/configs/default/setup.txt" --set Hairstyle.HairDensty=160
+  grep -q "did you mean 'HairDensity'" "$tmp/err" || fail "no hint: $(cat "$tmp/err")"
+  printf 'HairLengths 0.04\nYoung abc\n' > "$tmp/h.txt"
+  printf 'HairstyleInfo h.txt\nWickModel %s\n' "$src/configs/assets/wick.obj" > "$tmp/setup.txt"
+  expect_rc 2 "$hairgen" check "$tmp/setup.txt"
+  grep -q "^hairgen check: error: $tmp/h.txt:2: 'Young': 'abc' is not a number" "$tmp/err" || fail "bad message: $(cat "$tmp/err")"
+  printf 'Load true\n' > "$tmp/load.txt"
+  expect_rc 2 "$hairgen" check "$tmp/load.txt"
+  grep -q "load.txt:1:" "$tmp/err" || fail "Load without LoadFile not located: $(cat "$tmp/err")"
+  ;;
+no_partial_output)
+  head -c 300 "$src/tests/cli_test.sh" > "$tmp/broken.hair"
+  expect_rc 2 "$hairgen" convert "$tmp/broken.hair" "$tmp/out.glb"
+  [ ! -e "$tmp/out.glb" ] || fail "a failed convert left output behind"
+  [ -z "$(ls "$tmp" | grep tmp-)" ] || fail "a temporary file was left behind"
+  expect_rc 2 "$hairgen" convert "$tmp/broken.hair" "$tmp/out.xyz"
+  ;;
+real_cyhair)
+  [ -f "$real/luxcore/straight.hair" ] || { echo "shared/testdata/real is absent; skipped"; exit 0; }
+  expect_rc 0 "$hairgen" info "$real/luxcore/straight.hair"
+  grep -q "10000 strands, 160000 points" "$tmp/out" || fail "info: $(cat "$tmp/out")"
+  expect_rc 0 "$hairgen" convert "$real/luxcore/straight.hair" "$tmp/s.glb" --quiet
+  expect_rc 0 "$hairgen" convert "$tmp/s.glb" "$tmp/back.hair" --quiet
+  expect_rc 0 "$hairgen" convert "$real/luxcore/straight.hair" "$tmp/direct.hair" --quiet
+  # The same points: the cyHair core (header counts and arrays) is identical; only provenance differs.
+  core=$((128 + 160000 * 12 + 160000 * 12))
+  cmp -n "$core" "$tmp/back.hair" "$tmp/direct.hair" || fail "points changed through .glb"
+  expect_rc 0 "$hairgen" info "$tmp/s.glb" --json
+  grep -q '"points": 160000' "$tmp/out" || fail "glb info"
+  ;;
+wick_info)
+  expect_rc 0 "$hairgen" info "$src/configs/assets/wick.obj"
+  grep -q "759 vertices, 1443 triangles, area" "$tmp/out" || fail "wick info: $(cat "$tmp/out")"
+  ;;
+*) fail "unknown case" ;;
+esac
+echo "ok ($case)"

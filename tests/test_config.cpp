@@ -1,0 +1,270 @@
+// The strict config reader (DESIGN §4): the thesis' files parse to their printed values, and every kind
+// of bad value is an InputError naming file and line.
+#include <gtest/gtest.h>
+
+#include <fstream>
+
+#include "libcore/setup.h"
+#include "tests/test_util.h"
+
+namespace hairgen {
+namespace {
+
+using test::sourceDir;
+using test::text;
+
+std::filesystem::path thesis(const std::string& file) { return sourceDir() / "configs" / "thesis" / file; }
+
+// Runs `fn`, expects an InputError, and returns its message (what()).
+template <typename Fn>
+std::string inputError(Fn fn) {
+  try {
+    fn();
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  ADD_FAILURE() << "expected an InputError";
+  return {};
+}
+
+TEST(ThesisConfigs, AppendixBSetupParsesAsPrinted) {
+  hairgen::Setup s = readSetup(readConfigText(thesis("appendix-b/setup.txt")), {});
+  EXPECT_TRUE(s.load);
+  EXPECT_FALSE(s.save);
+  EXPECT_EQ(s.loadFile.path.filename(), "Hair1.hair");
+  EXPECT_EQ(s.hairstyleInfo.path.filename(), "Hairstyle1.txt");
+  EXPECT_EQ(s.wickModel.path.filename(), "Wick.obj");
+  EXPECT_EQ(s.headFrag.path.filename(), "Phong_Shadow.frag");
+  EXPECT_EQ(s.hairVert.path.filename(), "KajiyaKay_Shadow.vert");
+  EXPECT_EQ(s.wickModel.where.line, 28);
+}
+
+TEST(ThesisConfigs, AppendixBHairstyleParsesAsPrinted) {
+  Hairstyle h = readHairstyle(readConfigText(thesis("appendix-b/Properties/Hairstyle/Hairstyle1.txt")), {});
+  EXPECT_DOUBLE_EQ(h.visualityStep, 0.0025);
+  EXPECT_DOUBLE_EQ(h.collisionStep, 0.005);
+  EXPECT_EQ(h.maxIter, 5);
+  EXPECT_DOUBLE_EQ(h.epsilon, 0.0001);
+  EXPECT_EQ(h.hairLengths, std::vector<double>(8, 0.01));
+  EXPECT_DOUBLE_EQ(h.hairDensity, 80);
+  EXPECT_DOUBLE_EQ(h.hairRadius1, 0.000035);
+  EXPECT_DOUBLE_EQ(h.hairRadius2, 0.000050);
+  EXPECT_DOUBLE_EQ(h.helixRadius, 0.05);
+  EXPECT_DOUBLE_EQ(h.helixStep, 0.05);
+  EXPECT_DOUBLE_EQ(h.poisson, 0.48);
+  EXPECT_DOUBLE_EQ(h.young, 1e9);
+  EXPECT_DOUBLE_EQ(h.density, 13000);
+  EXPECT_DOUBLE_EQ(h.gravity, 9.81);
+}
+
+TEST(ThesisConfigs, AppendixBCollisionParsesAsPrinted) {
+  Collision c = readCollision(readConfigText(thesis("appendix-b/Properties/Collision/Collision1.txt")), {});
+  ASSERT_EQ(c.shapes.size(), 2u);
+  EXPECT_EQ(c.shapes[0].kind, ShapeKind::kEllipsoid);  // "Elipsoid", the thesis' spelling
+  EXPECT_DOUBLE_EQ(c.shapes[0].volume, 0.04);
+  EXPECT_DOUBLE_EQ(c.shapes[0].penalty, 10.0);
+  EXPECT_EQ(c.shapes[0].centre, glm::dvec3(0.0, 0.07, 0.01));
+  EXPECT_EQ(c.shapes[0].halfExtents, glm::dvec3(0.08, 0.08, 0.11));
+  EXPECT_EQ(c.shapes[0].axes, glm::dmat3(1.0));
+  EXPECT_EQ(c.shapes[1].kind, ShapeKind::kSphere);
+  EXPECT_DOUBLE_EQ(c.shapes[1].volume, -0.02);
+  EXPECT_DOUBLE_EQ(c.shapes[1].penalty, 0.01);
+  EXPECT_EQ(c.shapes[1].centre, glm::dvec3(0.0, 0.04, 0.16));
+  EXPECT_DOUBLE_EQ(c.shapes[1].halfExtents.x, 0.10);
+}
+
+TEST(ThesisConfigs, AppendixBVisualityParsesAsPrinted) {
+  Visuality v = readVisuality(readConfigText(thesis("appendix-b/Properties/Visuality/Visuality1.txt")), {});
+  EXPECT_EQ(v.ambientColor, glm::dvec3(0.392, 0.584, 0.929));
+  EXPECT_EQ(v.diffuseColor, glm::dvec3(0.471, 0.235, 0.0));
+  EXPECT_EQ(v.specularColor, glm::dvec3(0.2, 0.2, 0.2));
+  EXPECT_DOUBLE_EQ(v.glossiness, 60);
+}
+
+struct CoupeTable {
+  int coupe;
+  std::vector<double> lengths;
+  double density, helixRadius, helixStep;
+  glm::dvec3 diffuse, specular;
+  size_t shapes;
+  double ellipsoidVolume;
+};
+
+class ThesisCoupe : public ::testing::TestWithParam<CoupeTable> {};
+
+TEST_P(ThesisCoupe, ParsesToAppendixCTables) {
+  const CoupeTable& t = GetParam();
+  Config c = loadConfig(thesis("coupe" + std::to_string(t.coupe) + "/setup.txt"), {}, SetupUse::kCheck);
+  EXPECT_FALSE(c.setup.load);
+  EXPECT_EQ(c.hairstyle.hairLengths, t.lengths);
+  EXPECT_DOUBLE_EQ(c.hairstyle.hairDensity, t.density);
+  EXPECT_DOUBLE_EQ(c.hairstyle.helixRadius, t.helixRadius);
+  EXPECT_DOUBLE_EQ(c.hairstyle.helixStep, t.helixStep);
+  EXPECT_EQ(c.hairstyle.maxIter, 20);
+  EXPECT_DOUBLE_EQ(c.hairstyle.epsilon, 0.0001);
+  EXPECT_DOUBLE_EQ(c.hairstyle.young, 1e8);      // the thesis' own value, kept (DESIGN §7)
+  EXPECT_DOUBLE_EQ(c.hairstyle.density, 13000);  // likewise
+  EXPECT_DOUBLE_EQ(c.hairstyle.hairRadius1, 0.000035);
+  EXPECT_DOUBLE_EQ(c.hairstyle.hairRadius2, 0.000050);
+  EXPECT_EQ(c.visuality.ambientColor, glm::dvec3(0.1, 0.1, 0.1));
+  EXPECT_EQ(c.visuality.diffuseColor, t.diffuse);
+  EXPECT_EQ(c.visuality.specularColor, t.specular);
+  ASSERT_EQ(c.collision.shapes.size(), t.shapes);
+  EXPECT_EQ(c.collision.shapes[0].centre, glm::dvec3(-0.001, 0.068, 0.010));
+  EXPECT_EQ(c.collision.shapes[0].halfExtents, glm::dvec3(0.080, 0.080, 0.110));
+  EXPECT_DOUBLE_EQ(c.collision.shapes[0].volume, t.ellipsoidVolume);
+  EXPECT_DOUBLE_EQ(c.collision.shapes[0].penalty, 10.0);
+}
+
+INSTANTIATE_TEST_SUITE_P(
+    Tables, ThesisCoupe,
+    ::testing::Values(CoupeTable{1, {0.01}, 750, 0.002, 0.005, {0, 0, 0}, {0.5, 0.5, 0.5}, 1, 0.0},
+                      CoupeTable{2, {0.02, 0.02, 0.02, 0.02}, 100, 0.05, 0.05, {0.45, 0.25, 0}, {0.2, 0.2, 0.2}, 1, 0.0},
+                      CoupeTable{3, {0.04, 0.04, 0.04, 0.04}, 80, 0.025, 0.025, {0.45, 0.25, 0}, {0.2, 0.2, 0.2}, 2, 0.04},
+                      CoupeTable{4, {0.04, 0.04, 0.04, 0.04}, 80, 4.0, 0.025, {0.90, 0.65, 0.10}, {0.2, 0.2, 0.2}, 2, 0.0}),
+    [](const auto& p) { return "Coupe" + std::to_string(p.param.coupe); });
+
+TEST(ThesisConfigs, Coupe3FrontSphereAsTable11) {
+  Config c = loadConfig(thesis("coupe3/setup.txt"), {}, SetupUse::kCheck);
+  const CollisionShape& s = c.collision.shapes[1];
+  EXPECT_EQ(s.kind, ShapeKind::kSphere);
+  EXPECT_DOUBLE_EQ(s.volume, 0.15);
+  EXPECT_DOUBLE_EQ(s.penalty, 0.01);
+  EXPECT_EQ(s.centre, glm::dvec3(0.0, 0.033, 0.165));
+  EXPECT_DOUBLE_EQ(s.halfExtents.x, 0.080);
+}
+
+TEST(ConfigErrors, UnknownKeyNamesLineAndSuggestsClosest) {
+  std::string m = inputError([] { readHairstyle(text("HairLengths 0.1\n\nHairDensty 80\n", "h.txt"), {}); });
+  EXPECT_NE(m.find("h.txt:3:"), std::string::npos) << m;
+  EXPECT_NE(m.find("did you mean 'HairDensity'"), std::string::npos) << m;
+}
+
+TEST(ConfigErrors, KeyOfAnotherSectionSaysWhereItBelongs) {
+  std::string m = inputError([] { readHairstyle(text("HairLengths 0.1\nGlossiness 60\n", "h.txt"), {}); });
+  EXPECT_NE(m.find("h.txt:2:"), std::string::npos) << m;
+  EXPECT_NE(m.find("belongs in Visuality Info"), std::string::npos) << m;
+}
+
+TEST(ConfigErrors, DuplicateKeyNamesBothLines) {
+  std::string m = inputError([] { readHairstyle(text("HairLengths 0.1\nMaxIter 3\nmaxiter 4\n", "h.txt"), {}); });
+  EXPECT_NE(m.find("h.txt:3:"), std::string::npos) << m;
+  EXPECT_NE(m.find("h.txt:2"), std::string::npos) << m;
+}
+
+TEST(ConfigErrors, MissingRequiredKeyNamesFileAndExample) {
+  std::string m = inputError([] { readHairstyle(text("MaxIter 3\n", "h.txt"), {}); });
+  EXPECT_NE(m.find("h.txt: missing required key 'HairLengths'"), std::string::npos) << m;
+}
+
+TEST(ConfigErrors, MalformedNumberNamesLine) {
+  std::string m = inputError([] { readHairstyle(text("HairLengths 0.1\nYoung 1e9x\n", "h.txt"), {}); });
+  EXPECT_NE(m.find("h.txt:2:"), std::string::npos) << m;
+  EXPECT_NE(m.find("not a number"), std::string::npos) << m;
+}
+
+TEST(ConfigErrors, NonFiniteNumberIsRejected) {
+  for (const char* bad : {"nan", "inf", "-inf", "1e999"}) {
+    std::string m = inputError([&] { readHairstyle(text(std::string("HairLengths 0.1\nGravity ") + bad + "\n", "h.txt"), {}); });
+    EXPECT_NE(m.find("h.txt:2:"), std::string::npos) << bad << ": " << m;
+  }
+}
+
+TEST(ConfigErrors, OutOfRangeSaysTheRange) {
+  std::string m = inputError([] { readHairstyle(text("HairLengths 0.1 -0.2\n", "h.txt"), {}); });
+  EXPECT_NE(m.find("h.txt:1:"), std::string::npos) << m;
+  EXPECT_NE(m.find("out of range"), std::string::npos) << m;
+  EXPECT_NE(inputError([] { readHairstyle(text("HairLengths 0.1\nMaxIter 0\n"), {}); }).find("out of range"), std::string::npos);
+  EXPECT_NE(inputError([] { readHairstyle(text("HairLengths 0.1\nPoisson 0.7\n"), {}); }).find("out of range"), std::string::npos);
+  EXPECT_NE(inputError([] { readHairstyle(text("HairLengths 0.1\nHairDensity -1\n"), {}); }).find("out of range"), std::string::npos);
+}
+
+TEST(ConfigErrors, WrongValueCountNamesLine) {
+  std::string m = inputError([] { readVisuality(text("AmbientColor 0.1 0.1\n", "v.txt"), {}); });
+  EXPECT_NE(m.find("v.txt:1:"), std::string::npos) << m;
+  EXPECT_NE(m.find("takes 3 values, found 2"), std::string::npos) << m;
+  m = inputError([] { readCollision(text("# shapes\nSphere 0 1 0 0 0\n", "c.txt"), {}); });
+  EXPECT_NE(m.find("c.txt:2:"), std::string::npos) << m;
+}
+
+TEST(ConfigErrors, IntegerKeyRejectsFraction) {
+  std::string m = inputError([] { readHairstyle(text("HairLengths 0.1\nMaxIter 2.5\n", "h.txt"), {}); });
+  EXPECT_NE(m.find("not an integer"), std::string::npos) << m;
+}
+
+TEST(ConfigErrors, DegenerateCollisionAxesAreRejected) {
+  std::string m = inputError([] { readCollision(text("Ellipsoid 0 1 0 0 0 1 1 1 1 0 0 1 0 0 0 0 1\n", "c.txt"), {}); });
+  EXPECT_NE(m.find("parallel"), std::string::npos) << m;
+}
+
+TEST(ConfigErrors, UnterminatedQuoteNamesLine) {
+  std::string m = inputError([] { parseConfigText("Load false\nWickModel \"wick.obj\n", "s.txt", "."); });
+  EXPECT_NE(m.find("s.txt:2:"), std::string::npos) << m;
+}
+
+TEST(ConfigErrors, LoadWithoutLoadFileNamesTheLoadLine) {
+  std::string m = inputError([] { readSetup(text("# setup\nLoad true\n", "s.txt"), {}); });
+  EXPECT_NE(m.find("s.txt:2:"), std::string::npos) << m;
+  EXPECT_NE(m.find("LoadFile"), std::string::npos) << m;
+}
+
+TEST(ConfigErrors, SetupNamingMissingFileNamesSetupLine) {
+  test::TempDir dir("config");
+  std::ofstream(dir / "setup.txt") << "Load false\nHairstyleInfo hair.txt\nWickModel missing.obj\n";
+  std::ofstream(dir / "hair.txt") << "HairLengths 0.1\n";
+  std::string m = inputError([&] { loadConfig(dir / "setup.txt", {}, SetupUse::kGrow); });
+  EXPECT_NE(m.find("setup.txt:3:"), std::string::npos) << m;
+  EXPECT_NE(m.find("does not exist"), std::string::npos) << m;
+}
+
+TEST(Config, KeysAreCaseInsensitiveCommentsAndQuotesWork) {
+  hairgen::Setup s = readSetup(text("LOAD   false  # trailing comment\nwickmodel \"my wick.obj\"\nLoadPath a.hair\n"), {});
+  EXPECT_FALSE(s.load);
+  EXPECT_EQ(s.wickModel.path.filename(), "my wick.obj");
+  EXPECT_EQ(s.loadFile.path.filename(), "a.hair");  // LoadPath, the thesis' other spelling
+}
+
+TEST(Config, MissingKeysTakePhysicalDefaults) {
+  Hairstyle h = readHairstyle(text("HairLengths 0.04\n"), {});
+  EXPECT_DOUBLE_EQ(h.density, 1300.0);  // Table 3, not the examples' 13000
+  EXPECT_DOUBLE_EQ(h.young, 2.0e9);     // Table 1
+  EXPECT_DOUBLE_EQ(h.helixRadius, 0.0);
+  EXPECT_GT(h.hairRadius1, h.hairRadius2);
+}
+
+TEST(Overrides, ReplaceAValueAndAddAMissingOne) {
+  std::vector<Override> o = {parseOverride("Hairstyle.HairDensity=160"), parseOverride("hairstyle.clump=0.5")};
+  Hairstyle h = readHairstyle(text("HairLengths 0.1\nHairDensity 80\n"), o);
+  EXPECT_DOUBLE_EQ(h.hairDensity, 160);
+  EXPECT_DOUBLE_EQ(h.clump, 0.5);
+  EXPECT_EQ(o[0].text, "Hairstyle.HairDensity=160");
+}
+
+TEST(Overrides, MultiValueAndRepeatableKeys) {
+  std::vector<Override> o = {parseOverride("Collision.Sphere=0 1 0 0 0.2 0.05"), parseOverride("Hairstyle.HairLengths=0.02 0.03")};
+  Collision c = readCollision(text("Sphere 0 1 0 0 0 1\nSphere 0 1 1 1 1 1\nEllipsoid 0 1 0 0 0 1 1 1 1 0 0 0 1 0 0 0 1\n"), o);
+  ASSERT_EQ(c.shapes.size(), 2u);
+  EXPECT_EQ(c.shapes[0].kind, ShapeKind::kEllipsoid);
+  EXPECT_EQ(c.shapes[1].centre, glm::dvec3(0, 0, 0.2));
+  EXPECT_EQ(readHairstyle(text("HairLengths 0.1\n"), o).hairLengths, (std::vector<double>{0.02, 0.03}));
+}
+
+TEST(Overrides, BadOverridesAreInputErrors) {
+  EXPECT_NE(inputError([] { parseOverride("HairDensity=3"); }).find("Section.Key=VALUE"), std::string::npos);
+  EXPECT_NE(inputError([] { parseOverride("Hairstyl.HairDensity=3"); }).find("did you mean 'Hairstyle'"), std::string::npos);
+  EXPECT_NE(inputError([] { parseOverride("Hairstyle.Density="); }).find("no value"), std::string::npos);
+  std::string m = inputError([] { readHairstyle(text("HairLengths 0.1\n"), {parseOverride("Hairstyle.Gravity=abc")}); });
+  EXPECT_NE(m.find("--set Hairstyle.Gravity=abc"), std::string::npos) << m;
+}
+
+TEST(Config, DigestFollowsValuesNotFormatting) {
+  Config a, b;
+  a.hairstyle = readHairstyle(text("HairLengths 0.1\nYoung 2e9\n"), {});
+  b.hairstyle = readHairstyle(text("# comment\nhairlengths   0.10\nYoung 2000000000\n"), {});
+  EXPECT_EQ(a.digest(), b.digest());
+  b.hairstyle.young = 1e9;
+  EXPECT_NE(a.digest(), b.digest());
+}
+
+}  // namespace
+}  // namespace hairgen

@@ -1,0 +1,161 @@
+// The .hair cache: cyHair compatibility, byte-for-byte round trips, and hostile files.
+#include <gtest/gtest.h>
+
+#include <cstring>
+
+#include "libcore/error.h"
+#include "libcore/file_util.h"
+#include "libcore/hair_io.h"
+#include "tests/test_util.h"
+
+namespace hairgen {
+namespace {
+
+// A minimal cyHair reader written from the published layout alone: header, then the arrays the flags
+// name. It knows nothing of hairgen's chunk block.
+struct CyHair {
+  uint32_t strands = 0, points = 0, flags = 0, defaultSegments = 0;
+  std::vector<uint16_t> segments;
+  std::vector<float> xyz, thickness;
+  size_t bytesRead = 0;
+};
+
+CyHair readCyHair(const std::vector<uint8_t>& file) {
+  CyHair h;
+  EXPECT_EQ(std::memcmp(file.data(), "HAIR", 4), 0);
+  std::memcpy(&h.strands, &file[4], 4);
+  std::memcpy(&h.points, &file[8], 4);
+  std::memcpy(&h.flags, &file[12], 4);
+  std::memcpy(&h.defaultSegments, &file[16], 4);
+  size_t pos = 128;
+  if (h.flags & 1) {
+    h.segments.resize(h.strands);
+    std::memcpy(h.segments.data(), &file[pos], 2 * h.strands);
+    pos += 2 * h.strands;
+  }
+  h.xyz.resize(3 * h.points);
+  std::memcpy(h.xyz.data(), &file[pos], 12 * h.points);
+  pos += 12 * h.points;
+  if (h.flags & 4) {
+    h.thickness.resize(h.points);
+    std::memcpy(h.thickness.data(), &file[pos], 4 * h.points);
+    pos += 4 * h.points;
+  }
+  if (h.flags & 8) pos += 4 * h.points;
+  if (h.flags & 16) pos += 12 * h.points;
+  h.bytesRead = pos;
+  return h;
+}
+
+TEST(HairFile, WrittenFileRoundTripsByteForByte) {
+  Strands s = test::sampleStrands();
+  std::vector<uint8_t> bytes = encodeHair(s);
+  Strands back = decodeHair(bytes.data(), bytes.size(), "mem.hair");
+  test::expectSameStrands(back, s);
+  EXPECT_EQ(encodeHair(back), bytes);
+}
+
+TEST(HairFile, FileOnDiskRoundTripsByteForByte) {
+  test::TempDir dir("hair");
+  Strands s = test::sampleStrands(30, 5);
+  writeHair(dir / "a.hair", s);
+  writeHair(dir / "b.hair", readHair(dir / "a.hair"));
+  EXPECT_EQ(readFileBytes(dir / "a.hair"), readFileBytes(dir / "b.hair"));
+}
+
+TEST(HairFile, CyHairReaderReadsCoreAndStopsBeforeChunks) {
+  Strands s = test::sampleStrands();
+  std::vector<uint8_t> bytes = encodeHair(s);
+  CyHair h = readCyHair(bytes);
+  EXPECT_EQ(h.strands, s.strandCount());
+  EXPECT_EQ(h.points, s.pointCount());
+  ASSERT_EQ(h.segments.size(), s.strandCount());
+  for (size_t i = 0; i < s.strandCount(); ++i) EXPECT_EQ(h.segments[i] + 1u, s.pointsOf(i));
+  for (size_t p = 0; p < s.pointCount(); ++p) {
+    EXPECT_EQ(h.xyz[3 * p], s.points[p].x);
+    EXPECT_EQ(h.xyz[3 * p + 2], s.points[p].z);
+    EXPECT_EQ(h.thickness[p], s.thickness[p]);
+  }
+  ASSERT_LT(h.bytesRead, bytes.size());
+  EXPECT_EQ(std::memcmp(&bytes[h.bytesRead], "HGEN", 4), 0);  // the chunk block starts where cyHair ends
+}
+
+TEST(HairFile, UniformStrandsUseDefaultSegmentsAndReadBack) {
+  Strands s;
+  for (int i = 0; i < 5; ++i) s.addStrand({glm::vec3(i, 0, 0), glm::vec3(i, 1, 0), glm::vec3(i, 2, 0)});
+  std::vector<uint8_t> bytes = encodeHair(s);
+  CyHair h = readCyHair(bytes);
+  EXPECT_EQ(h.flags & 1, 0u);
+  EXPECT_EQ(h.defaultSegments, 2u);
+  EXPECT_EQ(decodeHair(bytes.data(), bytes.size(), "u.hair"), s);
+}
+
+TEST(HairFile, EveryTruncationIsAnInputError) {
+  std::vector<uint8_t> bytes = encodeHair(test::sampleStrands(4));
+  size_t cyHairEnd = readCyHair(bytes).bytesRead;  // cut exactly there, it is a valid plain cyHair file
+  for (size_t length = 0; length < bytes.size(); ++length)
+    if (length != cyHairEnd) {
+      EXPECT_THROW(decodeHair(bytes.data(), length, "t.hair"), InputError) << "length " << length;
+    }
+}
+
+TEST(HairFile, BitFlipsInChunksFailTheirCrc) {
+  std::vector<uint8_t> bytes = encodeHair(test::sampleStrands(4));
+  size_t block = readCyHair(bytes).bytesRead + 12;
+  for (size_t i = block; i < bytes.size(); i += 7) {
+    std::vector<uint8_t> flipped = bytes;
+    flipped[i] ^= 0x10;
+    EXPECT_THROW(decodeHair(flipped.data(), flipped.size(), "f.hair"), InputError) << "byte " << i;
+  }
+}
+
+TEST(HairFile, OversizedCountsAreRejectedBeforeAllocating) {
+  std::vector<uint8_t> bytes = encodeHair(test::sampleStrands(4));
+  for (uint32_t count : {0xffffffffu, 0x10000000u, 100000u}) {
+    std::vector<uint8_t> bad = bytes;
+    std::memcpy(&bad[8], &count, 4);  // points
+    EXPECT_THROW(decodeHair(bad.data(), bad.size(), "o.hair"), InputError);
+    bad = bytes;
+    std::memcpy(&bad[4], &count, 4);  // strands
+    EXPECT_THROW(decodeHair(bad.data(), bad.size(), "o.hair"), InputError);
+  }
+  // A chunk claiming 2^60 bytes.
+  std::vector<uint8_t> bad = bytes;
+  size_t chunkLength = readCyHair(bytes).bytesRead + 12 + 4;
+  uint64_t huge = uint64_t(1) << 60;
+  std::memcpy(&bad[chunkLength], &huge, 8);
+  EXPECT_THROW(decodeHair(bad.data(), bad.size(), "o.hair"), InputError);
+}
+
+TEST(HairFile, GarbageAfterArraysAndBadMagicAreErrors) {
+  std::vector<uint8_t> bytes = encodeHair(test::sampleStrands(2));
+  std::vector<uint8_t> trailing = bytes;
+  trailing.push_back(0);
+  EXPECT_THROW(decodeHair(trailing.data(), trailing.size(), "g.hair"), InputError);
+  std::vector<uint8_t> magic = bytes;
+  magic[0] = 'X';
+  EXPECT_THROW(decodeHair(magic.data(), magic.size(), "g.hair"), InputError);
+}
+
+TEST(HairFile, ErrorsNameTheFile) {
+  std::vector<uint8_t> bytes = encodeHair(test::sampleStrands(2));
+  try {
+    decodeHair(bytes.data(), 100, "named.hair");
+    FAIL();
+  } catch (const InputError& e) {
+    EXPECT_EQ(std::string(e.what()).rfind("named.hair: truncated", 0), 0u) << e.what();
+    EXPECT_EQ(e.code(), ExitCode::kBadInput);
+  }
+}
+
+TEST(HairFile, RealCyHairFilesRead) {
+  if (!std::filesystem::exists(test::realData())) GTEST_SKIP() << "shared/testdata/real is absent";
+  Strands straight = readHair(test::realData() / "luxcore" / "straight.hair");  // no segments array
+  EXPECT_EQ(straight.strandCount(), 10000u);
+  EXPECT_EQ(straight.pointCount(), 160000u);
+  Strands bangs = readHair(test::realData() / "hairutil" / "Bangs_100.hair");  // a segments array
+  EXPECT_EQ(bangs.strandCount(), 100u);
+}
+
+}  // namespace
+}  // namespace hairgen

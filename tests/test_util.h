@@ -1,0 +1,94 @@
+// Helpers shared by the unit tests: sample data generated in code, temporary directories.
+#pragma once
+
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <random>
+#include <string>
+
+#include "libcore/config.h"
+#include "libcore/strands.h"
+
+namespace hairgen::test {
+
+inline std::filesystem::path sourceDir() { return HAIRGEN_SOURCE_DIR; }
+inline std::filesystem::path realData() { return sourceDir() / ".." / "shared" / "testdata" / "real"; }
+
+// A fresh directory under the system temp dir, removed on destruction.
+class TempDir {
+ public:
+  explicit TempDir(const std::string& tag) {
+    path_ = std::filesystem::temp_directory_path() /
+            ("hairgen-test-" + tag + "-" + std::to_string(std::random_device{}()));
+    std::filesystem::create_directories(path_);
+  }
+  ~TempDir() {
+    std::error_code ec;
+    std::filesystem::remove_all(path_, ec);
+  }
+  const std::filesystem::path& path() const { return path_; }
+  std::filesystem::path operator/(const std::string& name) const { return path_ / name; }
+
+ private:
+  std::filesystem::path path_;
+};
+
+// Strands of unequal lengths carrying every optional attribute, with deterministic values.
+inline Strands sampleStrands(size_t count = 7, uint32_t seed = 1) {
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<float> u(-1.0f, 1.0f);
+  Strands s;
+  for (size_t i = 0; i < count; ++i) {
+    std::vector<glm::vec3> points;
+    size_t n = 2 + (i * 3) % 9;
+    glm::vec3 p(u(rng), u(rng), u(rng));
+    for (size_t k = 0; k < n; ++k) points.push_back(p + glm::vec3(0.01f * k, -0.02f * k, 0.003f * k * k));
+    s.addStrand(points);
+    s.strandId.push_back(static_cast<uint32_t>(1000 + i));
+    s.rootTriangle.push_back(static_cast<uint32_t>(i * 7));
+    s.rootBary.push_back(glm::vec3(0.2f, 0.3f, 0.5f));
+    s.rootUv.push_back(glm::vec2(0.1f * i, 0.5f));
+    s.guideIds.push_back(glm::uvec3(i, i + 1, i + 2));
+    s.guideWeights.push_back(glm::vec3(0.5f, 0.25f, 0.25f));
+  }
+  for (size_t p = 0; p < s.pointCount(); ++p) {
+    s.tangents.push_back(glm::normalize(glm::vec3(u(rng), u(rng), 1.5f)));
+    s.normals.push_back(glm::normalize(glm::vec3(1.5f, u(rng), u(rng))));
+    s.colors.push_back(glm::vec3(0.5f + 0.4f * u(rng), 0.3f, 0.1f));
+    s.thickness.push_back(7e-5f + 1e-5f * u(rng));
+    s.transparency.push_back(0.25f + 0.2f * u(rng));
+  }
+  s.provenance = {"hairgen test", "unit", 42, "0123456789abcdef"};
+  return s;
+}
+
+// Compares two strand sets field by field, so a failure names the attribute that differs.
+inline void expectSameStrands(const Strands& a, const Strands& b) {
+  EXPECT_EQ(a.points, b.points);
+  EXPECT_EQ(a.firstPoint, b.firstPoint);
+  EXPECT_EQ(a.tangents, b.tangents);
+  EXPECT_EQ(a.normals, b.normals);
+  EXPECT_EQ(a.colors, b.colors);
+  EXPECT_EQ(a.thickness, b.thickness);
+  EXPECT_EQ(a.transparency, b.transparency);
+  EXPECT_EQ(a.strandId, b.strandId);
+  EXPECT_EQ(a.rootTriangle, b.rootTriangle);
+  EXPECT_EQ(a.rootBary, b.rootBary);
+  EXPECT_EQ(a.rootUv, b.rootUv);
+  EXPECT_EQ(a.guideIds, b.guideIds);
+  EXPECT_EQ(a.guideWeights, b.guideWeights);
+  EXPECT_EQ(a.defaultThickness, b.defaultThickness);
+  EXPECT_EQ(a.defaultTransparency, b.defaultTransparency);
+  EXPECT_EQ(a.defaultColor, b.defaultColor);
+  EXPECT_EQ(a.provenance.producer, b.provenance.producer);
+  EXPECT_EQ(a.provenance.stage, b.provenance.stage);
+  EXPECT_EQ(a.provenance.seed, b.provenance.seed);
+  EXPECT_EQ(a.provenance.configDigest, b.provenance.configDigest);
+}
+
+inline ConfigText text(const std::string& body, const std::string& name = "test.txt") {
+  return parseConfigText(body, name, ".");
+}
+
+}  // namespace hairgen::test
