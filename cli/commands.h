@@ -10,5 +10,6 @@ void registerInfo(CLI::App& app, int& exitCode);
 void registerConvert(CLI::App& app, int& exitCode);
 void registerCheck(CLI::App& app, int& exitCode);
 void registerAssets(CLI::App& app, int& exitCode);
+void registerGrow(CLI::App& app, int& exitCode);
 
 }  // namespace hairgen::cli

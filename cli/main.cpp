@@ -18,6 +18,7 @@ int main(int argc, char** argv) {
   app.set_version_flag("--version", "hairgen " HAIRGEN_VERSION);
 
   int exitCode = 0;
+  registerGrow(app, exitCode);
   registerInfo(app, exitCode);
   registerConvert(app, exitCode);
   registerCheck(app, exitCode);

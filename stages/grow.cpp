@@ -1,0 +1,95 @@
+// grow: follicle frames (§4.1.4.1), Rosenbrock minimisation of each guide's energy from its rest shape
+// (§4.1.3), then sampling of the Super-Helix every VisualityStep (§4.1.4.2).
+#include "stages/grow.h"
+
+#include <cmath>
+
+#include <tbb/parallel_for.h>
+
+#include "libcore/error.h"
+
+namespace hairgen {
+
+GuideReport growGuide(const RodFrame& root, double envelope, const Hairstyle& style, const Collision& collision) {
+  StrandEnergy energy(style, collision, root, envelope);
+  RosenbrockOptions options;
+  options.maxStages = style.maxIter;
+  options.epsilon = style.epsilon;
+  options.energyScale = energy.energyScale();
+  std::vector<double> q0 = energy.restCoordinates(), steps = energy.initialSteps();
+  bool finite = true;
+  auto f = [&](std::span<const double> q) {
+    double e = energy(q);
+    if (!std::isfinite(e)) {
+      finite = false;
+      return HUGE_VAL;
+    }
+    return e;
+  };
+  RosenbrockResult result = minimizeRosenbrock(f, q0, steps, options);
+  GuideReport report;
+  report.coordinates = result.x;
+  report.start = energy.terms(q0);
+  report.end = energy.terms(result.x);
+  report.stages = result.stages;
+  report.evaluations = result.evaluations;
+  report.stop = result.stop;
+  if (!finite || !std::isfinite(report.start.total()) || !std::isfinite(report.end.total()))
+    throw NumericError("the energy is not finite for this guide");
+  return report;
+}
+
+GrowResult grow(const Mesh& wick, const Hairstyle& style, const Collision& collision, const GrowOptions& options) {
+  const size_t count = wick.vertexCount();
+  if (count == 0) throw InputError("the wick has no vertices");
+  if (style.hairLengths.empty()) throw InputError("HairLengths is empty");
+  for (size_t i = 0; i < count; ++i) {
+    const glm::vec3& n = wick.normals[i];
+    if (!std::isfinite(n.x) || !std::isfinite(n.y) || !std::isfinite(n.z) || glm::length(n) < 1e-6f)
+      throw InputError("wick vertex " + std::to_string(i) + " has a zero or non-finite normal; a follicle needs a direction");
+  }
+  float yMin = wick.positions[0].y, yMax = yMin;
+  for (const glm::vec3& p : wick.positions) {
+    yMin = std::min(yMin, p.y);
+    yMax = std::max(yMax, p.y);
+  }
+
+  GrowResult result;
+  result.reports.resize(count);
+  std::vector<std::string> failures(count);
+  tbb::parallel_for(size_t(0), count, [&](size_t i) {
+    double envelope = yMax > yMin ? (double(wick.positions[i].y) - yMin) / (double(yMax) - yMin) : 0.0;
+    RodFrame root = follicleFrame(glm::dvec3(wick.positions[i]), glm::dvec3(wick.normals[i]));
+    try {
+      result.reports[i] = growGuide(root, envelope, style, collision);
+      result.reports[i].follicle = static_cast<uint32_t>(i);
+    } catch (const NumericError& e) {
+      failures[i] = e.what();
+    }
+  });
+  for (size_t i = 0; i < count; ++i)
+    if (!failures[i].empty()) throw NumericError("guide " + std::to_string(i) + ": " + failures[i]);
+
+  // Sample every guide; fixed order, so the output is the same for any thread count.
+  const std::vector<double> s = sampleArcLengths(style.totalLength(), style.visualityStep, true);
+  Strands& guides = result.guides;
+  guides.points.reserve(count * s.size());
+  guides.tangents.reserve(count * s.size());
+  std::vector<glm::dvec3> positions, tangents;
+  for (size_t i = 0; i < count; ++i) {
+    RodFrame root = follicleFrame(glm::dvec3(wick.positions[i]), glm::dvec3(wick.normals[i]));
+    sampleRod(root, style.hairLengths, result.reports[i].coordinates, s, positions, &tangents);
+    for (size_t k = 0; k < s.size(); ++k) {
+      guides.points.push_back(glm::vec3(positions[k]));
+      guides.tangents.push_back(glm::vec3(tangents[k]));
+    }
+    guides.firstPoint.push_back(static_cast<uint32_t>(guides.points.size()));
+    guides.strandId.push_back(static_cast<uint32_t>(i));
+    result.evaluations += result.reports[i].evaluations;
+  }
+  guides.defaultThickness = static_cast<float>(style.hairRadius1 + style.hairRadius2);  // a diameter
+  guides.provenance = {"hairgen " HAIRGEN_VERSION, "grow", style.seed, options.configDigest};
+  return result;
+}
+
+}  // namespace hairgen

@@ -1,0 +1,44 @@
+// The grow stage: one Super-Helix guide per wick vertex, at the static equilibrium of elasticity,
+// gravity and penalty collisions (Lansink 2010 §4.1.1-4.1.4.2, DESIGN §5).
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "libcore/mesh.h"
+#include "libcore/params.h"
+#include "libcore/rosenbrock.h"
+#include "libcore/strand_energy.h"
+#include "libcore/strands.h"
+
+namespace hairgen {
+
+struct GrowOptions {
+  std::string configDigest;  // recorded in the guides' provenance
+};
+
+// What minimisation did for one guide.
+struct GuideReport {
+  uint32_t follicle = 0;
+  std::vector<double> coordinates;  // the 3N generalised coordinates found, 1/m
+  EnergyTerms start, end;           // joules
+  int stages = 0;
+  int evaluations = 0;
+  RosenbrockStop stop = RosenbrockStop::kMaxStages;
+};
+
+struct GrowResult {
+  Strands guides;  // one strand per wick vertex, in vertex order; points every VisualityStep, tangents
+  std::vector<GuideReport> reports;
+  long long evaluations = 0;
+};
+
+// Grows every guide (in parallel; the result does not depend on the thread count). Throws InputError
+// for a wick vertex with a zero or non-finite normal and NumericError naming the guide whose energy is
+// not finite.
+GrowResult grow(const Mesh& wick, const Hairstyle& style, const Collision& collision, const GrowOptions& options);
+
+// One guide, for tests and benchmarks.
+GuideReport growGuide(const RodFrame& root, double envelope, const Hairstyle& style, const Collision& collision);
+
+}  // namespace hairgen
