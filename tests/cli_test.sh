@@ -17,10 +17,10 @@ case "$case" in
 help)
   expect_rc 0 "$hairgen" --help
   grep -q "Exit codes" "$tmp/out" || fail "--help lists no exit codes"
-  for cmd in info convert check assets; do
+  for cmd in grow info convert check assets; do
     grep -q "^  $cmd" "$tmp/out" || fail "--help does not list $cmd"
   done
-  for cmd in info convert check assets; do
+  for cmd in grow info convert check assets; do
     expect_rc 0 "$hairgen" "$cmd" --help
     for flag in --threads --quiet --stats; do grep -q -- "$flag" "$tmp/out" || fail "$cmd --help lacks $flag"; done
     grep -q "Exit codes" "$tmp/out" || fail "$cmd --help lists no exit codes"
@@ -69,6 +69,17 @@ real_cyhair)
   cmp -n "$core" "$tmp/back.hair" "$tmp/direct.hair" || fail "points changed through .glb"
   expect_rc 0 "$hairgen" info "$tmp/s.glb" --json
   grep -q '"points": 160000' "$tmp/out" || fail "glb info"
+  ;;
+grow_errors)
+  printf 'HairLengths 0.04\nMaxIter 0\n' > "$tmp/h.txt"
+  printf 'HairstyleInfo h.txt\nWickModel %s\n' "$src/configs/assets/wick.obj" > "$tmp/setup.txt"
+  expect_rc 2 "$hairgen" grow "$tmp/setup.txt" -o "$tmp/g.hair"
+  grep -q "h.txt:2:" "$tmp/err" || fail "MaxIter 0 not located: $(cat "$tmp/err")"
+  [ ! -e "$tmp/g.hair" ] || fail "output written after an error"
+  printf 'v 0 0 0\nv 1 0 0\nv 0 1 0\nvn 0 0 0\nf 1//1 2//1 3//1\n' > "$tmp/flat.obj"
+  printf 'HairLengths 0.04\n' > "$tmp/h.txt"
+  printf 'HairstyleInfo h.txt\nWickModel flat.obj\n' > "$tmp/setup.txt"
+  expect_rc 0 "$hairgen" grow "$tmp/setup.txt" -o "$tmp/g.glb" --quiet  # zero file normals: computed ones are used
   ;;
 wick_info)
   expect_rc 0 "$hairgen" info "$src/configs/assets/wick.obj"

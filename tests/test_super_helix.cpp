@@ -1,0 +1,129 @@
+// Super-Helix kinematics and energy: properties the geometry and physics guarantee.
+#include <gtest/gtest.h>
+
+#include <random>
+
+#include "libcore/strand_energy.h"
+#include "libcore/super_helix.h"
+
+namespace hairgen {
+namespace {
+
+RodFrame verticalRoot() { return follicleFrame(glm::dvec3(0.01, 0.2, -0.03), glm::dvec3(0.3, 1.0, 0.2)); }
+
+TEST(SuperHelix, FollicleFrameIsOrthonormalAndUsesUpAsUp) {
+  RodFrame f = follicleFrame(glm::dvec3(0.0), glm::dvec3(0.0, 0.0, 2.0));
+  EXPECT_NEAR(glm::length(f.n0 - glm::dvec3(0, 0, 1)), 0.0, 1e-15);
+  EXPECT_NEAR(glm::length(f.n1 - glm::dvec3(-1, 0, 0)), 0.0, 1e-15);  // n0 × (0,1,0)
+  EXPECT_NEAR(glm::dot(f.n1, f.n2), 0.0, 1e-15);
+  RodFrame up = follicleFrame(glm::dvec3(0.0), glm::dvec3(0.0, 1.0, 0.0));
+  EXPECT_EQ(up.n1, glm::dvec3(0.0, 0.0, 1.0));  // the parallel case falls back to +z
+}
+
+TEST(SuperHelix, RestShapeIsTheExactHelix) {
+  // A rod at its rest coordinates is a helix of the configured radius and rise per turn.
+  const double radius = 0.01, step = 0.05;
+  RestShape rest = restShape(radius, step);
+  std::vector<double> lengths(4, 0.04), q;
+  for (int e = 0; e < 4; ++e) q.insert(q.end(), {rest.tau, rest.kappa1, rest.kappa2});
+  RodFrame root = verticalRoot();
+  std::vector<double> s = sampleArcLengths(0.16, 0.0005, true);
+  std::vector<glm::dvec3> p;
+  sampleRod(root, lengths, q, s, p, nullptr);
+  // The helix axis is the Darboux vector; distance of every point to the axis is the radius, and the
+  // advance along it per turn is the step.
+  glm::dvec3 w = darbouxVector(root, rest.tau, rest.kappa1, rest.kappa2);
+  glm::dvec3 axis = glm::normalize(w);
+  double omega = glm::length(w);
+  glm::dvec3 centre = root.position + glm::cross(w, root.n0) / (omega * omega);  // axis point, r = 1/Ω² · |W×n0|
+  for (size_t i = 0; i < p.size(); ++i) {
+    glm::dvec3 v = p[i] - centre;
+    glm::dvec3 radial = v - glm::dot(v, axis) * axis;
+    EXPECT_NEAR(glm::length(radial), radius, 1e-6 * radius) << "sample " << i;
+  }
+  double turn = 2.0 * M_PI / omega;  // arc length of one turn
+  std::vector<glm::dvec3> ends;
+  std::vector<double> two = {0.0, turn};
+  sampleRod(root, lengths, q, two, ends, nullptr);
+  EXPECT_NEAR(glm::dot(ends[1] - ends[0], axis), step, 1e-6 * step);
+}
+
+TEST(SuperHelix, ZeroHelixRadiusMeansStraight) {
+  RestShape rest = restShape(0.0, 0.05);
+  EXPECT_EQ(rest.kappa1, 0.0);
+  EXPECT_EQ(rest.tau, 0.0);
+}
+
+TEST(SuperHelix, SampledArcLengthEqualsTotalLength) {
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<double> k(-200.0, 200.0);
+  std::vector<double> lengths = {0.03, 0.05, 0.02, 0.06}, q;
+  for (int i = 0; i < 12; ++i) q.push_back(k(rng));
+  std::vector<double> s = sampleArcLengths(0.16, 0.00002, true);
+  EXPECT_DOUBLE_EQ(s.back(), 0.16);
+  std::vector<glm::dvec3> p;
+  sampleRod(verticalRoot(), lengths, q, s, p, nullptr);
+  double arc = 0.0;
+  for (size_t i = 1; i < p.size(); ++i) arc += glm::length(p[i] - p[i - 1]);
+  EXPECT_NEAR(arc, 0.16, 1e-6 * 0.16);
+}
+
+TEST(SuperHelix, PositionAndTangentAreContinuousAcrossJoints) {
+  std::vector<double> lengths = {0.04, 0.04, 0.04}, q = {50, -80, 120, 0, 300, -10, -90, 5, 60};
+  double joints[] = {0.04, 0.08};
+  for (double j : joints) {
+    std::vector<double> s = {j - 1e-9, j, j + 1e-9};
+    std::vector<glm::dvec3> p, t;
+    sampleRod(verticalRoot(), lengths, q, s, p, &t);
+    EXPECT_NEAR(glm::length(p[2] - p[0]), 2e-9, 1e-12);
+    EXPECT_NEAR(glm::length(t[2] - t[0]), 0.0, 1e-6);
+    std::vector<glm::dvec3> tangentsOnly;
+  }
+}
+
+TEST(SuperHelix, SeriesAndClosedFormAgreeAtTheSwitch) {
+  // Just below and above the series threshold the frame must move continuously in κ.
+  RodFrame root = verticalRoot();
+  double l = 0.04;
+  for (double omega : {0.05 / l * 0.999999, 0.05 / l * 1.000001}) {
+    RodFrame a = advance(root, omega * root.n1, l);
+    RodFrame b = advance(root, 0.05 / l * root.n1, l);
+    EXPECT_NEAR(glm::length(a.position - b.position), 0.0, 1e-8);
+  }
+  RodFrame straight = advance(root, glm::dvec3(0.0), l);
+  EXPECT_NEAR(glm::length(straight.position - (root.position + l * root.n0)), 0.0, 1e-18);
+}
+
+TEST(SuperHelix, ClosedFormGravityMatchesQuadrature) {
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> k(-300.0, 300.0);
+  for (int trial = 0; trial < 20; ++trial) {
+    std::vector<double> lengths = {0.04, 0.03, 0.05, 0.04}, q;
+    for (int i = 0; i < 12; ++i) q.push_back(trial == 0 ? 0.0 : k(rng) * (trial % 3 == 0 ? 1e-4 : 1.0));
+    RodFrame root = verticalRoot();
+    // Composite Simpson on 20000 intervals of ∫ (y(s) − y(0)) ds.
+    const int n = 20000;
+    std::vector<double> s(n + 1);
+    for (int i = 0; i <= n; ++i) s[i] = 0.16 * i / n;
+    std::vector<glm::dvec3> p;
+    sampleRod(root, lengths, q, s, p, nullptr);
+    double sum = 0.0;
+    for (int i = 0; i <= n; ++i) sum += (i == 0 || i == n ? 1 : (i % 2 ? 4 : 2)) * (p[i].y - root.position.y);
+    double quadrature = sum * (0.16 / n) / 3.0;
+    double closed = heightIntegral(root, lengths, q);
+    EXPECT_NEAR(closed, quadrature, 1e-9 * std::max(std::abs(quadrature), 1e-6)) << "trial " << trial;
+  }
+}
+
+TEST(StrandEnergy, PenetrationFollowsEachShapesDefinition) {
+  CollisionShape sphere{ShapeKind::kSphere, 0, 1, glm::dvec3(0), glm::dvec3(0.1), glm::dmat3(1.0), {}};
+  EXPECT_NEAR(penetration(sphere, {0.07, 0, 0}), 0.03, 1e-15);
+  CollisionShape ellipsoid{ShapeKind::kEllipsoid, 0, 1, glm::dvec3(0), glm::dvec3(0.2, 0.1, 0.1), glm::dmat3(1.0), {}};
+  EXPECT_NEAR(penetration(ellipsoid, {0.1, 0, 0}), 0.1, 1e-15);
+  EXPECT_NEAR(penetration(ellipsoid, {0, 0.2, 0}), -0.1, 1e-15);
+  CollisionShape cuboid{ShapeKind::kCuboid, 0, 1, glm::dvec3(0), glm::dvec3(0.2, 0.1, 0.3), glm::dmat3(1.0), {}};
+  EXPECT_NEAR(penetration(cuboid, {0.15, 0.02, 0}), 0.05, 1e-15);
+}
+
+}  // namespace
+}  // namespace hairgen
