@@ -1,6 +1,4 @@
 // hairgen grow SETUP -o guides.{hair,gltf,glb}: one Super-Helix guide per wick vertex.
-#include <fstream>
-
 #include "cli/commands.h"
 #include "cli/common.h"
 #include "libcore/file_util.h"

@@ -88,9 +88,10 @@ void sampleRod(const RodFrame& root, std::span<const double> lengths, std::span<
 }
 
 double heightIntegral(const RodFrame& root, std::span<const double> lengths, std::span<const double> q) {
-  // ∫0^L (r(s) − r0) ds = Σ_Q [ℓ_Q (r_Q(0) − r0) + ∫0^ℓ (r_Q(u) − r_Q(0)) du], and the element integral is
-  // ℓ n0 ℓ/2 + d(ℓ)(W×n0) + e(ℓ)(W×(W×n0)) with d = ∫ b = (x − sin x)/Ω³ ... integrated once more:
-  //   ∫0^ℓ b(u) du = (x − sin x)/Ω³,   ∫0^ℓ c(u) du = (x²/2 − 1 + cos x)/Ω⁴.
+  // ∫0^L (r(s) − r0) ds = Σ_Q [ℓ_Q (r_Q(0) − r0) + ∫0^ℓ (r_Q(u) − r_Q(0)) du], and integrating the
+  // centreline of the file comment over one element gives
+  //   ∫0^ℓ (r_Q(u) − r_Q(0)) du = ℓ²/2 n0 + ib (W×n0) + ic (W×(W×n0)),
+  //   ib = ∫0^ℓ b du = (x − sin x)/Ω³,   ic = ∫0^ℓ c du = (x²/2 − 1 + cos x)/Ω⁴.
   double total = 0.0;
   RodFrame start = root;
   for (size_t e = 0; e < lengths.size(); ++e) {

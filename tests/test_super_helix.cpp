@@ -77,7 +77,6 @@ TEST(SuperHelix, PositionAndTangentAreContinuousAcrossJoints) {
     sampleRod(verticalRoot(), lengths, q, s, p, &t);
     EXPECT_NEAR(glm::length(p[2] - p[0]), 2e-9, 1e-12);
     EXPECT_NEAR(glm::length(t[2] - t[0]), 0.0, 1e-6);
-    std::vector<glm::dvec3> tangentsOnly;
   }
 }
 
