@@ -27,6 +27,19 @@ double penetration(const CollisionShape& shape, const glm::dvec3& p) {
   return 0.0;
 }
 
+namespace {
+
+double boundingRadius(const CollisionShape& shape) {
+  switch (shape.kind) {
+    case ShapeKind::kSphere: return shape.halfExtents.x;
+    case ShapeKind::kEllipsoid: return std::max(shape.halfExtents.x, std::max(shape.halfExtents.y, shape.halfExtents.z));
+    case ShapeKind::kCuboid: return glm::length(shape.halfExtents);
+  }
+  return 0.0;
+}
+
+}  // namespace
+
 StrandEnergy::StrandEnergy(const Hairstyle& style, const Collision& collision, const RodFrame& root, double envelope)
     : lengths_(style.hairLengths), root_(root), rest_(restShape(style.helixRadius, style.helixStep)),
       collisionStep_(style.collisionStep) {
@@ -38,9 +51,45 @@ StrandEnergy::StrandEnergy(const Hairstyle& style, const Collision& collision, c
   bend2_ = 0.5 * style.young * i2;
   twist_ = 0.5 * mu * j;
   weight_ = style.density * M_PI * a * b * style.gravity;
-  for (const CollisionShape& s : collision.shapes)
-    if (s.penalty > 0.0) shapes_.push_back({s, s.volume * envelope});
-  if (!shapes_.empty()) samples_ = sampleArcLengths(style.totalLength(), style.collisionStep, false);
+  for (const CollisionShape& s : collision.shapes) {
+    if (!(s.penalty > 0.0)) continue;
+    double extra = s.volume * envelope;
+    double reach = boundingRadius(s) + std::max(extra, 0.0);
+    Shape shape{s, extra, reach * reach, {}, HUGE_VAL};
+    if (s.kind == ShapeKind::kEllipsoid) {
+      for (int k = 0; k < 3; ++k) shape.scaledAxes[k] = s.axes[k] / s.halfExtents[k];
+      double minHalf = std::min(s.halfExtents.x, std::min(s.halfExtents.y, s.halfExtents.z));
+      double ratio = 1.0 + std::max(extra, 0.0) / minHalf;
+      shape.ratio2Outside = ratio * ratio;
+    }
+    shapes_.push_back(shape);
+  }
+  if (shapes_.empty()) return;
+
+  // Samples every CollisionStep after the root, the last at the tip; each belongs to the element
+  // it ends in (a sample on a joint to the earlier element).
+  std::vector<double> s = sampleArcLengths(style.totalLength(), collisionStep_, false);
+  samples_.resize(lengths_.size());
+  size_t i = 0;
+  double elementStart = 0.0;
+  for (size_t k = 0; k < lengths_.size(); ++k) {
+    const double l = lengths_[k];
+    const bool last = k + 1 == lengths_.size();
+    ElementSamples& out = samples_[k];
+    for (; i < s.size() && (s[i] <= elementStart + l || last); ++i) {
+      double u = std::min(s[i] - elementStart, l);
+      if (out.gridCount == 0) {
+        out.first = u;
+        out.gridCount = 1;
+      } else if (out.offGrid.empty() &&
+                 std::abs(u - (out.first + static_cast<double>(out.gridCount) * collisionStep_)) < 1e-12) {
+        ++out.gridCount;
+      } else {
+        out.offGrid.push_back(u);
+      }
+    }
+    elementStart += l;
+  }
 }
 
 std::vector<double> StrandEnergy::restCoordinates() const {
@@ -60,59 +109,54 @@ std::vector<double> StrandEnergy::initialSteps() const {
   return steps;
 }
 
+double StrandEnergy::penalty(const glm::dvec3& p) const {
+  // penetration() per kind (equal to it within rounding), with the cheap rejections first.
+  double sum = 0.0;
+  for (const Shape& shape : shapes_) {
+    const glm::dvec3 v = p - shape.shape.centre;
+    const double dist2 = glm::dot(v, v);
+    if (dist2 >= shape.reach2) continue;
+    double dent;
+    if (shape.shape.kind == ShapeKind::kEllipsoid) {
+      glm::dvec3 scaled(glm::dot(v, shape.scaledAxes[0]), glm::dot(v, shape.scaledAxes[1]), glm::dot(v, shape.scaledAxes[2]));
+      const double ratio2 = glm::dot(scaled, scaled);
+      if (ratio2 >= shape.ratio2Outside) continue;
+      if (!(ratio2 > 0.0)) {
+        dent = penetration(shape.shape, p);
+      } else {
+        const double dist = std::sqrt(dist2);  // |local| = |v|: the axes are orthonormal
+        dent = dist / std::sqrt(ratio2) - dist;
+      }
+    } else if (shape.shape.kind == ShapeKind::kSphere) {
+      dent = shape.shape.halfExtents.x - std::sqrt(dist2);
+    } else {
+      dent = penetration(shape.shape, p);
+    }
+    double d = dent + shape.extra;
+    if (d > 0.0) sum += 0.5 * shape.shape.penalty * d * d;
+  }
+  return sum;
+}
+
 EnergyTerms StrandEnergy::terms(std::span<const double> q) const {
   EnergyTerms e;
   for (size_t k = 0; k < lengths_.size(); ++k) {
     double dt = q[3 * k] - rest_.tau, d1 = q[3 * k + 1] - rest_.kappa1, d2 = q[3 * k + 2] - rest_.kappa2;
     e.elastic += lengths_[k] * (bend1_ * d1 * d1 + bend2_ * d2 * d2 + twist_ * dt * dt);
   }
-  if (weight_ != 0.0) e.gravity = weight_ * heightIntegral(root_, lengths_, q);
-  if (!shapes_.empty()) {
-    // Walk the samples element by element; within an element each collision step is the same rigid
-    // motion, so positions follow by one rotation and one translation per sample (no trig).
-    double penalty = 0.0;
-    RodFrame start = root_;
-    double elementStart = 0.0;
-    size_t i = 0;
-    for (size_t k = 0; k < lengths_.size(); ++k) {
-      const double l = lengths_[k];
-      const glm::dvec3 w = darbouxVector(start, q[3 * k], q[3 * k + 1], q[3 * k + 2]);
-      const bool last = k + 1 == lengths_.size();
-      if (i < samples_.size() && (samples_[i] <= elementStart + l || last)) {
-        RodFrame f = advance(start, w, std::min(samples_[i] - elementStart, l));
-        // One collision step as a rotation R about w and a displacement in the element's start frame.
-        RodFrame unit{glm::dvec3(0.0), start.n0, start.n1, start.n2};
-        RodFrame stepped = advance(unit, w, collisionStep_);
-        glm::dmat3 toStart(start.n0, start.n1, start.n2), atStep(stepped.n0, stepped.n1, stepped.n2);
-        glm::dmat3 rotation = atStep * glm::transpose(toStart);
-        glm::dvec3 displacement = stepped.position;
-        glm::dmat3 current = glm::dmat3(f.n0, f.n1, f.n2) * glm::transpose(toStart);
-        glm::dvec3 p = f.position;
-        double s = samples_[i];
-        while (true) {
-          for (const Shape& shape : shapes_) {
-            double d = penetration(shape.shape, p) + shape.extra;
-            if (d > 0.0) penalty += 0.5 * shape.shape.penalty * d * d;
-          }
-          ++i;
-          if (i >= samples_.size() || (samples_[i] > elementStart + l && !last)) break;
-          double next = samples_[i];
-          if (std::abs(next - s - collisionStep_) > 1e-12) {  // the shorter last interval
-            RodFrame g = advance(start, w, std::min(next - elementStart, l));
-            p = g.position;
-            current = glm::dmat3(g.n0, g.n1, g.n2) * glm::transpose(toStart);
-          } else {
-            p += current * displacement;
-            current = rotation * current;
-          }
-          s = next;
-        }
-      }
-      start = advance(start, w, l);
-      elementStart += l;
-    }
-    e.collision = penalty * collisionStep_;
-  }
+  // One walk along the rod gives both the height integral (§4.1.1.3.2, closed form per element) and
+  // the collision samples (two sin/cos pairs per element, whatever the number of samples).
+  double height = 0.0, penalty = 0.0;
+  forEachElement(root_, lengths_, q, [&](const HelixElement& element, double, size_t k) {
+    height += element.length() * (element.start().position.y - root_.position.y) + element.displacementIntegral().y;
+    if (shapes_.empty()) return;
+    const ElementSamples& samples = samples_[k];
+    element.visitGrid(samples.first, collisionStep_, samples.gridCount,
+                      [&](size_t, const glm::dvec3& p) { penalty += this->penalty(p); });
+    for (double u : samples.offGrid) penalty += this->penalty(element.position(u));
+  });
+  e.gravity = weight_ * height;
+  e.collision = penalty * collisionStep_;
   return e;
 }
 

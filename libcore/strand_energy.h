@@ -43,14 +43,28 @@ class StrandEnergy {
   struct Shape {
     CollisionShape shape;
     double extra;
+    double reach2;  // (bounding radius + extra)²: a point farther from the centre cannot touch
+    // Ellipsoids: the axes divided by their semi-axes, and the squared "ratio" |local/half|² beyond
+    // which dent + extra ≤ 0 (dist ≥ ratio·min semi-axis bounds the dent by −min·(ratio − 1)).
+    glm::dvec3 scaledAxes[3];
+    double ratio2Outside;
   };
+  // The collision samples of one element: a grid u = first + j·CollisionStep, j < gridCount, and
+  // the samples off that grid (the tip, when CollisionStep does not divide the length).
+  struct ElementSamples {
+    double first = 0.0;
+    size_t gridCount = 0;
+    std::vector<double> offGrid;
+  };
+  double penalty(const glm::dvec3& p) const;
+
   std::vector<double> lengths_;
   RodFrame root_;
   RestShape rest_;
   double bend1_, bend2_, twist_;  // E I1 / 2, E I2 / 2, μ J / 2
   double weight_;                 // ρ S g, newtons per metre
   std::vector<Shape> shapes_;
-  std::vector<double> samples_;   // collision sample arc lengths
+  std::vector<ElementSamples> samples_;
   double collisionStep_;
 };
 

@@ -12,22 +12,12 @@
 namespace hairgen {
 namespace {
 
-constexpr double kSeriesBelow = 0.05;  // |Ω u| below which the Taylor series is used (error < 1e-17)
+using Coefficients = HelixCoefficients;
 
-struct Coefficients {
-  double a, b, c;
-};
-
-Coefficients coefficients(double omega, double u) {
+Coefficients coefficients(double omega, double invOmega, double u) {
   double x = omega * u;
-  if (std::abs(x) < kSeriesBelow) {
-    double x2 = x * x;
-    return {u * (1.0 - x2 / 6.0 * (1.0 - x2 / 20.0 * (1.0 - x2 / 42.0))),
-            u * u * (0.5 - x2 / 24.0 * (1.0 - x2 / 30.0 * (1.0 - x2 / 56.0))),
-            u * u * u * (1.0 / 6.0 - x2 / 120.0 * (1.0 - x2 / 42.0 * (1.0 - x2 / 72.0)))};
-  }
-  double s = std::sin(x), c = std::cos(x);
-  return {s / omega, (1.0 - c) / (omega * omega), (x - s) / (omega * omega * omega)};
+  if (std::abs(x) < kHelixSeriesBelow) return helixCoefficients(omega, invOmega, u, 1.0, 0.0);
+  return helixCoefficients(omega, invOmega, u, std::cos(x), std::sin(x));
 }
 
 glm::dvec3 rotate(const glm::dvec3& v, const glm::dvec3& w, const Coefficients& k) {
@@ -48,15 +38,56 @@ RodFrame follicleFrame(const glm::dvec3& root, const glm::dvec3& normal) {
   return f;
 }
 
-RodFrame advance(const RodFrame& start, const glm::dvec3& darboux, double u) {
-  Coefficients k = coefficients(glm::length(darboux), u);
+HelixElement::HelixElement(const RodFrame& start, const glm::dvec3& darboux, double length)
+    : start_(start), w_(darboux), omega_(glm::length(darboux)), invOmega_(omega_ > 0.0 ? 1.0 / omega_ : 0.0),
+      length_(length) {
+  wn0_ = glm::cross(w_, start.n0);
+  wwn0_ = glm::cross(w_, wn0_);
+  double x = omega_ * length;
+  sinL_ = std::abs(x) < kHelixSeriesBelow ? 0.0 : std::sin(x);
+  cosL_ = std::abs(x) < kHelixSeriesBelow ? 1.0 : std::cos(x);
+  Coefficients k = helixCoefficients(omega_, invOmega_, length, cosL_, sinL_);
+  end_.position = start.position + length * start.n0 + k.b * wn0_ + k.c * wwn0_;
+  end_.n0 = rotate(start.n0, w_, k);
+  end_.n1 = rotate(start.n1, w_, k);
+  end_.n2 = glm::cross(end_.n0, end_.n1);  // the frame stays right-handed; one rotation fewer
+}
+
+glm::dvec3 HelixElement::position(double u) const {
+  Coefficients k = coefficients(omega_, invOmega_, u);
+  return start_.position + u * start_.n0 + k.b * wn0_ + k.c * wwn0_;
+}
+
+RodFrame HelixElement::frame(double u) const {
+  Coefficients k = coefficients(omega_, invOmega_, u);
   RodFrame f;
-  glm::dvec3 wn0 = glm::cross(darboux, start.n0);
-  f.position = start.position + u * start.n0 + k.b * wn0 + k.c * glm::cross(darboux, wn0);
-  f.n0 = rotate(start.n0, darboux, k);
-  f.n1 = rotate(start.n1, darboux, k);
-  f.n2 = rotate(start.n2, darboux, k);
+  f.position = start_.position + u * start_.n0 + k.b * wn0_ + k.c * wwn0_;
+  f.n0 = rotate(start_.n0, w_, k);
+  f.n1 = rotate(start_.n1, w_, k);
+  f.n2 = rotate(start_.n2, w_, k);
   return f;
+}
+
+glm::dvec3 HelixElement::displacementIntegral() const {
+  // Integrating the centreline of the file comment over the element:
+  //   ∫0^ℓ (r(u) − r(0)) du = ℓ²/2 n0 + ib (W×n0) + ic (W×(W×n0)),
+  //   ib = ∫0^ℓ b du = (x − sin x)/Ω³,   ic = ∫0^ℓ c du = (x²/2 − 1 + cos x)/Ω⁴.
+  const double l = length_, x = omega_ * l;
+  double ib, ic;
+  if (std::abs(x) < kHelixSeriesBelow) {
+    double x2 = x * x;
+    ib = l * l * l * (1.0 / 6.0 - x2 / 120.0 * (1.0 - x2 / 42.0 * (1.0 - x2 / 72.0)));
+    ic = l * l * l * l * (1.0 / 24.0 - x2 / 720.0 * (1.0 - x2 / 56.0 * (1.0 - x2 / 90.0)));
+  } else {
+    double inv2 = invOmega_ * invOmega_;
+    ib = (x - sinL_) * inv2 * invOmega_;
+    ic = (0.5 * x * x - 1.0 + cosL_) * inv2 * inv2;
+  }
+  return 0.5 * l * l * start_.n0 + ib * wn0_ + ic * wwn0_;
+}
+
+RodFrame advance(const RodFrame& start, const glm::dvec3& darboux, double u) {
+  return HelixElement(start, darboux, u).end();
 }
 
 RestShape restShape(double helixRadius, double helixStep) {
@@ -70,49 +101,24 @@ void sampleRod(const RodFrame& root, std::span<const double> lengths, std::span<
                std::span<const double> s, std::vector<glm::dvec3>& positions, std::vector<glm::dvec3>* tangents) {
   positions.resize(s.size());
   if (tangents) tangents->resize(s.size());
-  RodFrame start = root;
-  double elementStart = 0.0;
   size_t i = 0;
-  for (size_t e = 0; e < lengths.size(); ++e) {
-    const double length = lengths[e];
-    const glm::dvec3 w = darbouxVector(start, q[3 * e], q[3 * e + 1], q[3 * e + 2]);
+  forEachElement(root, lengths, q, [&](const HelixElement& element, double elementStart, size_t e) {
+    const double end = elementStart + element.length();
     const bool last = e + 1 == lengths.size();
-    for (; i < s.size() && (s[i] <= elementStart + length || last); ++i) {
-      RodFrame f = advance(start, w, std::min(s[i] - elementStart, length));
+    for (; i < s.size() && (s[i] <= end || last); ++i) {
+      RodFrame f = element.frame(std::min(s[i] - elementStart, element.length()));
       positions[i] = f.position;
       if (tangents) (*tangents)[i] = glm::normalize(f.n0);
     }
-    start = advance(start, w, length);
-    elementStart += length;
-  }
+  });
 }
 
 double heightIntegral(const RodFrame& root, std::span<const double> lengths, std::span<const double> q) {
-  // ∫0^L (r(s) − r0) ds = Σ_Q [ℓ_Q (r_Q(0) − r0) + ∫0^ℓ (r_Q(u) − r_Q(0)) du], and integrating the
-  // centreline of the file comment over one element gives
-  //   ∫0^ℓ (r_Q(u) − r_Q(0)) du = ℓ²/2 n0 + ib (W×n0) + ic (W×(W×n0)),
-  //   ib = ∫0^ℓ b du = (x − sin x)/Ω³,   ic = ∫0^ℓ c du = (x²/2 − 1 + cos x)/Ω⁴.
+  // ∫0^L (r(s) − r0) ds = Σ_Q [ℓ_Q (r_Q(0) − r0) + ∫0^ℓ (r_Q(u) − r_Q(0)) du].
   double total = 0.0;
-  RodFrame start = root;
-  for (size_t e = 0; e < lengths.size(); ++e) {
-    const double l = lengths[e];
-    const glm::dvec3 w = darbouxVector(start, q[3 * e], q[3 * e + 1], q[3 * e + 2]);
-    const double omega = glm::length(w), x = omega * l;
-    double ib, ic;
-    if (std::abs(x) < kSeriesBelow) {
-      double x2 = x * x;
-      ib = l * l * l * (1.0 / 6.0 - x2 / 120.0 * (1.0 - x2 / 42.0 * (1.0 - x2 / 72.0)));
-      ic = l * l * l * l * (1.0 / 24.0 - x2 / 720.0 * (1.0 - x2 / 56.0 * (1.0 - x2 / 90.0)));
-    } else {
-      double o2 = omega * omega;
-      ib = (x - std::sin(x)) / (o2 * omega);
-      ic = (0.5 * x * x - 1.0 + std::cos(x)) / (o2 * o2);
-    }
-    glm::dvec3 wn0 = glm::cross(w, start.n0);
-    glm::dvec3 inner = 0.5 * l * l * start.n0 + ib * wn0 + ic * glm::cross(w, wn0);
-    total += l * (start.position.y - root.position.y) + inner.y;
-    start = advance(start, w, l);
-  }
+  forEachElement(root, lengths, q, [&](const HelixElement& element, double, size_t) {
+    total += element.length() * (element.start().position.y - root.position.y) + element.displacementIntegral().y;
+  });
   return total;
 }
 

@@ -3,6 +3,8 @@
 
 #include <random>
 
+#include <glm/gtc/matrix_transform.hpp>
+
 #include "libcore/strand_energy.h"
 #include "libcore/super_helix.h"
 
@@ -122,6 +124,43 @@ TEST(StrandEnergy, PenetrationFollowsEachShapesDefinition) {
   EXPECT_NEAR(penetration(ellipsoid, {0, 0.2, 0}), -0.1, 1e-15);
   CollisionShape cuboid{ShapeKind::kCuboid, 0, 1, glm::dvec3(0), glm::dvec3(0.2, 0.1, 0.3), glm::dmat3(1.0), {}};
   EXPECT_NEAR(penetration(cuboid, {0.15, 0.02, 0}), 0.05, 1e-15);
+}
+
+TEST(StrandEnergy, CollisionTermEqualsDirectSamplingOfEveryShape) {
+  // The energy walks samples by a trigonometric recurrence and rejects far shapes early; it must
+  // equal Δs Σ ½k max(penetration + extra, 0)² evaluated point by point from sampleRod.
+  Hairstyle style;
+  style.hairLengths = {0.035, 0.05, 0.04};  // 0.125 m: the last sample is off the 4 mm grid
+  style.collisionStep = 0.004;
+  Collision collision;
+  glm::dmat3 tilted = glm::dmat3(glm::rotate(glm::dmat4(1.0), 0.4, glm::dvec3(1, 2, 0.5)));
+  collision.shapes = {
+      {ShapeKind::kEllipsoid, 0.03, 10.0, glm::dvec3(0, 0.12, 0), glm::dvec3(0.08, 0.1, 0.11), tilted, {}},
+      {ShapeKind::kSphere, 0.01, 3.0, glm::dvec3(0.05, 0.2, 0.08), glm::dvec3(0.06), glm::dmat3(1.0), {}},
+      {ShapeKind::kCuboid, 0.0, 20.0, glm::dvec3(-0.04, 0.15, 0.0), glm::dvec3(0.05, 0.02, 0.04), tilted, {}}};
+  const double envelope = 0.7;
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> k(-60.0, 60.0);
+  int touching = 0;
+  for (int trial = 0; trial < 20; ++trial) {
+    RodFrame root = follicleFrame(glm::dvec3(0.0, 0.2, 0.0), glm::dvec3(0.3 * k(rng) / 60.0, 1.0, 0.2));
+    std::vector<double> q;
+    for (int i = 0; i < 9; ++i) q.push_back(trial == 0 ? 0.0 : k(rng));
+    StrandEnergy energy(style, collision, root, envelope);
+    std::vector<double> s = sampleArcLengths(style.totalLength(), style.collisionStep, false);
+    std::vector<glm::dvec3> p;
+    sampleRod(root, style.hairLengths, q, s, p, nullptr);
+    double direct = 0.0;
+    for (const glm::dvec3& x : p)
+      for (const CollisionShape& shape : collision.shapes) {
+        double d = penetration(shape, x) + shape.volume * envelope;
+        if (d > 0.0) direct += 0.5 * shape.penalty * d * d;
+      }
+    direct *= style.collisionStep;
+    EXPECT_NEAR(energy.terms(q).collision, direct, 1e-10 * direct + 1e-18) << "trial " << trial;
+    touching += direct > 0.0;
+  }
+  EXPECT_GE(touching, 15);  // the shapes are where the strands go
 }
 
 }  // namespace
