@@ -37,7 +37,8 @@ void registerGrow(CLI::App& app, int& exitCode) {
       auto t1 = std::chrono::steady_clock::now();
       note(options->common, "grow: " + std::to_string(wick.vertexCount()) + " guides from " +
                                 config.setup.wickModel.path.string());
-      GrowResult result = grow(wick, config.hairstyle, config.collision, GrowOptions{config.digest()});
+      Progress progress("grow", "guides", wick.vertexCount(), !options->common.quiet);
+      GrowResult result = grow(wick, config.hairstyle, config.collision, GrowOptions{config.digest(), &progress});
       auto t2 = std::chrono::steady_clock::now();
       if (!options->diagnostics.empty()) {
         nlohmann::ordered_json guides = nlohmann::ordered_json::array();

@@ -66,6 +66,7 @@ GrowResult grow(const Mesh& wick, const Hairstyle& style, const Collision& colli
     } catch (const NumericError& e) {
       failures[i] = e.what();
     }
+    if (options.progress) options.progress->advance();
   });
   for (size_t i = 0; i < count; ++i)
     if (!failures[i].empty()) throw NumericError("guide " + std::to_string(i) + ": " + failures[i]);

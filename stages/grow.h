@@ -7,6 +7,7 @@
 
 #include "libcore/mesh.h"
 #include "libcore/params.h"
+#include "libcore/progress.h"
 #include "libcore/rosenbrock.h"
 #include "libcore/strand_energy.h"
 #include "libcore/strands.h"
@@ -15,6 +16,7 @@ namespace hairgen {
 
 struct GrowOptions {
   std::string configDigest;  // recorded in the guides' provenance
+  Progress* progress = nullptr;  // advanced once per guide
 };
 
 // What minimisation did for one guide.
