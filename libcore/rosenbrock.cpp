@@ -86,7 +86,15 @@ RosenbrockResult minimizeRosenbrock(const std::function<double(std::span<const d
   result.stop = RosenbrockStop::kMaxStages;
   for (int stage = 0; stage < options.maxStages; ++stage) {
     const double stageStart = result.value;
-    step.assign(steps.begin(), steps.end());
+    // A stage starts from the step lengths the last one ended with, expanded once: near the minimum
+    // that saves the evaluations spent shrinking the initial steps again (measured on coupe 3: 15%
+    // fewer evaluations and a lower energy). The floor keeps a direction from starting dead.
+    if (stage == 0) {
+      step.assign(steps.begin(), steps.end());
+    } else {
+      for (size_t i = 0; i < n; ++i)
+        step[i] = std::max(std::abs(step[i]) * options.expand, options.minRestartFraction * std::abs(steps[i]));
+    }
     std::fill(advance.begin(), advance.end(), 0.0);
     std::fill(succeeded.begin(), succeeded.end(), 0);
     std::fill(done.begin(), done.end(), 0);

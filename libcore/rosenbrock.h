@@ -15,6 +15,7 @@ struct RosenbrockOptions {
   double expand = 3.0;           // step factor after a success
   double contract = -0.5;        // step factor after a failure (reverses the direction)
   double minStepFraction = 1e-9; // a direction whose step shrank below this fraction of its initial step is spent
+  double minRestartFraction = 1e-3;  // a new stage's steps: the last ones × expand, at least this × initial
   int maxEvaluations = 1000000;  // hard bound, so a pathological f cannot loop forever
 };
 
