@@ -86,6 +86,11 @@ void validate(std::string_view text, const std::string& name) {
       ++counts[1];
     } else if (tag == "vn") {
       numbers(3, 3, "x y z");
+      double x = *parseReal(words[1]), y = *parseReal(words[2]), z = *parseReal(words[3]);
+      // A follicle grows along its normal: a zero one is a broken export, not something to guess.
+      if (x * x + y * y + z * z < 1e-24)
+        throw InputError(where, "normal of zero length; fix the export, or delete the 'vn' lines (and the //n "
+                                "in the faces) to have hairgen compute area-weighted normals");
       ++counts[2];
     } else if (tag == "f") {
       if (words.size() < 4) throw InputError(where, "a face needs at least three corners");

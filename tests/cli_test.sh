@@ -79,7 +79,9 @@ grow_errors)
   printf 'v 0 0 0\nv 1 0 0\nv 0 1 0\nvn 0 0 0\nf 1//1 2//1 3//1\n' > "$tmp/flat.obj"
   printf 'HairLengths 0.04\n' > "$tmp/h.txt"
   printf 'HairstyleInfo h.txt\nWickModel flat.obj\n' > "$tmp/setup.txt"
-  expect_rc 0 "$hairgen" grow "$tmp/setup.txt" -o "$tmp/g.glb" --quiet  # zero file normals: computed ones are used
+  expect_rc 2 "$hairgen" grow "$tmp/setup.txt" -o "$tmp/g.glb"
+  grep -q "flat.obj:4: normal of zero length" "$tmp/err" || fail "zero normal not located: $(cat "$tmp/err")"
+  [ ! -e "$tmp/g.glb" ] || fail "output written after a zero normal"
   ;;
 wick_info)
   expect_rc 0 "$hairgen" info "$src/configs/assets/wick.obj"
