@@ -1,0 +1,17 @@
+#!/usr/bin/env bash
+# Benchmarks, one group or all: scripts/bench.sh [grow|all] [Google Benchmark flags]
+# Builds Release first. Speed targets are checked here, never by timed unit tests.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+group="${1:-all}"
+[[ $# -gt 0 ]] && shift
+bash scripts/setup.sh --no-build
+cmake -S . -B build -G Ninja -DCMAKE_BUILD_TYPE=Release >/dev/null
+cmake --build build --target hairgen_bench hairgen
+case "$group" in
+  grow) filter='EnergyEvaluation|GrowCoupe3' ;;
+  all) filter='.' ;;
+  *) echo "bench.sh: unknown group '$group' (grow, all)" >&2; exit 2 ;;
+esac
+echo "machine: $(nproc) cores, $(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2 | sed 's/^ //')"
+exec build/tests/hairgen_bench --benchmark_filter="$filter" "$@"

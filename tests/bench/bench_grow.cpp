@@ -1,0 +1,69 @@
+// grow benchmarks on coupe 3 (head ellipsoid and front sphere) and the bundled wick (759 follicles).
+//   EnergyEvaluation: one thread, energies at the minimised coordinates of 50 guides, so
+//                     items_per_second is energy evaluations per second per core.
+//   GrowCoupe3:       the whole grow stage on every core, counters guides/s and evaluations/s.
+#include <benchmark/benchmark.h>
+
+#include <tbb/global_control.h>
+#include <tbb/info.h>
+
+#include "libcore/obj_io.h"
+#include "libcore/setup.h"
+#include "stages/grow.h"
+
+namespace hairgen {
+namespace {
+
+struct Coupe3 {
+  Config config;
+  Mesh wick;
+  Coupe3()
+      : config(loadConfig(std::filesystem::path(HAIRGEN_SOURCE_DIR) / "configs/thesis/coupe3/setup.txt", {}, SetupUse::kGrow)),
+        wick(readObj(config.setup.wickModel.path)) {}
+};
+
+const Coupe3& coupe3() {
+  static const Coupe3 c;
+  return c;
+}
+
+void EnergyEvaluation(benchmark::State& state) {
+  const Coupe3& c = coupe3();
+  const size_t n = c.wick.vertexCount();
+  std::vector<StrandEnergy> energies;
+  std::vector<std::vector<double>> coordinates;
+  for (size_t k = 0; k < 50; ++k) {
+    size_t i = k * n / 50;
+    RodFrame root = follicleFrame(glm::dvec3(c.wick.positions[i]), glm::dvec3(c.wick.normals[i]));
+    energies.emplace_back(c.config.hairstyle, c.config.collision, root, double(k) / 50.0);
+    coordinates.push_back(growGuide(root, double(k) / 50.0, c.config.hairstyle, c.config.collision).coordinates);
+  }
+  size_t k = 0;
+  for (auto _ : state) {
+    benchmark::DoNotOptimize(energies[k](coordinates[k]));
+    k = k + 1 == energies.size() ? 0 : k + 1;
+  }
+  state.SetItemsProcessed(state.iterations());
+}
+BENCHMARK(EnergyEvaluation);
+
+void GrowCoupe3(benchmark::State& state) {
+  const Coupe3& c = coupe3();
+  uint64_t evaluations = 0, guides = 0;
+  for (auto _ : state) {
+    GrowResult g = grow(c.wick, c.config.hairstyle, c.config.collision, {});
+    evaluations += g.evaluations;
+    guides += g.reports.size();
+  }
+  state.counters["guides/s"] = benchmark::Counter(double(guides), benchmark::Counter::kIsRate);
+  state.counters["evals/s"] = benchmark::Counter(double(evaluations), benchmark::Counter::kIsRate);
+  state.counters["evals/s/core"] =
+      benchmark::Counter(double(evaluations) / tbb::info::default_concurrency(), benchmark::Counter::kIsRate);
+  state.counters["follicles"] = double(c.wick.vertexCount());
+}
+BENCHMARK(GrowCoupe3)->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(3.0);
+
+}  // namespace
+}  // namespace hairgen
+
+BENCHMARK_MAIN();
