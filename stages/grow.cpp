@@ -68,6 +68,7 @@ GrowResult grow(const Mesh& wick, const Hairstyle& style, const Collision& colli
     }
     if (options.progress) options.progress->advance();
   });
+  if (options.progress) options.progress->finish();
   for (size_t i = 0; i < count; ++i)
     if (!failures[i].empty()) throw NumericError("guide " + std::to_string(i) + ": " + failures[i]);
 
