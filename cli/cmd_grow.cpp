@@ -9,6 +9,43 @@
 
 namespace hairgen::cli {
 
+namespace {
+
+void writeDiagnostics(const std::string& file, const std::string& setup, const Config& config, const GrowResult& result) {
+  nlohmann::ordered_json guides = nlohmann::ordered_json::array();
+  auto terms = [](const EnergyTerms& e) {
+    return nlohmann::ordered_json{{"elastic", e.elastic}, {"gravity", e.gravity}, {"collision", e.collision}, {"total", e.total()}};
+  };
+  for (const GuideReport& r : result.reports)
+    guides.push_back({{"follicle", r.follicle}, {"coordinates", r.coordinates}, {"start", terms(r.start)},
+                      {"end", terms(r.end)}, {"stages", r.stages}, {"evaluations", r.evaluations},
+                      {"stoppedOn", name(r.stop)}});
+  nlohmann::ordered_json doc = {{"setup", setup}, {"configDigest", config.digest()}, {"guides", guides}};
+  writeFileAtomic(file, doc.dump(1) + "\n");
+}
+
+}  // namespace
+
+GrowResult growStage(const CommonOptions& common, const Config& config, const Mesh& wick, Stats& stats) {
+  note(common, "grow: " + std::to_string(wick.vertexCount()) + " guides from " + config.setup.wickModel.path.string());
+  Stopwatch clock;
+  Progress progress("grow", "guides", wick.vertexCount(), !common.quiet);
+  GrowResult result = grow(wick, config.hairstyle, config.collision, GrowOptions{config.digest(), &progress});
+  double seconds = clock.lap();
+  stats.time("grow", seconds);
+  stats.counts()["guides"] = result.guides.strandCount();
+  stats.counts()["guidePoints"] = result.guides.pointCount();
+  stats.counts()["energyEvaluations"] = result.evaluations;
+  int onEpsilon = 0;
+  for (const GuideReport& r : result.reports)
+    onEpsilon += r.stop == RosenbrockStop::kEpsilon || r.stop == RosenbrockStop::kStalled;
+  stats.counts()["convergedOnEpsilon"] = onEpsilon;
+  stats.counts()["stoppedOnMaxIter"] = static_cast<int>(result.reports.size()) - onEpsilon;
+  note(common, "grow: " + std::to_string(result.guides.strandCount()) + " guides, " +
+                   std::to_string(result.evaluations) + " energy evaluations in " + formatSeconds(seconds));
+  return result;
+}
+
 void registerGrow(CLI::App& app, int& exitCode) {
   struct Options {
     CommonOptions common;
@@ -31,43 +68,15 @@ void registerGrow(CLI::App& app, int& exitCode) {
       hairFormatOf(options->output);
       std::vector<Override> overrides = parseOverrides(options->common);
       stats.setOverrides(overrides);
-      auto t0 = std::chrono::steady_clock::now();
+      Stopwatch clock;
       Config config = loadConfig(options->setup, overrides, SetupUse::kGrow);
       Mesh wick = readObj(config.setup.wickModel.path);
-      auto t1 = std::chrono::steady_clock::now();
-      note(options->common, "grow: " + std::to_string(wick.vertexCount()) + " guides from " +
-                                config.setup.wickModel.path.string());
-      Progress progress("grow", "guides", wick.vertexCount(), !options->common.quiet);
-      GrowResult result = grow(wick, config.hairstyle, config.collision, GrowOptions{config.digest(), &progress});
-      auto t2 = std::chrono::steady_clock::now();
-      if (!options->diagnostics.empty()) {
-        nlohmann::ordered_json guides = nlohmann::ordered_json::array();
-        auto terms = [](const EnergyTerms& e) {
-          return nlohmann::ordered_json{{"elastic", e.elastic}, {"gravity", e.gravity}, {"collision", e.collision}, {"total", e.total()}};
-        };
-        for (const GuideReport& r : result.reports)
-          guides.push_back({{"follicle", r.follicle}, {"coordinates", r.coordinates}, {"start", terms(r.start)},
-                            {"end", terms(r.end)}, {"stages", r.stages}, {"evaluations", r.evaluations},
-                            {"stoppedOn", name(r.stop)}});
-        nlohmann::ordered_json doc = {{"setup", options->setup}, {"configDigest", config.digest()}, {"guides", guides}};
-        writeFileAtomic(options->diagnostics, doc.dump(1) + "\n");
-      }
+      stats.time("read", clock.lap());
+      GrowResult result = growStage(options->common, config, wick, stats);
+      if (!options->diagnostics.empty()) writeDiagnostics(options->diagnostics, options->setup, config, result);
       writeStrands(options->output, result.guides);
-      auto t3 = std::chrono::steady_clock::now();
-      double growSeconds = std::chrono::duration<double>(t2 - t1).count();
-      stats.time("read", std::chrono::duration<double>(t1 - t0).count());
-      stats.time("grow", growSeconds);
-      stats.time("write", std::chrono::duration<double>(t3 - t2).count());
-      stats.counts()["guides"] = result.guides.strandCount();
-      stats.counts()["points"] = result.guides.pointCount();
-      stats.counts()["energyEvaluations"] = result.evaluations;
-      int onEpsilon = 0;
-      for (const GuideReport& r : result.reports) onEpsilon += r.stop == RosenbrockStop::kEpsilon || r.stop == RosenbrockStop::kStalled;
-      stats.counts()["convergedOnEpsilon"] = onEpsilon;
-      stats.counts()["stoppedOnMaxIter"] = static_cast<int>(result.reports.size()) - onEpsilon;
-      note(options->common, "grow: wrote " + options->output + " (" + std::to_string(result.guides.strandCount()) +
-                                " guides, " + std::to_string(result.evaluations) + " energy evaluations, " +
-                                std::to_string(growSeconds) + " s)");
+      stats.time("write", clock.lap());
+      note(options->common, "grow: wrote " + options->output);
       stats.write(options->common);
     });
   });

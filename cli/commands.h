@@ -1,8 +1,17 @@
 // Registration of the hairgen subcommands. Each registers its options and a callback that runs the
-// command and stores its exit code.
+// command and stores its exit code. The *Stage functions are the stage bodies `run` shares with the
+// single-stage commands, so both give the same files.
 #pragma once
 
+#include <string>
+
 #include <CLI/CLI.hpp>
+
+#include "cli/common.h"
+#include "libcore/mesh.h"
+#include "libcore/params.h"
+#include "libcore/strands.h"
+#include "stages/grow.h"
 
 namespace hairgen::cli {
 
@@ -11,5 +20,11 @@ void registerConvert(CLI::App& app, int& exitCode);
 void registerCheck(CLI::App& app, int& exitCode);
 void registerAssets(CLI::App& app, int& exitCode);
 void registerGrow(CLI::App& app, int& exitCode);
+void registerInterpolate(CLI::App& app, int& exitCode);
+void registerRun(CLI::App& app, int& exitCode);
+
+GrowResult growStage(const CommonOptions& common, const Config& config, const Mesh& wick, Stats& stats);
+Strands interpolateStage(const CommonOptions& common, const Config& config, const Mesh& wick, const Strands& guides,
+                         const std::string& guidesName, Stats& stats);
 
 }  // namespace hairgen::cli

@@ -1,5 +1,6 @@
 #include "cli/common.h"
 
+#include <cstdio>
 #include <iostream>
 
 #include <tbb/global_control.h>
@@ -71,6 +72,12 @@ int runCommand(const std::string& command, const CommonOptions& options, const s
     std::cerr << "hairgen " << command << ": error: internal: " << e.what() << "\n";
     return static_cast<int>(ExitCode::kWorkFailed);
   }
+}
+
+std::string formatSeconds(double seconds) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%.2f s", seconds);
+  return text;
 }
 
 void note(const CommonOptions& options, const std::string& line) {

@@ -44,6 +44,23 @@ class Stats {
   nlohmann::ordered_json json_;
 };
 
+// Seconds since construction or the last lap.
+class Stopwatch {
+ public:
+  double lap() {
+    auto now = std::chrono::steady_clock::now();
+    double s = std::chrono::duration<double>(now - last_).count();
+    last_ = now;
+    return s;
+  }
+
+ private:
+  std::chrono::steady_clock::time_point last_ = std::chrono::steady_clock::now();
+};
+
+// "1.23 s"
+std::string formatSeconds(double seconds);
+
 // Runs one command body with the thread limit applied, catching every error once: prints
 // "hairgen CMD: error: FILE:LINE: message" and returns the documented exit code.
 int runCommand(const std::string& command, const CommonOptions& options, const std::function<void()>& body);

@@ -18,7 +18,9 @@ int main(int argc, char** argv) {
   app.set_version_flag("--version", "hairgen " HAIRGEN_VERSION);
 
   int exitCode = 0;
+  registerRun(app, exitCode);
   registerGrow(app, exitCode);
+  registerInterpolate(app, exitCode);
   registerInfo(app, exitCode);
   registerConvert(app, exitCode);
   registerCheck(app, exitCode);

@@ -192,7 +192,7 @@ Config loadConfig(const std::filesystem::path& setupFile, const std::vector<Over
   config.overrides = overrides;
   config.setup = readSetup(readConfigText(setupFile), overrides);
   const Setup& s = config.setup;
-  bool grows = use == SetupUse::kGrow || (use == SetupUse::kRun && !s.load);
+  bool grows = use == SetupUse::kGrow || use == SetupUse::kInterpolate || (use == SetupUse::kRun && !s.load);
 
   auto need = [&](const PathRef& ref, const char* key, const char* why) {
     if (!ref.given()) throw InputError({setupFile.string(), 0}, std::string("missing required key '") + key + "' (" + why + ")");

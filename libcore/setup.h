@@ -19,10 +19,11 @@ RenderSettings readRender(const ConfigText& text, const std::vector<Override>& o
 
 // What the command about to run needs from the Setup.
 enum class SetupUse {
-  kGrow,    // hairstyle, collision and the wick
-  kRender,  // the coupe comes from the command line; visuality, render and the head
-  kRun,     // everything the Setup's Load flag implies
-  kCheck,   // every file the Setup names must exist
+  kGrow,         // hairstyle, collision and the wick
+  kInterpolate,  // the same: density, clump and seed come from the hairstyle, triangles from the wick
+  kRender,       // the coupe comes from the command line; visuality, render and the head
+  kRun,          // everything the Setup's Load flag implies
+  kCheck,        // every file the Setup names must exist
 };
 
 // Reads `setupFile` and every info file it names. A file that is named but missing, or a file the use

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Benchmarks, one group or all: scripts/bench.sh [grow|all] [Google Benchmark flags]
+# Benchmarks, one group or all: scripts/bench.sh [grow|interpolate|all] [Google Benchmark flags]
 # Builds Release first. Speed targets are checked here, never by timed unit tests.
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -10,8 +10,9 @@ cmake -S . -B build -G Ninja -DCMAKE_BUILD_TYPE=Release >/dev/null
 cmake --build build --target hairgen_bench hairgen
 case "$group" in
   grow) filter='EnergyEvaluation|GrowCoupe3' ;;
+  interpolate) filter='InterpolateCoupe3' ;;
   all) filter='.' ;;
-  *) echo "bench.sh: unknown group '$group' (grow, all)" >&2; exit 2 ;;
+  *) echo "bench.sh: unknown group '$group' (grow, interpolate, all)" >&2; exit 2 ;;
 esac
 echo "machine: $(nproc) cores, $(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2 | sed 's/^ //')"
 exec build/tests/hairgen_bench --benchmark_filter="$filter" "$@"

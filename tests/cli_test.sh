@@ -83,6 +83,33 @@ grow_errors)
   grep -q "flat.obj:4: normal of zero length" "$tmp/err" || fail "zero normal not located: $(cat "$tmp/err")"
   [ ! -e "$tmp/g.glb" ] || fail "output written after a zero normal"
   ;;
+run_equals_stages)
+  setup="$src/configs/thesis/coupe2/setup.txt"
+  set_density=(--set Hairstyle.HairDensity=15)
+  expect_rc 0 "$hairgen" run "$setup" -o "$tmp/run" --quiet "${set_density[@]}"
+  expect_rc 0 "$hairgen" grow "$setup" -o "$tmp/g.hair" --quiet --threads 1 "${set_density[@]}"
+  expect_rc 0 "$hairgen" interpolate "$setup" --guides "$tmp/g.hair" -o "$tmp/c.hair" --threads 2 "${set_density[@]}" \
+    --stats "$tmp/stats.json"
+  cmp "$tmp/run/guides.hair" "$tmp/g.hair" || fail "run's guides differ from grow's"
+  cmp "$tmp/run/coupe.hair" "$tmp/c.hair" || fail "run's coupe differs from interpolate's"
+  grep -q '"strands"' "$tmp/stats.json" || fail "no strand count in --stats"
+  expect_rc 0 "$hairgen" convert "$tmp/c.hair" "$tmp/c.glb"
+  expect_rc 0 "$hairgen" convert "$tmp/c.glb" "$tmp/back.hair"
+  cmp "$tmp/c.hair" "$tmp/back.hair" || fail "coupe does not round-trip through GLB"
+  ;;
+interpolate_errors)
+  printf 'v 0 0 0\nv 0.01 0 0\nv 0 0 0.01\nvn 0 1 0\nf 1//1 2//1 3//1\n' > "$tmp/tri.obj"
+  printf 'HairLengths 0.04\n' > "$tmp/h.txt"
+  printf 'HairstyleInfo h.txt\nWickModel tri.obj\n' > "$tmp/tri.txt"
+  expect_rc 0 "$hairgen" grow "$tmp/tri.txt" -o "$tmp/tri.hair" --quiet
+  expect_rc 2 "$hairgen" interpolate "$src/configs/default/setup.txt" --guides "$tmp/tri.hair" -o "$tmp/c.hair"
+  grep -q "tri.hair: has 3 guides but the wick has 759 vertices" "$tmp/err" || fail "mismatch: $(cat "$tmp/err")"
+  head -c 300 "$tmp/tri.hair" > "$tmp/cut.hair"
+  expect_rc 2 "$hairgen" interpolate "$tmp/tri.txt" --guides "$tmp/cut.hair" -o "$tmp/c.hair"
+  grep -q "cut.hair" "$tmp/err" || fail "truncated guides not named: $(cat "$tmp/err")"
+  [ ! -e "$tmp/c.hair" ] || fail "output written after an error"
+  expect_rc 0 "$hairgen" interpolate "$tmp/tri.txt" --guides "$tmp/tri.hair" -o "$tmp/c.glb" --quiet
+  ;;
 wick_info)
   expect_rc 0 "$hairgen" info "$src/configs/assets/wick.obj"
   grep -q "759 vertices, 1443 triangles, area" "$tmp/out" || fail "wick info: $(cat "$tmp/out")"

@@ -1,7 +1,8 @@
-// grow benchmarks on coupe 3 (head ellipsoid and front sphere) and the bundled wick (759 follicles).
-//   EnergyEvaluation: one thread, energies at the minimised coordinates of 50 guides, so
-//                     items_per_second is energy evaluations per second per core.
-//   GrowCoupe3:       the whole grow stage on every core, counters guides/s and evaluations/s.
+// Stage benchmarks on coupe 3 (head ellipsoid and front sphere) and the bundled wick (759 follicles).
+//   EnergyEvaluation:   one thread, energies at the minimised coordinates of 50 guides, so
+//                       items_per_second is energy evaluations per second per core.
+//   GrowCoupe3:         the whole grow stage on every core, counters guides/s and evaluations/s.
+//   InterpolateCoupe3:  ~150,000 strands of 64 vertices from coupe 3's guides, every core.
 #include <benchmark/benchmark.h>
 
 #include <tbb/global_control.h>
@@ -10,6 +11,7 @@
 #include "libcore/obj_io.h"
 #include "libcore/setup.h"
 #include "stages/grow.h"
+#include "stages/interpolate.h"
 
 namespace hairgen {
 namespace {
@@ -62,6 +64,31 @@ void GrowCoupe3(benchmark::State& state) {
   state.counters["follicles"] = double(c.wick.vertexCount());
 }
 BENCHMARK(GrowCoupe3)->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(3.0);
+
+void InterpolateCoupe3(benchmark::State& state) {
+  const Coupe3& c = coupe3();
+  Hairstyle style = c.config.hairstyle;
+  style.visualityStep = style.totalLength() / 63.0;  // 64 vertices per guide and strand
+  const Strands guides = grow(c.wick, style, c.config.collision, {}).guides;
+  double area = 0.0;
+  for (const glm::uvec3& t : c.wick.triangles) {
+    glm::dvec3 a(c.wick.positions[t.x]), b(c.wick.positions[t.y]), d(c.wick.positions[t.z]);
+    area += 0.5 * glm::length(glm::cross(b - a, d - a)) * 1e4;
+  }
+  style.hairDensity = 150000.0 / area;
+  uint64_t strands = 0, points = 0;
+  for (auto _ : state) {
+    Strands coupe = interpolate(c.wick, guides, style, c.config.collision, {});
+    strands += coupe.strandCount();
+    points += coupe.pointCount();
+    benchmark::DoNotOptimize(coupe.points.data());
+  }
+  state.counters["strands"] = double(strands) / double(state.iterations());
+  state.counters["vertices/strand"] = double(points) / double(strands);
+  state.counters["strands/s"] = benchmark::Counter(double(strands), benchmark::Counter::kIsRate);
+  state.counters["vertices/s"] = benchmark::Counter(double(points), benchmark::Counter::kIsRate);
+}
+BENCHMARK(InterpolateCoupe3)->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(3.0);
 
 }  // namespace
 }  // namespace hairgen

@@ -1,0 +1,93 @@
+// hairgen run [SETUP] [-o DIR]: the stages in one process, with the same files the stages give when
+// chained by hand. With no SETUP it runs the bundled default coupe.
+#include <cstdlib>
+#include <filesystem>
+
+#include "cli/commands.h"
+#include "cli/common.h"
+#include "libcore/error.h"
+#include "libcore/hair_cache.h"
+#include "libcore/obj_io.h"
+#include "libcore/setup.h"
+
+namespace hairgen::cli {
+namespace {
+
+namespace fs = std::filesystem;
+
+// configs/default/setup.txt under $HAIRGEN_DATA, beside the executable's build tree (build/ → ..), or
+// in an installed share/hairgen.
+fs::path defaultSetup() {
+  std::vector<fs::path> candidates;
+  if (const char* data = std::getenv("HAIRGEN_DATA"); data && *data) candidates.push_back(fs::path(data) / "configs/default/setup.txt");
+  std::error_code ec;
+  fs::path exe = fs::read_symlink("/proc/self/exe", ec);
+  if (!ec) {
+    for (fs::path dir = exe.parent_path(); !dir.empty() && dir != dir.root_path(); dir = dir.parent_path()) {
+      candidates.push_back(dir / "configs/default/setup.txt");
+      candidates.push_back(dir / "share/hairgen/configs/default/setup.txt");
+    }
+  }
+  for (const fs::path& c : candidates)
+    if (fs::is_regular_file(c, ec)) return c;
+  throw InputError("no SETUP given and the default coupe (configs/default/setup.txt) was not found next to the "
+                   "executable; name a Setup file or set HAIRGEN_DATA to the folder that holds configs/");
+}
+
+}  // namespace
+
+void registerRun(CLI::App& app, int& exitCode) {
+  struct Options {
+    CommonOptions common;
+    std::string setup, outDir;
+  };
+  auto options = std::make_shared<Options>();
+  CLI::App* cmd = app.add_subcommand(
+      "run", "Run the stages in one process: grow and interpolate (or Load a saved coupe), writing DIR/guides.hair "
+             "and DIR/coupe.hair; files equal those of the stages run one by one");
+  cmd->add_option("SETUP", options->setup, "The Setup file (default: the bundled configs/default/setup.txt)");
+  cmd->add_option("-o,--output", options->outDir, "Output folder (default: out/NAME, NAME the Setup's folder)")
+      ->type_name("DIR");
+  addCommonFlags(*cmd, options->common, true);
+  cmd->footer(exitCodeHelp());
+  cmd->callback([options, &exitCode] {
+    exitCode = runCommand("run", options->common, [&] {
+      Stats stats("run");
+      std::vector<Override> overrides = parseOverrides(options->common);
+      stats.setOverrides(overrides);
+      fs::path setup = options->setup.empty() ? defaultSetup() : fs::path(options->setup);
+      fs::path out = options->outDir.empty() ? fs::path("out") / fs::absolute(setup).parent_path().filename() : fs::path(options->outDir);
+      Stopwatch clock;
+      Config config = loadConfig(setup, overrides, SetupUse::kRun);
+      stats.time("read", clock.lap());
+      fs::create_directories(out);
+
+      Strands coupe;
+      if (config.setup.load) {
+        coupe = readStrands(config.setup.loadFile.path);
+        note(options->common, "run: loaded " + config.setup.loadFile.path.string() + " (" +
+                                  std::to_string(coupe.strandCount()) + " strands)");
+      } else {
+        Mesh wick = readObj(config.setup.wickModel.path);
+        stats.time("read", stats.json()["seconds"]["read"].get<double>() + clock.lap());
+        GrowResult grown = growStage(options->common, config, wick, stats);
+        const fs::path guidesFile = out / "guides.hair";
+        clock.lap();
+        writeStrands(guidesFile, grown.guides);
+        double writing = clock.lap();
+        coupe = interpolateStage(options->common, config, wick, grown.guides, guidesFile.string(), stats);
+        clock.lap();
+        writeStrands(out / "coupe.hair", coupe);
+        stats.time("write", writing + clock.lap());
+        note(options->common, "run: wrote " + guidesFile.string() + " and " + (out / "coupe.hair").string());
+      }
+      if (config.setup.save) {
+        writeStrands(config.setup.saveFile.path, coupe);
+        note(options->common, "run: saved the coupe to " + config.setup.saveFile.path.string());
+      }
+      stats.write(options->common);
+    });
+  });
+}
+
+}  // namespace hairgen::cli

@@ -1,0 +1,248 @@
+// interpolate: Lansink 2010 §4.1.4.3-4.1.4.4. Per wick triangle, area × HairDensity strands; each
+// strand's root weights are uniform barycentrics, its tip weights clump to the corner guide nearest
+// the root, and the weights blend linearly from root to tip over the strand's vertices.
+#include "stages/interpolate.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <limits>
+
+#include <tbb/parallel_for.h>
+
+#include "libcore/error.h"
+#include "libcore/random.h"
+
+namespace hairgen {
+namespace {
+
+// The random streams of one key (seed, triangle, strand).
+enum Stream : uint64_t { kRootU1, kRootU2, kTipV1, kTipV2, kCountFraction };
+constexpr uint64_t kTriangleKey = std::numeric_limits<uint64_t>::max();  // "strand" of per-triangle numbers
+
+// Unit tangents of a polyline by forward differences (the last point looks back).
+std::vector<glm::vec3> polylineTangents(const Strands& s) {
+  std::vector<glm::vec3> t(s.pointCount(), glm::vec3(0.0f, 1.0f, 0.0f));
+  for (size_t i = 0; i < s.strandCount(); ++i) {
+    uint32_t first = s.firstPoint[i], last = s.firstPoint[i + 1];
+    glm::vec3 previous(0.0f, 1.0f, 0.0f);
+    for (uint32_t p = first; p < last; ++p) {
+      glm::vec3 d = p + 1 < last ? s.points[p + 1] - s.points[p] : (p > first ? s.points[p] - s.points[p - 1] : previous);
+      float len = glm::length(d);
+      t[p] = previous = len > 0.0f ? d / len : previous;
+    }
+  }
+  return t;
+}
+
+// Normalised arc length of every vertex of a polyline; all zero when it has no length.
+std::vector<double> normalisedArcLength(const glm::vec3* p, uint32_t count) {
+  std::vector<double> u(count, 0.0);
+  for (uint32_t i = 1; i < count; ++i) u[i] = u[i - 1] + glm::length(glm::dvec3(p[i]) - glm::dvec3(p[i - 1]));
+  double total = count > 0 ? u[count - 1] : 0.0;
+  for (double& v : u) v = total > 0.0 ? v / total : 0.0;
+  return u;
+}
+
+// Samples a polyline at normalised arc lengths `at`, linearly between its vertices.
+void resample(const glm::vec3* p, const glm::vec3* t, uint32_t count, const std::vector<double>& at,
+              std::vector<glm::vec3>& points, std::vector<glm::vec3>& tangents) {
+  std::vector<double> u = normalisedArcLength(p, count);
+  points.resize(at.size());
+  tangents.resize(at.size());
+  size_t seg = 0;
+  for (size_t i = 0; i < at.size(); ++i) {
+    while (seg + 2 < count && u[seg + 1] < at[i]) ++seg;
+    if (count == 1 || u[count - 1] == 0.0) {
+      points[i] = p[0];
+      tangents[i] = t[0];
+      continue;
+    }
+    double span = u[seg + 1] - u[seg];
+    double f = span > 0.0 ? std::clamp((at[i] - u[seg]) / span, 0.0, 1.0) : 0.0;
+    points[i] = glm::vec3(glm::mix(glm::dvec3(p[seg]), glm::dvec3(p[seg + 1]), f));
+    glm::vec3 tangent = glm::mix(t[seg], t[seg + 1], static_cast<float>(f));
+    float len = glm::length(tangent);
+    tangents[i] = len > 0.0f ? tangent / len : t[seg];
+  }
+}
+
+double triangleAreaCm2(const Mesh& wick, const glm::uvec3& tri) {
+  glm::dvec3 a(wick.positions[tri.x]), b(wick.positions[tri.y]), c(wick.positions[tri.z]);
+  return 0.5 * glm::length(glm::cross(b - a, c - a)) * 1e4;
+}
+
+void checkGuides(const Mesh& wick, const Strands& guides, const std::string& name) {
+  const FileLoc where{name, 0};
+  if (guides.strandCount() != wick.vertexCount())
+    throw InputError(where, "has " + std::to_string(guides.strandCount()) + " guides but the wick has " +
+                                std::to_string(wick.vertexCount()) +
+                                " vertices; interpolate needs the guides grown from this Setup's wick");
+  for (size_t i = 0; i < guides.strandCount(); ++i) {
+    if (guides.pointsOf(i) == 0) throw InputError(where, "guide " + std::to_string(i) + " has no points");
+    if (!guides.strandId.empty() && guides.strandId[i] != i)
+      throw InputError(where, "guide " + std::to_string(i) + " has id " + std::to_string(guides.strandId[i]) +
+                                  "; guides must be in the wick's vertex order");
+    double gap = glm::length(glm::dvec3(guides.points[guides.firstPoint[i]]) - glm::dvec3(wick.positions[i]));
+    if (!(gap <= 1e-4)) {
+      char mm[32];
+      std::snprintf(mm, sizeof mm, "%.3g mm", gap * 1e3);
+      throw InputError(where, "guide " + std::to_string(i) + " starts " + mm + " from wick vertex " + std::to_string(i) +
+                                  "; these guides were not grown from this Setup's wick");
+    }
+  }
+}
+
+}  // namespace
+
+uint32_t strandsInTriangle(double areaCm2, double density, double u) {
+  double n = areaCm2 * density;
+  double whole = std::floor(n);
+  return static_cast<uint32_t>(whole) + (u < n - whole ? 1u : 0u);
+}
+
+glm::dvec3 rootWeights(double u1, double u2) {
+  if (u1 + u2 > 1.0) {
+    u1 = 1.0 - u1;
+    u2 = 1.0 - u2;
+  }
+  return {u1, u2, 1.0 - (u1 + u2)};
+}
+
+glm::dvec3 tipWeights(const glm::dvec3& r, double v1, double v2, bool strayHairs) {
+  if (v1 + v2 > 1.0) {
+    if (v1 > v2)
+      v1 = 1.0 - v1;
+    else
+      v2 = 1.0 - v2;
+  }
+  const double v3 = 1.0 - (v1 + v2);
+  if (strayHairs) {
+    // The thesis' conditions as printed; for three distinct weights they give its Table 4.
+    return {r.x < r.y ? v1 : (r.x < r.z ? v2 : v3),  //
+            r.y < r.z ? v1 : (r.y < r.x ? v2 : v3),  //
+            r.z < r.x ? v1 : (r.z < r.y ? v2 : v3)};
+  }
+  int nearest = r.x >= r.y && r.x >= r.z ? 0 : (r.y >= r.z ? 1 : 2);
+  glm::dvec3 w;
+  w[nearest] = v3;
+  w[(nearest + 1) % 3] = v1;
+  w[(nearest + 2) % 3] = v2;
+  return w;
+}
+
+void blendStrand(const GuideSpan (&g)[3], uint32_t n, const glm::dvec3& root, const glm::dvec3& tip,
+                 const glm::dvec3& centre, glm::vec3* points, glm::vec3* tangents) {
+  for (uint32_t i = 0; i < n; ++i) {
+    // b_i from b_root at the root to b_tip at the tip (the thesis' i/n never reaches the tip).
+    const double f = n > 1 ? double(i) / double(n - 1) : 0.0;
+    const glm::dvec3 w = root + (tip - root) * f;
+    glm::dvec3 p = centre, tangent(0.0);
+    for (int c = 0; c < 3; ++c) {
+      p += w[c] * (glm::dvec3(g[c].points[i]) - centre);
+      tangent += w[c] * glm::dvec3(g[c].tangents[i]);
+    }
+    // Opposed tangents cancel only on a pathological blend; keep the heaviest guide's then.
+    const int heaviest = w.x >= w.y && w.x >= w.z ? 0 : (w.y >= w.z ? 1 : 2);
+    const double len = glm::length(tangent);
+    points[i] = glm::vec3(p);
+    tangents[i] = len > 1e-12 ? glm::vec3(tangent / len) : g[heaviest].tangents[i];
+  }
+}
+
+glm::dvec3 strayCentre(const Collision& collision) {
+  for (const CollisionShape& s : collision.shapes)
+    if (s.kind == ShapeKind::kEllipsoid) return s.centre;
+  return glm::dvec3(0.0);
+}
+
+Strands interpolate(const Mesh& wick, const Strands& guides, const Hairstyle& style, const Collision& collision,
+                    const InterpolateOptions& options) {
+  checkGuides(wick, guides, options.guidesName);
+  const size_t triangleCount = wick.triangles.size();
+  const uint64_t seed = style.seed;
+  const std::vector<glm::vec3> computedTangents = guides.tangents.empty() ? polylineTangents(guides) : std::vector<glm::vec3>{};
+  const std::vector<glm::vec3>& guideTangents = guides.tangents.empty() ? computedTangents : guides.tangents;
+
+  // Counts and offsets first, so every triangle writes its own slice of the arrays in parallel.
+  std::vector<uint32_t> count(triangleCount), vertices(triangleCount);
+  std::vector<uint64_t> firstStrand(triangleCount + 1, 0), firstPoint(triangleCount + 1, 0);
+  uint64_t maxCount = 0;
+  for (size_t t = 0; t < triangleCount; ++t) {
+    const glm::uvec3& tri = wick.triangles[t];
+    count[t] = strandsInTriangle(triangleAreaCm2(wick, tri), style.hairDensity,
+                                 counterUniform(seed, t, kTriangleKey, kCountFraction));
+    vertices[t] = std::max({guides.pointsOf(tri.x), guides.pointsOf(tri.y), guides.pointsOf(tri.z)});
+    firstStrand[t + 1] = firstStrand[t] + count[t];
+    firstPoint[t + 1] = firstPoint[t] + uint64_t(count[t]) * vertices[t];
+    maxCount = std::max<uint64_t>(maxCount, count[t]);
+  }
+  if (firstPoint.back() >= std::numeric_limits<uint32_t>::max() ||
+      (maxCount > 0 && (maxCount - 1) * triangleCount + triangleCount > std::numeric_limits<uint32_t>::max()))
+    throw InputError("HairDensity " + std::to_string(style.hairDensity) + " gives " + std::to_string(firstStrand.back()) +
+                     " strands of " + std::to_string(firstPoint.back()) +
+                     " points, more than 32-bit offsets and ids can hold; lower HairDensity");
+
+  const size_t strands = firstStrand.back(), points = firstPoint.back();
+  Strands coupe;
+  coupe.points.resize(points);
+  coupe.tangents.resize(points);
+  coupe.firstPoint.resize(strands + 1);
+  coupe.strandId.resize(strands);
+  coupe.rootTriangle.resize(strands);
+  coupe.rootBary.resize(strands);
+  coupe.guideIds.resize(strands);
+  coupe.guideWeights.resize(strands);
+  if (!wick.uvs.empty()) coupe.rootUv.resize(strands);
+  coupe.firstPoint[strands] = static_cast<uint32_t>(points);
+
+  const glm::dvec3 centre = strayCentre(collision);
+  tbb::parallel_for(size_t(0), triangleCount, [&](size_t t) {
+    const glm::uvec3 tri = wick.triangles[t];
+    const uint32_t n = vertices[t];
+    // Guides with n vertices are read by index (grow samples every guide at the same fractions of its
+    // length); a shorter one is resampled at the normalised arc lengths of the first longest guide.
+    std::vector<glm::vec3> resampledPoints[3], resampledTangents[3];
+    GuideSpan g[3];
+    int reference = guides.pointsOf(tri.x) == n ? 0 : (guides.pointsOf(tri.y) == n ? 1 : 2);
+    std::vector<double> at;
+    for (int c = 0; c < 3; ++c) {
+      const uint32_t first = guides.firstPoint[tri[c]], m = guides.pointsOf(tri[c]);
+      if (m == n) {
+        g[c] = {&guides.points[first], &guideTangents[first]};
+        continue;
+      }
+      if (at.empty()) at = normalisedArcLength(&guides.points[guides.firstPoint[tri[reference]]], n);
+      resample(&guides.points[first], &guideTangents[first], m, at, resampledPoints[c], resampledTangents[c]);
+      g[c] = {resampledPoints[c].data(), resampledTangents[c].data()};
+    }
+
+    for (uint32_t k = 0; k < count[t]; ++k) {
+      const size_t s = firstStrand[t] + k;
+      const glm::dvec3 root = rootWeights(counterUniform(seed, t, k, kRootU1), counterUniform(seed, t, k, kRootU2));
+      const glm::dvec3 tip = tipWeights(root, style.clump * counterUniform(seed, t, k, kTipV1),
+                                        style.clump * counterUniform(seed, t, k, kTipV2), style.strayHairs);
+      const size_t p0 = firstPoint[t] + uint64_t(k) * n;
+      blendStrand(g, n, root, tip, centre, &coupe.points[p0], &coupe.tangents[p0]);
+      coupe.firstPoint[s] = static_cast<uint32_t>(p0);
+      coupe.strandId[s] = static_cast<uint32_t>(uint64_t(k) * triangleCount + t);
+      coupe.rootTriangle[s] = static_cast<uint32_t>(t);
+      coupe.rootBary[s] = glm::vec3(root);
+      coupe.guideIds[s] = tri;
+      coupe.guideWeights[s] = glm::vec3(root);
+      if (!wick.uvs.empty())
+        coupe.rootUv[s] = glm::vec2(root.x * glm::dvec2(wick.uvs[tri.x]) + root.y * glm::dvec2(wick.uvs[tri.y]) +
+                                    root.z * glm::dvec2(wick.uvs[tri.z]));
+    }
+    if (options.progress) options.progress->advance();
+  });
+  if (options.progress) options.progress->finish();
+
+  coupe.defaultThickness = guides.defaultThickness;
+  coupe.defaultTransparency = guides.defaultTransparency;
+  coupe.defaultColor = guides.defaultColor;
+  coupe.provenance = {"hairgen " HAIRGEN_VERSION, "interpolate", seed, options.configDigest};
+  return coupe;
+}
+
+}  // namespace hairgen

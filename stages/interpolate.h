@@ -1,0 +1,60 @@
+// The interpolate stage: a full coupe from the guides, filling every wick triangle with strands blended
+// from the guides at its corners, clumped toward the nearest guide at the tips, with the thesis' stray
+// hairs (Lansink 2010 §4.1.4.3-4.1.4.4, DESIGN §2 and §5).
+#pragma once
+
+#include <cstdint>
+#include <string>
+
+#include <glm/glm.hpp>
+
+#include "libcore/mesh.h"
+#include "libcore/params.h"
+#include "libcore/progress.h"
+#include "libcore/strands.h"
+
+namespace hairgen {
+
+struct InterpolateOptions {
+  std::string configDigest;      // recorded in the coupe's provenance
+  std::string guidesName;        // names the guides in error messages
+  Progress* progress = nullptr;  // advanced once per triangle
+};
+
+// Fills every wick triangle. Guide i must be the one grown from wick vertex i. The coupe is ordered by
+// triangle, then by strand index k within it; strand k of triangle t has id k·T + t (T triangles), so
+// ids are stable when the density changes and the strands with id < m·T are the first m of every
+// triangle. Deterministic for any thread count. Throws InputError when the guides do not fit the wick.
+Strands interpolate(const Mesh& wick, const Strands& guides, const Hairstyle& style, const Collision& collision,
+                    const InterpolateOptions& options);
+
+// The pieces, for tests.
+
+// Strands in a triangle of `areaCm2`: area × density, the fraction rounded up when u < fraction. For a
+// fixed u the count never decreases as the density grows.
+uint32_t strandsInTriangle(double areaCm2, double density, double u);
+
+// Uniform root barycentrics from two uniforms in [0, 1): a pair past the diagonal is reflected back.
+glm::dvec3 rootWeights(double u1, double u2);
+
+// Tip barycentrics (§4.1.4.3): v1, v2 drawn in [0, Clump), folded when their sum passes 1, v3 = 1 − v1
+// − v2 for the corner nearest the root. `strayHairs` assigns v1 and v2 to the other two corners by the
+// thesis' conditions (its Table 4: in half the orderings v1 lands on both and the sum is not 1);
+// otherwise the next corner after the nearest (A→B→C→A) takes v1 and the one after takes v2.
+glm::dvec3 tipWeights(const glm::dvec3& root, double v1, double v2, bool strayHairs);
+
+// One strand of n vertices from three guides of n vertices each: weights from `root` at vertex 0 to
+// `tip` at vertex n − 1, positions blended about `centre` (a weight sum K ≠ 1 scales the blend about
+// it, §4.1.4.4), tangents blended and renormalised.
+struct GuideSpan {
+  const glm::vec3* points;
+  const glm::vec3* tangents;
+};
+void blendStrand(const GuideSpan (&guides)[3], uint32_t n, const glm::dvec3& root, const glm::dvec3& tip,
+                 const glm::dvec3& centre, glm::vec3* points, glm::vec3* tangents);
+
+// The head centre the stray hairs scale about: the centre of the first Ellipsoid of Collision Info,
+// or the origin (the thesis puts its origin at the head centre).
+glm::dvec3 strayCentre(const Collision& collision);
+
+}  // namespace hairgen
