@@ -37,7 +37,7 @@ struct Hairstyle {
   double density = 1300.0;          // ρ, kilograms per cubic metre (Table 3)
   double gravity = 9.81;            // g, newtons per kilogram (Table 3)
   StylingModel model = StylingModel::kSuperHelix;
-  double clump = 0.25;              // 0 = tips spread like roots, 1 = tips gather at the nearest guide
+  double clump = 0.25;              // tip weights v1, v2 drawn in [0, Clump): 0 gathers tips at the nearest guide
   bool strayHairs = true;           // true = the thesis' barycentric assignment (§4.1.4.4)
   uint64_t seed = 0;                // keys every random number; --seed overrides it
 
