@@ -1,6 +1,8 @@
 // hairgen run [SETUP] [-o DIR]: the stages in one process, with the same files the stages give when
 // chained by hand. With no SETUP it runs the bundled default coupe.
 #include <cstdlib>
+#include <iostream>
+#include <optional>
 #include <filesystem>
 
 #include "cli/commands.h"
@@ -40,14 +42,17 @@ void registerRun(CLI::App& app, int& exitCode) {
   struct Options {
     CommonOptions common;
     std::string setup, outDir;
+    bool noRender = false;
   };
   auto options = std::make_shared<Options>();
   CLI::App* cmd = app.add_subcommand(
-      "run", "Run the stages in one process: grow and interpolate (or Load a saved coupe), writing DIR/guides.hair "
-             "and DIR/coupe.hair; files equal those of the stages run one by one");
+      "run", "Run the stages in one process: grow and interpolate (or Load a saved coupe), then render; writes "
+             "DIR/guides.hair, DIR/coupe.hair, DIR/beauty.exr and DIR/beauty.png, each equal to what the stage run "
+             "alone writes");
   cmd->add_option("SETUP", options->setup, "The Setup file (default: the bundled configs/default/setup.txt)");
   cmd->add_option("-o,--output", options->outDir, "Output folder (default: out/NAME, NAME the Setup's folder)")
       ->type_name("DIR");
+  cmd->add_flag("--no-render", options->noRender, "Stop after the coupe (no EXR, no preview)");
   addCommonFlags(*cmd, options->common, true);
   cmd->footer(exitCodeHelp());
   cmd->callback([options, &exitCode] {
@@ -84,6 +89,15 @@ void registerRun(CLI::App& app, int& exitCode) {
       if (config.setup.save) {
         writeStrands(config.setup.saveFile.path, coupe);
         note(options->common, "run: saved the coupe to " + config.setup.saveFile.path.string());
+      }
+      if (!options->noRender) {
+        std::optional<Mesh> head;
+        if (config.setup.headModel.given()) head = readObj(config.setup.headModel.path);
+        RenderOutput image = renderStage(options->common, config, coupe, head ? &*head : nullptr, false, stats);
+        clock.lap();
+        writeRenderOutputs(config, image, (out / "beauty.exr").string(), "", (out / "beauty.png").string());
+        stats.time("write", stats.json()["seconds"].value("write", 0.0) + clock.lap());
+        note(options->common, "run: wrote " + (out / "beauty.exr").string() + " and " + (out / "beauty.png").string());
       }
       stats.write(options->common);
     });

@@ -11,6 +11,7 @@
 #include "libcore/mesh.h"
 #include "libcore/params.h"
 #include "libcore/strands.h"
+#include "libcore/renderer.h"
 #include "stages/grow.h"
 
 namespace hairgen::cli {
@@ -22,9 +23,16 @@ void registerAssets(CLI::App& app, int& exitCode);
 void registerGrow(CLI::App& app, int& exitCode);
 void registerInterpolate(CLI::App& app, int& exitCode);
 void registerRun(CLI::App& app, int& exitCode);
+void registerRender(CLI::App& app, int& exitCode);
+void registerDiff(CLI::App& app, int& exitCode);
 
 GrowResult growStage(const CommonOptions& common, const Config& config, const Mesh& wick, Stats& stats);
 Strands interpolateStage(const CommonOptions& common, const Config& config, const Mesh& wick, const Strands& guides,
                          const std::string& guidesName, Stats& stats);
+RenderOutput renderStage(const CommonOptions& common, const Config& config, const Strands& hair, const Mesh* head,
+                         bool keepDom, Stats& stats);
+// Writes the EXR, and the light's maps and the preview where named (empty: not wanted).
+void writeRenderOutputs(const Config& config, const RenderOutput& out, const std::string& exr, const std::string& dom,
+                        const std::string& preview);
 
 }  // namespace hairgen::cli

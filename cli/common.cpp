@@ -62,6 +62,8 @@ int runCommand(const std::string& command, const CommonOptions& options, const s
     tbb::global_control limit(tbb::global_control::max_allowed_parallelism, static_cast<size_t>(threads));
     body();
     return static_cast<int>(ExitCode::kSuccess);
+  } catch (const ExitWith& e) {
+    return static_cast<int>(e.code);
   } catch (const Error& e) {
     std::cerr << "hairgen " << command << ": error: " << e.what() << "\n";
     return static_cast<int>(e.code());

@@ -10,6 +10,7 @@
 #include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
 
+#include "libcore/error.h"
 #include "libcore/params.h"
 
 namespace hairgen::cli {
@@ -60,6 +61,11 @@ class Stopwatch {
 
 // "1.23 s"
 std::string formatSeconds(double seconds);
+
+// Thrown by a command body that has said what it had to and ends with `code` (diff's verdict).
+struct ExitWith {
+  ExitCode code;
+};
 
 // Runs one command body with the thread limit applied, catching every error once: prints
 // "hairgen CMD: error: FILE:LINE: message" and returns the documented exit code.

@@ -21,6 +21,8 @@ int main(int argc, char** argv) {
   registerRun(app, exitCode);
   registerGrow(app, exitCode);
   registerInterpolate(app, exitCode);
+  registerRender(app, exitCode);
+  registerDiff(app, exitCode);
   registerInfo(app, exitCode);
   registerConvert(app, exitCode);
   registerCheck(app, exitCode);

@@ -69,7 +69,8 @@ std::vector<SectionSpec> makeSections() {
         key("StrandOpacity", "0 to 1, e.g. 0.7"),
         key("StrandWidth", "metres, e.g. 0.00008"),
         key("ShadingModel", "kajiya-kay, thesis, anjyo or volumetric"),
-        key("Background", "r g b")}},
+        key("Background", "r g b"),
+        key("HeadColor", "r g b, the head's albedo")}},
   };
 }
 

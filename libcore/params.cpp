@@ -90,7 +90,8 @@ std::string Config::canonicalText() const {
       << "Render.StrandOpacity " << formatReal(r.strandOpacity) << "\n"
       << "Render.StrandWidth " << formatReal(r.strandWidth) << "\n"
       << "Render.ShadingModel " << name(r.shadingModel) << "\n"
-      << "Render.Background " << join(r.background) << "\n";
+      << "Render.Background " << join(r.background) << "\n"
+      << "Render.HeadColor " << join(r.headColor) << "\n";
   return out.str();
 }
 

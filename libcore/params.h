@@ -80,12 +80,13 @@ struct RenderSettings {
   glm::dvec3 lightPosition{0.6, 1.0, 0.8};    // metres
   glm::dvec3 lightColor{1.0, 1.0, 1.0};
   double ambientIntensity = 0.2;
-  int samples = 8;                            // antialiasing samples per pixel
+  int samples = 4;                            // antialiasing sub-pixels per pixel (k² for k×k)
   glm::dvec4 layerSizes{0.002, 0.006, 0.015, 0.04};  // metres: the 4 deep-opacity layer depths
   double strandOpacity = 0.7;                 // opacity of one strand, 0-1
   double strandWidth = 8.0e-5;                // metres, on-screen diameter of a strand
   ShadingModel shadingModel = ShadingModel::kKajiyaKay;
   glm::dvec3 background{0.18, 0.18, 0.20};
+  glm::dvec3 headColor{0.72, 0.55, 0.45};     // Lambert albedo of the head
 };
 
 // A path named by a config file, with where it was named (for "missing file" errors).

@@ -183,6 +183,7 @@ RenderSettings readRender(const ConfigText& text, const std::vector<Override>& o
                    : model == "volumetric" ? ShadingModel::kVolumetric
                                            : ShadingModel::kKajiyaKay;
   s.background = r.vec3("Background", s.background, Range::closed(0.0, 1e6));
+  s.headColor = r.vec3("HeadColor", s.headColor, Range::closed(0.0, 1.0));
   r.finish();
   return s;
 }

@@ -1,0 +1,57 @@
+// The hair renderer (thesis §4.1.5-4.1.6, Appendix A for the method): per light three passes —
+// depth from the light, a deep opacity map of 4 layers with additive blending, and the shading pass
+// from the camera reading both — into framebuffer objects of a headless EGL context.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include "libcore/mesh.h"
+#include "libcore/params.h"
+#include "libcore/strands.h"
+
+namespace hairgen {
+
+class GlContext;
+
+// Camera depth (Z) of a pixel where nothing was drawn, metres.
+inline constexpr float kBackgroundZ = 1.0e10f;
+
+// Float planes, rows top to bottom.
+struct Image {
+  int width = 0, height = 0;
+  std::vector<std::string> channels;  // names, in plane order
+  std::vector<std::vector<float>> planes;
+  const std::vector<float>& plane(const std::string& name) const;
+  float at(const std::string& name, int x, int y) const { return plane(name)[size_t(y) * width + x]; }
+};
+
+struct RenderTimings {
+  double upload = 0.0, lightDepth = 0.0, opacity = 0.0, shading = 0.0, readback = 0.0;  // seconds
+};
+
+struct RenderOutput {
+  Image beauty;  // R G B A (A: coverage of hair and head), Z, opacity (hair coverage), shadow
+  Image dom;     // the light's view: Z (distance along the light's axis where hair begins), layer1-4
+  glm::dmat4 worldToCamera{1.0}, worldToNdc{1.0};
+  glm::dmat4 worldToLight{1.0};
+  RenderTimings timings;
+  int samples = 1;  // the samples used (Samples, clamped to what the device offers)
+};
+
+struct RenderInput {
+  const Strands* hair = nullptr;
+  const Mesh* head = nullptr;  // may be null
+  Visuality visuality;
+  RenderSettings settings;
+  int domResolution = 1024;    // texels per side of the light's maps
+  bool keepDom = false;
+};
+
+// Renders with the current context of `gl`. Deterministic for a given device and driver.
+RenderOutput renderHair(GlContext& gl, const RenderInput& input);
+
+}  // namespace hairgen

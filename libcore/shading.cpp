@@ -1,0 +1,17 @@
+#include "libcore/shading.h"
+
+#include <cmath>
+
+namespace hairgen {
+
+glm::dvec3 shadeHair(ShadingModel model, const glm::dvec3& t, const glm::dvec3& l, const glm::dvec3& e,
+                     const Visuality& visuality, const RenderSettings& render, double shadow) {
+  const double tl = glm::dot(t, l), te = glm::dot(t, e);
+  const double sinTL = std::sqrt(std::max(0.0, 1.0 - tl * tl)), sinTE = std::sqrt(std::max(0.0, 1.0 - te * te));
+  double cone = model == ShadingModel::kThesis ? std::abs(tl) * std::abs(te) + sinTL * sinTE : -tl * te + sinTL * sinTE;
+  double specular = std::pow(std::max(cone, 0.0), visuality.glossiness);
+  return render.ambientIntensity * visuality.ambientColor +
+         shadow * render.lightColor * (visuality.diffuseColor * sinTL + visuality.specularColor * specular);
+}
+
+}  // namespace hairgen

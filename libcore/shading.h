@@ -1,0 +1,26 @@
+// Hair and head reflectance, on the CPU. The renderer's shaders evaluate the same formulas; tests
+// compare the two pixel by pixel.
+//
+// Kajiya-Kay (thesis §3.3.2.1.1, DESIGN §7), t the unit tangent, l and e unit vectors to the light and
+// the eye:
+//   diffuse  = sin(t, l) = sqrt(1 − (t·l)²)
+//   specular = max(cos(θ − φ), 0)^p with cos θ = −t·l, cos φ = t·e: the mirror cone, brightest where
+//              the eye sees the light's reflection off the cylinder;
+//   `thesis` = the thesis' shader, (|t·l| |t·e| + sin(t,l) sin(t,e))^p, which lights both sides.
+//   colour   = AmbientIntensity·AmbientColor + shadow·LightColor·(DiffuseColor·diffuse + SpecularColor·specular)
+// Head: AmbientIntensity·HeadColor + shadow·LightColor·HeadColor·max(n·l, 0).
+// `shadow` is the light that arrives: 1 − 0.75·opacity (the thesis maps opacity [0, 1] to [1, 0.25]).
+#pragma once
+
+#include <glm/glm.hpp>
+
+#include "libcore/params.h"
+
+namespace hairgen {
+
+glm::dvec3 shadeHair(ShadingModel model, const glm::dvec3& t, const glm::dvec3& l, const glm::dvec3& e,
+                     const Visuality& visuality, const RenderSettings& render, double shadow);
+
+inline double shadowFactor(double opacity) { return 1.0 - 0.75 * glm::clamp(opacity, 0.0, 1.0); }
+
+}  // namespace hairgen

@@ -1,0 +1,198 @@
+// The renderer on llvmpipe (or a GPU): Kajiya-Kay against the CPU formula, deep-opacity shadows
+// between strands and onto the head, the background's AOVs, and what supersampling changes.
+#include <gtest/gtest.h>
+
+#include "libcore/gl_context.h"
+#include "libcore/renderer.h"
+#include "libcore/shading.h"
+
+namespace hairgen {
+namespace {
+
+GlContext& gl() {
+  static GlContext context;  // every test here needs it; failing to open one fails them (exit 3 in the CLI)
+  return context;
+}
+
+// A straight strand from `a` to `b` with `n` points.
+void addStraight(Strands& s, glm::vec3 a, glm::vec3 b, int n = 11) {
+  std::vector<glm::vec3> p;
+  for (int i = 0; i < n; ++i) p.push_back(glm::mix(a, b, float(i) / float(n - 1)));
+  s.addStrand(p);
+  glm::vec3 t = glm::normalize(b - a);
+  for (int i = 0; i < n; ++i) s.tangents.push_back(t);
+}
+
+RenderSettings frontCamera(int size, int samples) {
+  RenderSettings r;
+  r.resolution = {size, size};
+  r.cameraPosition = {0.0, 0.0, 0.3};
+  r.cameraTarget = {0.0, 0.0, 0.0};
+  r.fieldOfView = 30.0;
+  r.samples = samples;
+  r.strandOpacity = 1.0;
+  return r;
+}
+
+RenderOutput render(const Strands& hair, const RenderSettings& r, const Mesh* head = nullptr,
+                    const Visuality& v = Visuality{}) {
+  RenderInput in;
+  in.hair = &hair;
+  in.head = head;
+  in.settings = r;
+  in.visuality = v;
+  in.domResolution = 512;
+  return renderHair(gl(), in);
+}
+
+// The world point on the plane z = 0 seen through the centre of pixel (x, y) by frontCamera.
+glm::dvec3 onPlane(const RenderSettings& r, int x, int y) {
+  double focal = 0.5 * r.resolution.y / std::tan(glm::radians(r.fieldOfView) * 0.5);
+  double px = (x + 0.5 - 0.5 * r.resolution.x) / focal, py = (0.5 * r.resolution.y - (y + 0.5)) / focal;
+  return glm::dvec3(px * r.cameraPosition.z, py * r.cameraPosition.z, 0.0);
+}
+
+TEST(Render, StraightStrandMatchesKajiyaKayOnTheCpu) {
+  for (ShadingModel model : {ShadingModel::kKajiyaKay, ShadingModel::kThesis}) {
+    Strands s;
+    addStraight(s, {-0.05f, 0, 0}, {0.05f, 0, 0});
+    RenderSettings r = frontCamera(96, 1);
+    r.strandWidth = 0.008;  // ~4 pixels: fully covered pixels along the middle
+    r.lightPosition = {0.15, 0.4, 0.25};
+    r.shadingModel = model;
+    Visuality v;
+    v.glossiness = 20.0;
+    v.specularColor = {0.6, 0.6, 0.6};
+    RenderOutput out = render(s, r, nullptr, v);
+    int checked = 0;
+    for (int y = 0; y < 96; ++y)
+      for (int x = 0; x < 96; ++x) {
+        if (out.beauty.at("opacity", x, y) < 1.0f) continue;
+        glm::dvec3 p = onPlane(r, x, y);
+        p.y = 0.0;  // shading is at the centreline
+        glm::dvec3 expect = shadeHair(model, {1, 0, 0}, glm::normalize(r.lightPosition - p),
+                                      glm::normalize(r.cameraPosition - p), v, r, out.beauty.at("shadow", x, y));
+        for (int c = 0; c < 3; ++c) {
+          float got = out.beauty.at(std::string(1, "RGB"[c]), x, y);
+          ASSERT_NEAR(got, expect[c], 0.02 * std::max(expect[c], 0.05)) << "pixel " << x << "," << y << " channel " << c;
+        }
+        EXPECT_NEAR(out.beauty.at("shadow", x, y), 1.0f, 1e-6f) << "a lone strand is not in its own shadow";
+        ++checked;
+      }
+    EXPECT_GT(checked, 200);
+  }
+}
+
+TEST(Render, BackgroundPixelsHaveNoOpacityAndTheBackgroundZ) {
+  Strands s;
+  addStraight(s, {-0.02f, 0, 0}, {0.02f, 0, 0});
+  RenderSettings r = frontCamera(64, 4);
+  RenderOutput out = render(s, r);
+  EXPECT_EQ(out.beauty.at("opacity", 0, 0), 0.0f);
+  EXPECT_EQ(out.beauty.at("A", 0, 0), 0.0f);
+  EXPECT_EQ(out.beauty.at("Z", 0, 0), kBackgroundZ);
+  EXPECT_EQ(out.beauty.at("shadow", 0, 0), 1.0f);
+  EXPECT_NEAR(out.beauty.at("R", 0, 0), r.background.x, 1e-3);
+  EXPECT_GT(out.beauty.at("opacity", 32, 31) + out.beauty.at("opacity", 32, 32), 0.0f);
+  EXPECT_NEAR(std::min(out.beauty.at("Z", 32, 31), out.beauty.at("Z", 32, 32)), 0.3f, 1e-3f);
+}
+
+TEST(Render, AStrandBetweenTheLightAndAnotherDarkensOnlyThatOne) {
+  // Light straight above; strand A 2 cm above strand B; the camera sees both from the front.
+  RenderSettings r = frontCamera(96, 1);
+  r.strandWidth = 0.004;
+  r.lightPosition = {0.0, 1.0, 0.0};
+  Strands both, aAlone, bAlone;
+  addStraight(both, {-0.04f, 0.02f, 0}, {0.04f, 0.02f, 0});
+  addStraight(both, {-0.04f, 0.0f, 0}, {0.04f, 0.0f, 0});
+  addStraight(aAlone, {-0.04f, 0.02f, 0}, {0.04f, 0.02f, 0});
+  addStraight(bAlone, {-0.04f, 0.0f, 0}, {0.04f, 0.0f, 0});
+  RenderOutput all = render(both, r), a = render(aAlone, r), b = render(bAlone, r);
+  int aPixels = 0, bPixels = 0;
+  for (int y = 0; y < 96; ++y)
+    for (int x = 20; x < 76; ++x) {
+      if (a.beauty.at("opacity", x, y) == 1.0f && all.beauty.at("opacity", x, y) == 1.0f) {
+        EXPECT_NEAR(all.beauty.at("R", x, y), a.beauty.at("R", x, y), 1e-3) << "A at " << x << "," << y;
+        ++aPixels;
+      }
+      if (b.beauty.at("opacity", x, y) == 1.0f && all.beauty.at("opacity", x, y) == 1.0f) {
+        EXPECT_LT(all.beauty.at("shadow", x, y), 0.7f);
+        EXPECT_LT(all.beauty.at("R", x, y), 0.8f * b.beauty.at("R", x, y)) << "B at " << x << "," << y;
+        ++bPixels;
+      }
+    }
+  EXPECT_GT(aPixels, 50);
+  EXPECT_GT(bPixels, 50);
+}
+
+TEST(Render, TheHeadIsDarkerUnderTheHairThanBesideIt) {
+  // A flat "head" facing up, a patch of hair 5 cm above its middle, the light above and to the +x
+  // side (so the hair's shadow falls toward −x), the camera straight above.
+  Mesh head;
+  head.positions = {{-0.1f, 0, -0.1f}, {0.1f, 0, -0.1f}, {0.1f, 0, 0.1f}, {-0.1f, 0, 0.1f}};
+  head.normals.assign(4, glm::vec3(0, 1, 0));
+  head.triangles = {{0, 2, 1}, {0, 3, 2}};
+  Strands hair;
+  for (int i = 0; i < 40; ++i) {
+    float x = -0.02f + 0.04f * i / 39.0f;
+    addStraight(hair, {x, 0.05f, -0.03f}, {x, 0.05f, 0.03f});
+  }
+  RenderSettings r;
+  r.resolution = {128, 128};
+  r.samples = 1;
+  r.cameraPosition = {0.0, 0.5, 0.0};
+  r.cameraTarget = {0.0, 0.0, 0.0};
+  r.cameraUp = {0.0, 0.0, -1.0};
+  r.fieldOfView = 30.0;
+  r.lightPosition = {0.5, 1.0, 0.0};
+  r.strandWidth = 0.002;
+  r.strandOpacity = 0.9;
+  RenderOutput out = render(hair, r, &head);
+  const double focal = 0.5 * 128 / std::tan(glm::radians(15.0));
+  double under = 0.0, beside = 0.0;
+  int nUnder = 0, nBeside = 0;
+  for (int y = 54; y < 74; ++y)
+    for (int x = 0; x < 128; ++x) {
+      if (out.beauty.at("opacity", x, y) != 0.0f || out.beauty.at("A", x, y) != 1.0f) continue;
+      double wx = (x + 0.5 - 64) / focal * 0.5;
+      if (wx > -0.033 && wx < -0.024) under += out.beauty.at("R", x, y), ++nUnder;
+      if (wx > 0.04 && wx < 0.06) beside += out.beauty.at("R", x, y), ++nBeside;
+    }
+  ASSERT_GT(nUnder, 20);
+  ASSERT_GT(nBeside, 20);
+  EXPECT_LT(under / nUnder, 0.75 * beside / nBeside);
+}
+
+TEST(Render, SupersamplingChangesOnlyStrandEdges) {
+  Strands s;
+  addStraight(s, {-0.05f, -0.01f, 0}, {0.05f, 0.012f, 0});
+  RenderSettings r = frontCamera(80, 1);
+  r.strandWidth = 0.01;
+  r.lightPosition = {0.1, 0.3, 0.3};
+  RenderOutput one = render(s, r);
+  r.samples = 9;
+  RenderOutput nine = render(s, r);
+  int edges = 0, changedEdges = 0;
+  for (int y = 1; y < 79; ++y)
+    for (int x = 1; x < 79; ++x) {
+      // An edge pixel: partly covered when supersampled, or next to a coverage change without.
+      bool edge = nine.beauty.at("opacity", x, y) > 0.0f && nine.beauty.at("opacity", x, y) < 1.0f;
+      for (int dy = -1; dy <= 1; ++dy)
+        for (int dx = -1; dx <= 1; ++dx)
+          edge = edge || one.beauty.at("opacity", x + dx, y + dy) != one.beauty.at("opacity", x, y);
+      double change = 0.0;
+      for (const char* c : {"R", "G", "B", "A"})
+        change = std::max(change, double(std::abs(one.beauty.at(c, x, y) - nine.beauty.at(c, x, y))));
+      if (!edge) {
+        ASSERT_LT(change, 0.01) << "pixel " << x << "," << y << " is not on an edge";
+      } else {
+        ++edges;
+        changedEdges += change > 0.01;
+      }
+    }
+  EXPECT_GT(edges, 100);
+  EXPECT_GT(changedEdges, edges / 4) << "supersampling should soften the edges";
+}
+
+}  // namespace
+}  // namespace hairgen
