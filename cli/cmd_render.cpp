@@ -72,7 +72,7 @@ RenderOutput renderStage(const CommonOptions& common, const Config& config, cons
   input.head = head;
   input.visuality = config.visuality;
   input.settings = config.render;
-  input.domResolution = std::clamp(std::max(config.render.resolution.x, config.render.resolution.y), 1024, 4096);
+  input.domResolution = domResolutionFor(config.render.resolution);
   input.keepDom = keepDom;
   RenderOutput out = renderHair(gl, input);
   stats.time("upload", out.timings.upload);

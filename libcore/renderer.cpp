@@ -48,37 +48,48 @@ void checkGl(const char* where) {
 
 // ---------------------------------------------------------------------------------------------- GLSL
 
-constexpr const char* kHairVertex = R"(#version 450 core
+// Hair points and tangents arrive as vertex attributes for lines (one vertex per point), or from
+// storage buffers for ribbons (two vertices per point; RIBBON defined).
+constexpr const char* kHairVertex = R"(
+#ifdef RIBBON
 layout(std430, binding = 0) readonly buffer Points { float pointData[]; };
 layout(std430, binding = 1) readonly buffer Tangents { float tangentData[]; };
+#else
+layout(location = 0) in vec3 aPosition;
+layout(location = 1) in vec3 aTangent;
+#endif
 uniform mat4 uView;
 uniform mat4 uProj;
 uniform vec2 uViewport;   // pixels
 uniform float uFocalPx;   // pixels per metre at one metre of depth
 uniform float uWidth;     // strand diameter, metres
 uniform float uOpacity;
-uniform int uRibbon;      // 1: two vertices per point, widened on screen; 0: one per point, drawn as lines
 uniform float uMinWidth;  // pixels: the narrowest ribbon
 out vec3 vWorld;
 out vec3 vTangent;
 out float vAlpha;
 out float vDepth;         // metres along the view axis
 void main() {
-  int i = uRibbon != 0 ? gl_VertexID >> 1 : gl_VertexID;
-  float side = (gl_VertexID & 1) == 0 ? -1.0 : 1.0;
+#ifdef RIBBON
+  int i = gl_VertexID >> 1;
   vec3 p = vec3(pointData[3 * i], pointData[3 * i + 1], pointData[3 * i + 2]);
   vec3 t = vec3(tangentData[3 * i], tangentData[3 * i + 1], tangentData[3 * i + 2]);
+#else
+  vec3 p = aPosition;
+  vec3 t = aTangent;
+#endif
   vec4 view = uView * vec4(p, 1.0);
   vec4 clip = uProj * view;
   float depth = -view.z;
-  if (uRibbon != 0) {
-    vec4 ahead = uProj * (view + uView * vec4(1e-3 * t, 0.0));
-    vec2 d = (ahead.xy / ahead.w - clip.xy / clip.w) * uViewport;
-    float len = length(d);
-    vec2 across = len > 1e-9 ? vec2(-d.y, d.x) / len : vec2(1.0, 0.0);
-    float widthPx = uWidth * uFocalPx / max(depth, 1e-6);
-    clip.xy += across * (side * 0.5 * max(widthPx, uMinWidth)) * 2.0 / uViewport * clip.w;
-  }
+#ifdef RIBBON
+  float side = (gl_VertexID & 1) == 0 ? -1.0 : 1.0;
+  vec4 ahead = uProj * (view + uView * vec4(1e-3 * t, 0.0));
+  vec2 d = (ahead.xy / ahead.w - clip.xy / clip.w) * uViewport;
+  float len = length(d);
+  vec2 across = len > 1e-9 ? vec2(-d.y, d.x) / len : vec2(1.0, 0.0);
+  float widthPx = uWidth * uFocalPx / max(depth, 1e-6);
+  clip.xy += across * (side * 0.5 * max(widthPx, uMinWidth)) * 2.0 / uViewport * clip.w;
+#endif
   gl_Position = clip;
   vWorld = p;
   vTangent = t;
@@ -390,9 +401,16 @@ struct HairGeometry {
       ribbonCounts.push_back(static_cast<GLsizei>(2 * s.pointsOf(i)));
     }
     glCreateVertexArrays(1, &vao);
+    glVertexArrayVertexBuffer(vao, 0, points.id, 0, sizeof(glm::vec3));
+    glVertexArrayVertexBuffer(vao, 1, tangents.id, 0, sizeof(glm::vec3));
+    for (GLuint a = 0; a < 2; ++a) {
+      glEnableVertexArrayAttrib(vao, a);
+      glVertexArrayAttribFormat(vao, a, 3, GL_FLOAT, GL_FALSE, 0);
+      glVertexArrayAttribBinding(vao, a, a);
+    }
   }
   ~HairGeometry() { glDeleteVertexArrays(1, &vao); }
-  void draw(const class Shader& shader, bool ribbon) const;
+  void draw(bool ribbon) const;
 };
 
 struct HeadGeometry {
@@ -431,11 +449,10 @@ struct HeadGeometry {
   }
 };
 
-void HairGeometry::draw(const Shader& shader, bool ribbon) const {
+void HairGeometry::draw(bool ribbon) const {
   glBindVertexArray(vao);
   glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, points.id);
   glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, tangents.id);
-  shader.set("uRibbon", ribbon ? 1 : 0);
   if (lineFirsts.empty()) return;
   if (ribbon)
     glMultiDrawArrays(GL_TRIANGLE_STRIP, ribbonFirsts.data(), ribbonCounts.data(), static_cast<GLsizei>(ribbonFirsts.size()));
@@ -602,10 +619,16 @@ RenderOutput renderHair(GlContext&, const RenderInput& in) {
   std::unique_ptr<HeadGeometry> headGeometry;
   if (in.head && !in.head->triangles.empty()) headGeometry = std::make_unique<HeadGeometry>(*in.head);
   const std::string fragmentHeader = "#version 450 core\n";
-  Shader hairDepth(kHairVertex, kDepthFragment, "hair depth");
+  const std::string v450 = "#version 450 core\n";
+  Shader hairDepth(v450 + kHairVertex, kDepthFragment, "hair depth");
   Shader headDepth(kHeadVertex, kDepthFragment, "head depth");
-  Shader opacity(kHairVertex, kOpacityFragment, "deep opacity");
-  Shader hairShade(kHairVertex, fragmentHeader + kShadowFunction + kHairFragment, "hair shading");
+  Shader opacity(v450 + kHairVertex, kOpacityFragment, "deep opacity");
+  // Lines where every strand is at most a pixel and a half wide (at the scene's nearest point) and
+  // there are no sub-pixels; ribbons otherwise.
+  const double nearest = std::max(glm::length(scene.centre - r.cameraPosition) - scene.radius, 1e-3);
+  const bool ribbons = block > 1 || r.strandWidth * camera.focalPx / nearest > 1.5;
+  Shader hairShade(v450 + (ribbons ? "#define RIBBON\n" : "") + kHairVertex,
+                   fragmentHeader + kShadowFunction + kHairFragment, "hair shading");
   Shader headShade(kHeadVertex, fragmentHeader + kShadowFunction + kHeadFragment, "head shading");
   Shader resolve(kFullscreenVertex, kResolveFragment, "resolve");
   checkGl("setting up");
@@ -638,7 +661,7 @@ RenderOutput renderHair(GlContext&, const RenderInput& in) {
     hairDepth.use();
     setView(hairDepth, light);
     setHairWidth(hairDepth, light, r);
-    hairGeometry.draw(hairDepth, false);
+    hairGeometry.draw(false);
   }
   checkGl("the light's depth pass");
   out.timings.lightDepth = seconds(clock);
@@ -659,7 +682,7 @@ RenderOutput renderHair(GlContext&, const RenderInput& in) {
     opacity.set("uLayers", glm::vec4(r.layerSizes));
     opacity.set("uStart", 0);
     glBindTextureUnit(0, startZ.id);
-    hairGeometry.draw(opacity, false);
+    hairGeometry.draw(false);
     glDisable(GL_BLEND);
   }
   checkGl("the deep opacity pass");
@@ -717,10 +740,7 @@ RenderOutput renderHair(GlContext&, const RenderInput& in) {
     hairShade.set("uSpecularColor", glm::vec3(in.visuality.specularColor));
     hairShade.set("uGlossiness", float(in.visuality.glossiness));
     hairShade.set("uThesisModel", r.shadingModel == ShadingModel::kThesis ? 1 : 0);
-    // Lines where every strand is at most a pixel and a half wide (at the scene's nearest point) and
-    // there are no sub-pixels; ribbons otherwise.
-    const double nearest = std::max(glm::length(scene.centre - r.cameraPosition) - scene.radius, 1e-3);
-    hairGeometry.draw(hairShade, block > 1 || r.strandWidth * camera.focalPx / nearest > 1.5);
+    hairGeometry.draw(ribbons);
   }
   Texture resolvedColour(GL_RGBA32F, w, h, 1), resolvedData(GL_RGBA32F, w, h, 1);
   {

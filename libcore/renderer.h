@@ -3,6 +3,7 @@
 // from the camera reading both — into framebuffer objects of a headless EGL context.
 #pragma once
 
+#include <algorithm>
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -50,6 +51,12 @@ struct RenderInput {
   int domResolution = 1024;    // texels per side of the light's maps
   bool keepDom = false;
 };
+
+// The light's maps for an image: half the image's larger side, at least 1024 and at most 4096 texels
+// (the shadow lookup filters 2×2 texels, so this keeps shadows as sharp as the image needs).
+inline int domResolutionFor(const glm::ivec2& resolution) {
+  return std::clamp(std::max(resolution.x, resolution.y) / 2, 1024, 4096);
+}
 
 // Renders with the current context of `gl`. Deterministic for a given device and driver.
 RenderOutput renderHair(GlContext& gl, const RenderInput& input);

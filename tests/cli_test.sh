@@ -110,6 +110,43 @@ interpolate_errors)
   [ ! -e "$tmp/c.hair" ] || fail "output written after an error"
   expect_rc 0 "$hairgen" interpolate "$tmp/tri.txt" --guides "$tmp/tri.hair" -o "$tmp/c.glb" --quiet
   ;;
+render_errors)
+  expect_rc 2 "$hairgen" render "$src/configs/default/setup.txt" -o "$tmp/i.exr"
+  grep -q -- "--hair" "$tmp/err" || fail "missing --hair not named: $(cat "$tmp/err")"
+  printf 'HAIR' > "$tmp/bad.hair"
+  expect_rc 2 "$hairgen" render "$src/configs/default/setup.txt" --hair "$tmp/bad.hair" -o "$tmp/i.exr"
+  grep -q "bad.hair" "$tmp/err" || fail "bad cache not named: $(cat "$tmp/err")"
+  expect_rc 2 "$hairgen" render "$src/configs/default/setup.txt" --hair "$tmp/bad.hair" -o "$tmp/i.png"
+  [ ! -e "$tmp/i.exr" ] && [ ! -e "$tmp/i.png" ] || fail "output written after an error"
+  expect_rc 0 "$hairgen" render --list-devices
+  grep -q "opens" "$tmp/out" || fail "no device opens: $(cat "$tmp/out")"
+  ;;
+render_diff)
+  expect_rc 0 "$hairgen" grow "$src/configs/thesis/coupe2/setup.txt" -o "$tmp/g.hair" --quiet
+  small=(--set "Render.Resolution=96 96" --quiet)
+  expect_rc 0 "$hairgen" render "$src/configs/default/setup.txt" --hair "$tmp/g.hair" -o "$tmp/a.exr" "${small[@]}" \
+    --preview "$tmp/a.png" --dom "$tmp/dom.exr"
+  expect_rc 0 "$hairgen" render "$src/configs/default/setup.txt" --hair "$tmp/g.hair" -o "$tmp/b.exr" "${small[@]}" \
+    --set "Render.LightPosition=-0.6 1.0 0.8"
+  if command -v exrheader >/dev/null; then
+    exrheader "$tmp/a.exr" > "$tmp/header"
+    for c in "R, 16-bit floating" "G, 16-bit" "B, 16-bit" "A, 16-bit" "Z, 32-bit floating" "opacity, 32-bit" \
+             "shadow, 32-bit" 'producer (type string): "hairgen' "hairgen:configDigest" "worldToCamera"; do
+      grep -q "$c" "$tmp/header" || fail "exrheader does not show '$c'"
+    done
+    exrheader "$tmp/dom.exr" | grep -q "layer4, 32-bit" || fail "the DOM file lacks its fourth layer"
+  fi
+  [ -s "$tmp/a.png" ] || fail "no preview"
+  expect_rc 0 "$hairgen" diff "$tmp/a.exr" "$tmp/a.exr"
+  grep -q "^PASS" "$tmp/out" || fail "an image differs from itself: $(cat "$tmp/out")"
+  expect_rc 4 "$hairgen" diff "$tmp/a.exr" "$tmp/b.exr" --out "$tmp/d.exr"
+  grep -q "^FAIL" "$tmp/out" || fail "no FAIL verdict: $(cat "$tmp/out")"
+  grep -q "worst pixel ([0-9]*, [0-9]*) channel" "$tmp/out" || fail "worst pixel not named: $(cat "$tmp/out")"
+  [ -s "$tmp/d.exr" ] || fail "no difference image"
+  # Moving the light changes the shading, not the geometry.
+  expect_rc 0 "$hairgen" diff "$tmp/a.exr" "$tmp/b.exr" --channels Z,opacity
+  expect_rc 2 "$hairgen" diff "$tmp/a.exr" "$tmp/missing.exr"
+  ;;
 wick_info)
   expect_rc 0 "$hairgen" info "$src/configs/assets/wick.obj"
   grep -q "759 vertices, 1443 triangles, area" "$tmp/out" || fail "wick info: $(cat "$tmp/out")"

@@ -3,7 +3,11 @@
 //                       items_per_second is energy evaluations per second per core.
 //   GrowCoupe3:         the whole grow stage on every core, counters guides/s and evaluations/s.
 //   InterpolateCoupe3:  ~150,000 strands of 64 vertices from coupe 3's guides, every core.
+//   Render/strands/width/height/samples: coupe 3 with the head and shadows, through whatever EGL opens
+//                       (llvmpipe here); counters give each pass's seconds.
 #include <benchmark/benchmark.h>
+
+#include <map>
 
 #include <tbb/global_control.h>
 #include <tbb/info.h>
@@ -12,6 +16,8 @@
 #include "libcore/setup.h"
 #include "stages/grow.h"
 #include "stages/interpolate.h"
+#include "libcore/gl_context.h"
+#include "libcore/renderer.h"
 
 namespace hairgen {
 namespace {
@@ -89,6 +95,64 @@ void InterpolateCoupe3(benchmark::State& state) {
   state.counters["vertices/s"] = benchmark::Counter(double(points), benchmark::Counter::kIsRate);
 }
 BENCHMARK(InterpolateCoupe3)->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(3.0);
+
+// Coupe 3 at about `strands` strands (64 vertices each), made once per size.
+const Strands& coupe3Strands(int strands) {
+  static std::map<int, Strands> made;
+  auto it = made.find(strands);
+  if (it != made.end()) return it->second;
+  const Coupe3& c = coupe3();
+  Hairstyle style = c.config.hairstyle;
+  style.visualityStep = style.totalLength() / 63.0;
+  const Strands guides = grow(c.wick, style, c.config.collision, {}).guides;
+  double area = 0.0;
+  for (const glm::uvec3& t : c.wick.triangles) {
+    glm::dvec3 a(c.wick.positions[t.x]), b(c.wick.positions[t.y]), d(c.wick.positions[t.z]);
+    area += 0.5 * glm::length(glm::cross(b - a, d - a)) * 1e4;
+  }
+  style.hairDensity = strands / area;
+  return made[strands] = interpolate(c.wick, guides, style, c.config.collision, {});
+}
+
+void Render(benchmark::State& state) {
+  static GlContext gl;
+  static const Mesh head = readObj(std::filesystem::path(HAIRGEN_SOURCE_DIR) / "configs/assets/head.obj");
+  const Strands& hair = coupe3Strands(int(state.range(0)));
+  RenderInput in;
+  in.hair = &hair;
+  in.head = &head;
+  in.visuality = coupe3().config.visuality;
+  in.settings = coupe3().config.render;
+  in.settings.resolution = {int(state.range(1)), int(state.range(2))};
+  in.settings.samples = int(state.range(3));
+  in.domResolution = domResolutionFor(in.settings.resolution);
+  RenderTimings sum;
+  for (auto _ : state) {
+    RenderOutput out = renderHair(gl, in);
+    sum.upload += out.timings.upload;
+    sum.lightDepth += out.timings.lightDepth;
+    sum.opacity += out.timings.opacity;
+    sum.shading += out.timings.shading;
+    sum.readback += out.timings.readback;
+  }
+  const double n = double(state.iterations());
+  state.counters["strands"] = double(hair.strandCount());
+  state.counters["upload_s"] = sum.upload / n;
+  state.counters["lightDepth_s"] = sum.lightDepth / n;
+  state.counters["opacity_s"] = sum.opacity / n;
+  state.counters["shading_s"] = sum.shading / n;
+  state.counters["readback_s"] = sum.readback / n;
+  state.SetLabel(gl.renderer() + " (" + gl.platform() + ")");
+}
+BENCHMARK(Render)
+    ->ArgNames({"strands", "width", "height", "samples"})
+    ->Args({10000, 512, 512, 1})
+    ->Args({10000, 512, 512, 4})
+    ->Args({150000, 1920, 1080, 1})
+    ->Args({150000, 1920, 1080, 4})
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime()
+    ->Iterations(3);
 
 }  // namespace
 }  // namespace hairgen
