@@ -526,20 +526,6 @@ void setHairWidth(const Shader& s, const View& v, const RenderSettings& r) {
   s.set("uOpacity", float(r.strandOpacity));
 }
 
-std::vector<glm::vec3> tangentsOf(const Strands& s) {
-  if (!s.tangents.empty()) return s.tangents;
-  std::vector<glm::vec3> t(s.pointCount(), glm::vec3(0, 1, 0));
-  for (size_t i = 0; i < s.strandCount(); ++i) {
-    uint32_t first = s.firstPoint[i], last = s.firstPoint[i + 1];
-    for (uint32_t p = first; p < last; ++p) {
-      glm::vec3 d = p + 1 < last ? s.points[p + 1] - s.points[p] : (p > first ? s.points[p] - s.points[p - 1] : glm::vec3(0, 1, 0));
-      float len = glm::length(d);
-      t[p] = len > 0.0f ? d / len : (p > first ? t[p - 1] : glm::vec3(0, 1, 0));
-    }
-  }
-  return t;
-}
-
 // Reads `count` float channels of a single-sample RGBA32F texture into planes, rows top to bottom.
 void readPlanes(GLuint texture, int w, int h, std::vector<std::vector<float>*> planes) {
   std::vector<float> rgba(size_t(w) * h * 4);

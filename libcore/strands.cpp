@@ -57,4 +57,18 @@ void Strands::validate(const std::string& source) const {
     throw InputError({source, 0}, "header defaults are not finite");
 }
 
+std::vector<glm::vec3> polylineTangents(const Strands& s) {
+  std::vector<glm::vec3> t(s.pointCount(), glm::vec3(0.0f, 1.0f, 0.0f));
+  for (size_t i = 0; i < s.strandCount(); ++i) {
+    const uint32_t first = s.firstPoint[i], last = s.firstPoint[i + 1];
+    glm::vec3 previous(0.0f, 1.0f, 0.0f);
+    for (uint32_t p = first; p < last; ++p) {
+      glm::vec3 d = p + 1 < last ? s.points[p + 1] - s.points[p] : (p > first ? s.points[p] - s.points[p - 1] : previous);
+      float len = glm::length(d);
+      t[p] = previous = len > 0.0f ? d / len : previous;
+    }
+  }
+  return t;
+}
+
 }  // namespace hairgen

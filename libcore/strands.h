@@ -65,4 +65,13 @@ struct Strands {
   bool operator==(const Strands&) const = default;
 };
 
+// Unit tangents of every strand's polyline by forward differences (the last point looks back; a
+// repeated point keeps the previous tangent, +y before any), for caches that carry none.
+std::vector<glm::vec3> polylineTangents(const Strands& strands);
+
+// The strands' own tangents when they carry them, else polylineTangents().
+inline std::vector<glm::vec3> tangentsOf(const Strands& strands) {
+  return strands.tangents.empty() ? polylineTangents(strands) : strands.tangents;
+}
+
 }  // namespace hairgen

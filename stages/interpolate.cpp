@@ -20,21 +20,6 @@ namespace {
 enum Stream : uint64_t { kRootU1, kRootU2, kTipV1, kTipV2, kCountFraction };
 constexpr uint64_t kTriangleKey = std::numeric_limits<uint64_t>::max();  // "strand" of per-triangle numbers
 
-// Unit tangents of a polyline by forward differences (the last point looks back).
-std::vector<glm::vec3> polylineTangents(const Strands& s) {
-  std::vector<glm::vec3> t(s.pointCount(), glm::vec3(0.0f, 1.0f, 0.0f));
-  for (size_t i = 0; i < s.strandCount(); ++i) {
-    uint32_t first = s.firstPoint[i], last = s.firstPoint[i + 1];
-    glm::vec3 previous(0.0f, 1.0f, 0.0f);
-    for (uint32_t p = first; p < last; ++p) {
-      glm::vec3 d = p + 1 < last ? s.points[p + 1] - s.points[p] : (p > first ? s.points[p] - s.points[p - 1] : previous);
-      float len = glm::length(d);
-      t[p] = previous = len > 0.0f ? d / len : previous;
-    }
-  }
-  return t;
-}
-
 // Normalised arc length of every vertex of a polyline; all zero when it has no length.
 std::vector<double> normalisedArcLength(const glm::vec3* p, uint32_t count) {
   std::vector<double> u(count, 0.0);
@@ -161,8 +146,7 @@ Strands interpolate(const Mesh& wick, const Strands& guides, const Hairstyle& st
   checkGuides(wick, guides, options.guidesName);
   const size_t triangleCount = wick.triangles.size();
   const uint64_t seed = style.seed;
-  const std::vector<glm::vec3> computedTangents = guides.tangents.empty() ? polylineTangents(guides) : std::vector<glm::vec3>{};
-  const std::vector<glm::vec3>& guideTangents = guides.tangents.empty() ? computedTangents : guides.tangents;
+  const std::vector<glm::vec3> guideTangents = tangentsOf(guides);
 
   // Counts and offsets first, so every triangle writes its own slice of the arrays in parallel.
   std::vector<uint32_t> count(triangleCount), vertices(triangleCount);
