@@ -65,7 +65,9 @@ void registerRun(CLI::App& app, int& exitCode) {
       Stopwatch clock;
       Config config = loadConfig(setup, overrides, SetupUse::kRun);
       stats.time("read", clock.lap());
-      fs::create_directories(out);
+      std::error_code made;
+      fs::create_directories(out, made);
+      if (made) throw InputError("-o " + out.string() + ": cannot create the output folder: " + made.message());
 
       Strands coupe;
       if (config.setup.load) {
