@@ -85,7 +85,7 @@ grow_errors)
   ;;
 run_equals_stages)
   setup="$src/configs/thesis/coupe2/setup.txt"
-  set_density=(--set Hairstyle.HairDensity=15)
+  set_density=(--set Hairstyle.HairDensity=15 --set "Render.Resolution=64 64")
   expect_rc 0 "$hairgen" run "$setup" -o "$tmp/run" --quiet "${set_density[@]}"
   expect_rc 0 "$hairgen" grow "$setup" -o "$tmp/g.hair" --quiet --threads 1 "${set_density[@]}"
   expect_rc 0 "$hairgen" interpolate "$setup" --guides "$tmp/g.hair" -o "$tmp/c.hair" --threads 2 "${set_density[@]}" \
@@ -93,6 +93,17 @@ run_equals_stages)
   cmp "$tmp/run/guides.hair" "$tmp/g.hair" || fail "run's guides differ from grow's"
   cmp "$tmp/run/coupe.hair" "$tmp/c.hair" || fail "run's coupe differs from interpolate's"
   grep -q '"strands"' "$tmp/stats.json" || fail "no strand count in --stats"
+  expect_rc 0 "$hairgen" render "$setup" --hair "$tmp/c.hair" -o "$tmp/beauty.exr" --quiet "${set_density[@]}"
+  cmp "$tmp/run/beauty.exr" "$tmp/beauty.exr" || fail "run's image differs from render's"
+  # Load and Save: render a saved coupe without growing it.
+  printf 'Load true\nLoadFile %s\nSave true\nSaveFile saved.hair\nHeadModel %s\n' "$tmp/c.hair" \
+    "$src/configs/assets/head.obj" > "$tmp/load.txt"
+  expect_rc 0 "$hairgen" run "$tmp/load.txt" -o "$tmp/loaded" --quiet --set "Render.Resolution=48 48"
+  cmp "$tmp/saved.hair" "$tmp/c.hair" || fail "Save did not write the loaded coupe"
+  [ -s "$tmp/loaded/beauty.exr" ] && [ ! -e "$tmp/loaded/guides.hair" ] || fail "Load should render without growing"
+  printf 'Load true\n' > "$tmp/noload.txt"
+  expect_rc 2 "$hairgen" run "$tmp/noload.txt" -o "$tmp/x"
+  grep -q "noload.txt:1:" "$tmp/err" || fail "Load without LoadFile not located: $(cat "$tmp/err")"
   expect_rc 0 "$hairgen" convert "$tmp/c.hair" "$tmp/c.glb"
   expect_rc 0 "$hairgen" convert "$tmp/c.glb" "$tmp/back.hair"
   cmp "$tmp/c.hair" "$tmp/back.hair" || fail "coupe does not round-trip through GLB"
