@@ -158,6 +158,18 @@ render_diff)
   expect_rc 0 "$hairgen" diff "$tmp/a.exr" "$tmp/b.exr" --channels Z,opacity
   expect_rc 2 "$hairgen" diff "$tmp/a.exr" "$tmp/missing.exr"
   ;;
+run_default)
+  # With no Setup, run finds configs/default beside an installed executable, or through HAIRGEN_DATA.
+  cmake --install "$(dirname "$hairgen")" --prefix "$tmp/prefix" >/dev/null || fail "install failed"
+  (cd "$tmp" && expect_rc 0 "$tmp/prefix/bin/hairgen" run -o "$tmp/installed" --no-render --quiet \
+    --set Hairstyle.HairDensity=5) || exit 1
+  [ -s "$tmp/installed/coupe.hair" ] || fail "the installed hairgen did not find its default coupe"
+  mkdir -p "$tmp/lonely" && cp "$hairgen" "$tmp/lonely/hairgen"
+  (cd "$tmp" && expect_rc 2 "$tmp/lonely/hairgen" run --no-render) || exit 1
+  grep -q "HAIRGEN_DATA" "$tmp/err" || fail "no hint at HAIRGEN_DATA: $(cat "$tmp/err")"
+  (cd "$tmp" && HAIRGEN_DATA="$src" expect_rc 0 "$tmp/lonely/hairgen" run -o "$tmp/viaenv" --no-render --quiet \
+    --set Hairstyle.HairDensity=5) || exit 1
+  ;;
 wick_info)
   expect_rc 0 "$hairgen" info "$src/configs/assets/wick.obj"
   grep -q "759 vertices, 1443 triangles, area" "$tmp/out" || fail "wick info: $(cat "$tmp/out")"
