@@ -11,6 +11,7 @@
 #include "libcore/hair_cache.h"
 #include "libcore/obj_io.h"
 #include "libcore/setup.h"
+#include "stages/shade.h"
 
 namespace hairgen::cli {
 namespace {
@@ -87,6 +88,12 @@ void registerRun(CLI::App& app, int& exitCode) {
         writeStrands(out / "coupe.hair", coupe);
         stats.time("write", writing + clock.lap());
         note(options->common, "run: wrote " + guidesFile.string() + " and " + (out / "coupe.hair").string());
+      }
+      if (wantsShade(config.visuality)) {
+        coupe = shadeStage(options->common, config, coupe, stats);
+        clock.lap();
+        writeStrands(out / "shaded.hair", coupe);
+        stats.time("write", stats.json()["seconds"].value("write", 0.0) + clock.lap());
       }
       if (config.setup.save) {
         writeStrands(config.setup.saveFile.path, coupe);

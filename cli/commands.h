@@ -24,11 +24,13 @@ void registerGrow(CLI::App& app, int& exitCode);
 void registerInterpolate(CLI::App& app, int& exitCode);
 void registerRun(CLI::App& app, int& exitCode);
 void registerRender(CLI::App& app, int& exitCode);
+void registerShade(CLI::App& app, int& exitCode);
 void registerDiff(CLI::App& app, int& exitCode);
 
 GrowResult growStage(const CommonOptions& common, const Config& config, const Mesh& wick, Stats& stats);
 Strands interpolateStage(const CommonOptions& common, const Config& config, const Mesh& wick, const Strands& guides,
                          const std::string& guidesName, Stats& stats);
+Strands shadeStage(const CommonOptions& common, const Config& config, const Strands& coupe, Stats& stats);
 RenderOutput renderStage(const CommonOptions& common, const Config& config, const Strands& hair, const Mesh* head,
                          bool keepDom, Stats& stats);
 // Writes the EXR, and the light's maps and the preview where named (empty: not wanted).

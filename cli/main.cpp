@@ -21,6 +21,7 @@ int main(int argc, char** argv) {
   registerRun(app, exitCode);
   registerGrow(app, exitCode);
   registerInterpolate(app, exitCode);
+  registerShade(app, exitCode);
   registerRender(app, exitCode);
   registerDiff(app, exitCode);
   registerInfo(app, exitCode);

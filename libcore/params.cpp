@@ -39,6 +39,17 @@ const char* name(ShapeKind kind) {
   return "Sphere";
 }
 
+bool ForceField::contains(const glm::dvec3& p) const {
+  switch (region) {
+    case Region::kAll: return true;
+    case Region::kAbove: return p.y > level;
+    case Region::kBelow: return p.y < level;
+    case Region::kSide: return glm::dot(p, side) > 0.0;
+    case Region::kBox: return glm::all(glm::greaterThanEqual(p, lo)) && glm::all(glm::lessThanEqual(p, hi));
+  }
+  return false;
+}
+
 double Hairstyle::totalLength() const { return std::accumulate(hairLengths.begin(), hairLengths.end(), 0.0); }
 
 std::string Config::canonicalText() const {
@@ -63,7 +74,15 @@ std::string Config::canonicalText() const {
       << "Hairstyle.Model " << name(h.model) << "\n"
       << "Hairstyle.Clump " << formatReal(h.clump) << "\n"
       << "Hairstyle.StrayHairs " << (h.strayHairs ? "true" : "false") << "\n"
-      << "Hairstyle.Seed " << h.seed << "\n";
+      << "Hairstyle.Seed " << h.seed << "\n"
+      << "Hairstyle.Segments " << h.segments << "\n"
+      << "Hairstyle.FlexuralRigidity " << formatReal(h.flexuralRigidity) << "\n"
+      << "Hairstyle.JointAngleLimit " << formatReal(h.jointLimit) << " " << h.jointLimitFrom << "\n";
+  for (const ForceField& f : h.forces)
+    out << "Hairstyle.Force " << join(f.acceleration) << " " << int(f.region) << " " << formatReal(f.level) << " "
+        << join(f.side) << " " << join(f.lo) << " " << join(f.hi) << "\n";
+  for (const HairCut& c : h.cuts)
+    out << "Hairstyle.Cut " << join({c.azimuthFrom, c.azimuthTo, c.zenithMax, c.height}) << "\n";
   for (const CollisionShape& c : collision.shapes) {
     out << "Collision." << name(c.kind) << " " << join({c.volume, c.penalty}) << " " << join(c.centre) << " "
         << join(c.halfExtents);
@@ -75,7 +94,9 @@ std::string Config::canonicalText() const {
   out << "Visuality.AmbientColor " << join(v.ambientColor) << "\n"
       << "Visuality.DiffuseColor " << join(v.diffuseColor) << "\n"
       << "Visuality.SpecularColor " << join(v.specularColor) << "\n"
-      << "Visuality.Glossiness " << formatReal(v.glossiness) << "\n";
+      << "Visuality.Glossiness " << formatReal(v.glossiness) << "\n"
+      << "Visuality.AmbientMean " << formatReal(v.ambientMean) << "\n"
+      << "Visuality.AmbientDeviation " << formatReal(v.ambientDeviation) << "\n";
   const RenderSettings& r = render;
   out << "Render.Resolution " << r.resolution.x << " " << r.resolution.y << "\n"
       << "Render.CameraPosition " << join(r.cameraPosition) << "\n"

@@ -20,6 +20,27 @@ enum class ShadingModel { kKajiyaKay, kThesis, kAnjyo, kVolumetric };
 const char* name(StylingModel model);
 const char* name(ShadingModel model);
 
+// Anjyo's styling extras (Hairstyle Info, repeatable lines). A force field adds an acceleration
+// (m/s², like Gravity) to the segments whose start node lies in its region.
+struct ForceField {
+  enum class Region { kAll, kAbove, kBelow, kSide, kBox };
+  glm::dvec3 acceleration{0.0};
+  Region region = Region::kAll;
+  double level = 0.0;          // kAbove / kBelow: a height, metres
+  glm::dvec3 side{0.0};        // kSide: a unit axis (±x or ±z); the region is where p·side > 0
+  glm::dvec3 lo{0.0}, hi{0.0}; // kBox
+  FileLoc where;
+  bool contains(const glm::dvec3& p) const;
+};
+
+// A cut: for pores whose azimuth (degrees from the face, +z, toward +x) lies in [azimuthFrom,
+// azimuthTo] and whose zenith (degrees from the top) is at most zenithMax, on the head ellipsoid's
+// polar coordinates, the hair ends at its first node below `height` (metres).
+struct HairCut {
+  double azimuthFrom = 0.0, azimuthTo = 0.0, zenithMax = 0.0, height = 0.0;
+  FileLoc where;
+};
+
 // Hairstyle Info: the mechanics of one hair and the density of the coupe.
 struct Hairstyle {
   double visualityStep = 0.0025;    // metres of arc length between output vertices
@@ -40,6 +61,13 @@ struct Hairstyle {
   double clump = 0.25;              // tip weights v1, v2 drawn in [0, Clump): 0 gathers tips at the nearest guide
   bool strayHairs = true;           // true = the thesis' barycentric assignment (§4.1.4.4)
   uint64_t seed = 0;                // keys every random number; --seed overrides it
+  // Model cantilever (Anjyo et al. 1992):
+  int segments = 20;                // equal segments per hair, over the whole of HairLengths
+  double flexuralRigidity = 0.0;    // E·I in N·m²; 0 = Young × π a b³/4
+  double jointLimit = 180.0;        // degrees: the largest turn between consecutive segments
+  int jointLimitFrom = 1;           // the first node (1 = the first after the pore) the limit applies to
+  std::vector<ForceField> forces;
+  std::vector<HairCut> cuts;
 
   double totalLength() const;       // metres
 };
@@ -68,6 +96,9 @@ struct Visuality {
   glm::dvec3 diffuseColor{0.45, 0.25, 0.00};
   glm::dvec3 specularColor{0.20, 0.20, 0.20};
   double glossiness = 60.0;  // specular exponent p
+  // `hairgen shade`: a per-strand coefficient a ~ N(AmbientMean, AmbientDeviation), clamped at 0,
+  // multiplies the strand's colour (stored per vertex in the cache).
+  double ambientMean = 1.0, ambientDeviation = 0.0;
 };
 
 // Render Info (new in hairgen): camera, light and film.

@@ -53,6 +53,40 @@ CollisionShape readShape(const SectionReader& reader, const ConfigLine& line, Sh
   return shape;
 }
 
+ForceField readForce(const SectionReader& r, const ConfigLine& line) {
+  auto bad = [&](const std::string& why) {
+    return r.error(line, "Force " + why + "; expected ax ay az all | above Y | below Y | side +x|-x|+z|-z | box x0 y0 z0 x1 y1 z1");
+  };
+  if (line.values.size() < 4) throw bad("needs an acceleration and a region");
+  ForceField f;
+  f.where = line.where;
+  for (int i = 0; i < 3; ++i) f.acceleration[i] = r.checkReal(line, i, Range::closed(-1e4, 1e4), "acceleration");
+  std::string region = line.values[3];
+  for (char& c : region) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  const size_t extra = line.values.size() - 4;
+  if (region == "all" && extra == 0) {
+    f.region = ForceField::Region::kAll;
+  } else if ((region == "above" || region == "below") && extra == 1) {
+    f.region = region == "above" ? ForceField::Region::kAbove : ForceField::Region::kBelow;
+    f.level = r.checkReal(line, 4, {}, "height");
+  } else if (region == "side" && extra == 1) {
+    const std::string& s = line.values[4];
+    f.region = ForceField::Region::kSide;
+    if (s == "+x") f.side = {1, 0, 0};
+    else if (s == "-x") f.side = {-1, 0, 0};
+    else if (s == "+z") f.side = {0, 0, 1};
+    else if (s == "-z") f.side = {0, 0, -1};
+    else throw bad("side '" + s + "' is not +x, -x, +z or -z");
+  } else if (region == "box" && extra == 6) {
+    f.region = ForceField::Region::kBox;
+    for (int i = 0; i < 3; ++i) f.lo[i] = r.checkReal(line, 4 + i, {}, "box corner");
+    for (int i = 0; i < 3; ++i) f.hi[i] = r.checkReal(line, 7 + i, {}, "box corner");
+  } else {
+    throw bad("region '" + line.values[3] + "' with " + std::to_string(extra) + " values is not understood");
+  }
+  return f;
+}
+
 ConfigText emptyText(const std::filesystem::path& setupFile, const char* what) {
   return ConfigText{std::string("(no ") + what + " file; defaults)", setupFile.parent_path(), {}};
 }
@@ -119,6 +153,33 @@ Hairstyle readHairstyle(const ConfigText& text, const std::vector<Override>& ove
   h.clump = r.real("Clump", h.clump, Range::closed(0.0, 1.0));
   h.strayHairs = r.boolean("StrayHairs", h.strayHairs);
   h.seed = r.unsignedInteger("Seed", h.seed);
+  h.segments = static_cast<int>(r.integer("Segments", h.segments, 1, 100000));
+  h.flexuralRigidity = r.real("FlexuralRigidity", h.flexuralRigidity, Range::nonNegative());
+  if (r.has("JointAngleLimit")) {
+    std::vector<const ConfigLine*> limit = r.lines("JointAngleLimit");
+    const ConfigLine& line = *limit.front();
+    if (line.values.empty() || line.values.size() > 2)
+      throw r.error(line, "JointAngleLimit takes degrees and, optionally, the first node it applies to");
+    h.jointLimit = r.checkReal(line, 0, Range::closed(0.0, 180.0), "degrees");
+    if (line.values.size() == 2) {
+      double from = r.checkReal(line, 1, Range::closed(1.0, 100000.0), "first node");
+      if (from != std::floor(from)) throw r.error(line, "the first node must be a whole number");
+      h.jointLimitFrom = static_cast<int>(from);
+    }
+  }
+  for (const ConfigLine* line : r.lines("Force")) h.forces.push_back(readForce(r, *line));
+  for (const ConfigLine* line : r.lines("Cut")) {
+    if (line->values.size() != 4)
+      throw r.error(*line, "Cut takes azimuthFrom azimuthTo zenithMax height, found " + std::to_string(line->values.size()) +
+                               " values");
+    HairCut c;
+    c.azimuthFrom = r.checkReal(*line, 0, Range::closed(-360.0, 360.0), "azimuth");
+    c.azimuthTo = r.checkReal(*line, 1, Range::closed(-360.0, 360.0), "azimuth");
+    c.zenithMax = r.checkReal(*line, 2, Range::closed(0.0, 180.0), "zenith");
+    c.height = r.checkReal(*line, 3, {}, "height");
+    c.where = line->where;
+    h.cuts.push_back(c);
+  }
   r.finish();
   return h;
 }
@@ -147,6 +208,8 @@ Visuality readVisuality(const ConfigText& text, const std::vector<Override>& ove
   v.diffuseColor = r.vec3("DiffuseColor", v.diffuseColor, Range::closed(0.0, 1000.0));
   v.specularColor = r.vec3("SpecularColor", v.specularColor, Range::closed(0.0, 1000.0));
   v.glossiness = r.real("Glossiness", v.glossiness, Range::closed(0.0, 100000.0));
+  v.ambientMean = r.real("AmbientMean", v.ambientMean, Range::closed(0.0, 1000.0));
+  v.ambientDeviation = r.real("AmbientDeviation", v.ambientDeviation, Range::closed(0.0, 1000.0));
   r.finish();
   return v;
 }

@@ -7,6 +7,7 @@
 #include <tbb/parallel_for.h>
 
 #include "libcore/error.h"
+#include "stages/cantilever.h"
 
 namespace hairgen {
 
@@ -48,6 +49,7 @@ GrowResult grow(const Mesh& wick, const Hairstyle& style, const Collision& colli
     if (!std::isfinite(n.x) || !std::isfinite(n.y) || !std::isfinite(n.z) || glm::length(n) < 1e-6f)
       throw InputError("wick vertex " + std::to_string(i) + " has a zero or non-finite normal; a follicle needs a direction");
   }
+  if (style.model == StylingModel::kCantilever) return growCantilever(wick, style, collision, options);
   float yMin = wick.positions[0].y, yMax = yMin;
   for (const glm::vec3& p : wick.positions) {
     yMin = std::min(yMin, p.y);

@@ -3,6 +3,7 @@
 //                       items_per_second is energy evaluations per second per core.
 //   GrowCoupe3:         the whole grow stage on every core, counters guides/s and evaluations/s.
 //   InterpolateCoupe3:  ~150,000 strands of 64 vertices from coupe 3's guides, every core.
+//   CantileverStyling:  Anjyo's figures, 20,000 hairs of 20 segments bent around the head ellipsoid.
 //   Render/strands/width/height/samples: coupe 3 with the head and shadows, through whatever EGL opens
 //                       (llvmpipe here); counters give each pass's seconds.
 #include <benchmark/benchmark.h>
@@ -14,6 +15,7 @@
 
 #include "libcore/obj_io.h"
 #include "libcore/setup.h"
+#include "stages/cantilever.h"
 #include "stages/grow.h"
 #include "stages/interpolate.h"
 #include "libcore/gl_context.h"
@@ -95,6 +97,30 @@ void InterpolateCoupe3(benchmark::State& state) {
   state.counters["vertices/s"] = benchmark::Counter(double(points), benchmark::Counter::kIsRate);
 }
 BENCHMARK(InterpolateCoupe3)->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(3.0);
+
+void CantileverStyling(benchmark::State& state) {
+  // 20,000 pores spread evenly over the upper head ellipsoid (a Fibonacci lattice), normals outward.
+  const CollisionShape head{ShapeKind::kEllipsoid, 0.0, 10.0, glm::dvec3(-0.001, 0.068, 0.010), glm::dvec3(0.08, 0.08, 0.11),
+                            glm::dmat3(1.0), {}};
+  Mesh wick;
+  const int n = 20000;
+  for (int i = 0; i < n; ++i) {
+    double y = 1.0 - double(i) / (n - 1) * 1.2, r = std::sqrt(std::max(0.0, 1.0 - y * y)), phi = i * 2.399963229728653;
+    glm::dvec3 unit(r * std::sin(phi), y, r * std::cos(phi));
+    wick.positions.push_back(glm::vec3(head.centre + unit * head.halfExtents));
+    wick.normals.push_back(glm::vec3(glm::normalize(unit / head.halfExtents)));
+  }
+  Hairstyle style;
+  style.model = StylingModel::kCantilever;
+  style.hairLengths = {0.22};
+  style.segments = 20;
+  style.forces.push_back({glm::dvec3(6, 0, 0), ForceField::Region::kSide, 0.0, glm::dvec3(1, 0, 0), {}, {}, {}});
+  Collision collision;
+  collision.shapes.push_back(head);
+  for (auto _ : state) benchmark::DoNotOptimize(grow(wick, style, collision, {}).guides.points.data());
+  state.counters["hairs/s"] = benchmark::Counter(double(n) * double(state.iterations()), benchmark::Counter::kIsRate);
+}
+BENCHMARK(CantileverStyling)->Unit(benchmark::kMillisecond)->UseRealTime();
 
 // Coupe 3 at about `strands` strands (64 vertices each), made once per size.
 const Strands& coupe3Strands(int strands) {
