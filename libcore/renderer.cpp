@@ -54,9 +54,12 @@ constexpr const char* kHairVertex = R"(
 #ifdef RIBBON
 layout(std430, binding = 0) readonly buffer Points { float pointData[]; };
 layout(std430, binding = 1) readonly buffer Tangents { float tangentData[]; };
+layout(std430, binding = 2) readonly buffer Colours { float colourData[]; };
+uniform int uHasColour;
 #else
 layout(location = 0) in vec3 aPosition;
 layout(location = 1) in vec3 aTangent;
+layout(location = 2) in vec3 aColour;  // (1, 1, 1) when the cache has no colours
 #endif
 uniform mat4 uView;
 uniform mat4 uProj;
@@ -67,6 +70,7 @@ uniform float uOpacity;
 uniform float uMinWidth;  // pixels: the narrowest ribbon
 out vec3 vWorld;
 out vec3 vTangent;
+out vec3 vColour;
 out float vAlpha;
 out float vDepth;         // metres along the view axis
 void main() {
@@ -74,9 +78,11 @@ void main() {
   int i = gl_VertexID >> 1;
   vec3 p = vec3(pointData[3 * i], pointData[3 * i + 1], pointData[3 * i + 2]);
   vec3 t = vec3(tangentData[3 * i], tangentData[3 * i + 1], tangentData[3 * i + 2]);
+  vColour = uHasColour != 0 ? vec3(colourData[3 * i], colourData[3 * i + 1], colourData[3 * i + 2]) : vec3(1.0);
 #else
   vec3 p = aPosition;
   vec3 t = aTangent;
+  vColour = aColour;
 #endif
   vec4 view = uView * vec4(p, 1.0);
   vec4 clip = uProj * view;
@@ -180,6 +186,7 @@ float lightArriving(vec3 world, float bias) {
 constexpr const char* kHairFragment = R"(
 in vec3 vWorld;
 in vec3 vTangent;
+in vec3 vColour;
 in float vAlpha;
 in float vDepth;
 uniform vec3 uEye;
@@ -190,7 +197,7 @@ uniform vec3 uAmbientColor;
 uniform vec3 uDiffuseColor;
 uniform vec3 uSpecularColor;
 uniform float uGlossiness;
-uniform int uThesisModel;
+uniform int uModel;       // 0 Kajiya-Kay, 1 the thesis' variant, 2 Anjyo
 uniform int uBlock;       // k: sub-pixels per pixel side
 uniform int uOrder[64];   // the screen door's threshold rank of each sub-pixel of a block, row by row
 layout(location = 0) out vec4 oColor;
@@ -208,10 +215,18 @@ void main() {
   vec3 e = normalize(uEye - vWorld);
   float tl = dot(t, l), te = dot(t, e);
   float sinTL = sqrt(max(0.0, 1.0 - tl * tl)), sinTE = sqrt(max(0.0, 1.0 - te * te));
-  float cone = uThesisModel != 0 ? abs(tl) * abs(te) + sinTL * sinTE : -tl * te + sinTL * sinTE;
-  float specular = pow(max(cone, 0.0), uGlossiness);
+  float diffuse = sinTL, specular;
+  if (uModel == 2) {
+    float th = dot(t, normalize(l + e));
+    specular = pow(max(1.0 - th * th, 0.0), 0.5 * uGlossiness);
+    diffuse = 0.0;
+  } else {
+    float cone = uModel == 1 ? abs(tl) * abs(te) + sinTL * sinTE : -tl * te + sinTL * sinTE;
+    specular = pow(max(cone, 0.0), uGlossiness);
+  }
   float shadow = lightArriving(vWorld, 0.001);
-  vec3 colour = uAmbient * uAmbientColor + shadow * uLightColor * (uDiffuseColor * sinTL + uSpecularColor * specular);
+  vec3 colour = uAmbient * uAmbientColor * vColour +
+                shadow * uLightColor * (uDiffuseColor * vColour * diffuse + uSpecularColor * specular);
   oColor = vec4(colour, vAlpha);
   oData = vec4(vDepth, 1.0, shadow, 0.0);
 }
@@ -386,13 +401,16 @@ struct Buffer {
 // Hair on the GPU: points and tangents in storage buffers; per strand a line strip (one vertex per
 // point) or a triangle strip (two).
 struct HairGeometry {
-  Buffer points, tangents;
+  Buffer points, tangents, colours;
+  bool hasColours;
   std::vector<GLint> lineFirsts, ribbonFirsts;
   std::vector<GLsizei> lineCounts, ribbonCounts;
   GLuint vao = 0;
   HairGeometry(const Strands& s, const std::vector<glm::vec3>& tangentData)
       : points(s.points.data(), s.points.size() * sizeof(glm::vec3)),
-        tangents(tangentData.data(), tangentData.size() * sizeof(glm::vec3)) {
+        tangents(tangentData.data(), tangentData.size() * sizeof(glm::vec3)),
+        colours(s.colors.data(), s.colors.size() * sizeof(glm::vec3)),
+        hasColours(!s.colors.empty()) {
     for (size_t i = 0; i < s.strandCount(); ++i) {
       if (s.pointsOf(i) < 2) continue;
       lineFirsts.push_back(static_cast<GLint>(s.firstPoint[i]));
@@ -403,7 +421,8 @@ struct HairGeometry {
     glCreateVertexArrays(1, &vao);
     glVertexArrayVertexBuffer(vao, 0, points.id, 0, sizeof(glm::vec3));
     glVertexArrayVertexBuffer(vao, 1, tangents.id, 0, sizeof(glm::vec3));
-    for (GLuint a = 0; a < 2; ++a) {
+    glVertexArrayVertexBuffer(vao, 2, colours.id, 0, sizeof(glm::vec3));
+    for (GLuint a = 0; a < (hasColours ? 3u : 2u); ++a) {
       glEnableVertexArrayAttrib(vao, a);
       glVertexArrayAttribFormat(vao, a, 3, GL_FLOAT, GL_FALSE, 0);
       glVertexArrayAttribBinding(vao, a, a);
@@ -453,6 +472,8 @@ void HairGeometry::draw(bool ribbon) const {
   glBindVertexArray(vao);
   glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, points.id);
   glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, tangents.id);
+  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 2, colours.id);
+  if (!hasColours) glVertexAttrib3f(2, 1.0f, 1.0f, 1.0f);
   if (lineFirsts.empty()) return;
   if (ribbon)
     glMultiDrawArrays(GL_TRIANGLE_STRIP, ribbonFirsts.data(), ribbonCounts.data(), static_cast<GLsizei>(ribbonFirsts.size()));
@@ -725,7 +746,8 @@ RenderOutput renderHair(GlContext&, const RenderInput& in) {
     hairShade.set("uDiffuseColor", glm::vec3(in.visuality.diffuseColor));
     hairShade.set("uSpecularColor", glm::vec3(in.visuality.specularColor));
     hairShade.set("uGlossiness", float(in.visuality.glossiness));
-    hairShade.set("uThesisModel", r.shadingModel == ShadingModel::kThesis ? 1 : 0);
+    hairShade.set("uModel", r.shadingModel == ShadingModel::kThesis ? 1 : r.shadingModel == ShadingModel::kAnjyo ? 2 : 0);
+    hairShade.set("uHasColour", hair.colors.empty() ? 0 : 1);
     hairGeometry.draw(ribbons);
   }
   Texture resolvedColour(GL_RGBA32F, w, h, 1), resolvedData(GL_RGBA32F, w, h, 1);

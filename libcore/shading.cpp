@@ -6,6 +6,11 @@ namespace hairgen {
 
 glm::dvec3 shadeHair(ShadingModel model, const glm::dvec3& t, const glm::dvec3& l, const glm::dvec3& e,
                      const Visuality& visuality, const RenderSettings& render, double shadow) {
+  if (model == ShadingModel::kAnjyo) {
+    const double th = glm::dot(t, glm::normalize(l + e));
+    const double specular = std::pow(std::max(1.0 - th * th, 0.0), 0.5 * visuality.glossiness);
+    return render.ambientIntensity * visuality.ambientColor + shadow * render.lightColor * visuality.specularColor * specular;
+  }
   const double tl = glm::dot(t, l), te = glm::dot(t, e);
   const double sinTL = std::sqrt(std::max(0.0, 1.0 - tl * tl)), sinTE = std::sqrt(std::max(0.0, 1.0 - te * te));
   double cone = model == ShadingModel::kThesis ? std::abs(tl) * std::abs(te) + sinTL * sinTE : -tl * te + sinTL * sinTE;

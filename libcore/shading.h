@@ -7,7 +7,9 @@
 //   specular = max(cos(θ − φ), 0)^p with cos θ = −t·l, cos φ = t·e: the mirror cone, brightest where
 //              the eye sees the light's reflection off the cylinder;
 //   `thesis` = the thesis' shader, (|t·l| |t·e| + sin(t,l) sin(t,e))^p, which lights both sides.
+//   `anjyo`  = Anjyo et al. 1992 (8): specular k_s (1 − (t·h)²)^{p/2}, h the halfway vector, no diffuse;
 //   colour   = AmbientIntensity·AmbientColor + shadow·LightColor·(DiffuseColor·diffuse + SpecularColor·specular)
+// A strand's per-vertex colour, where the cache has one, multiplies AmbientColor and DiffuseColor.
 // Head: AmbientIntensity·HeadColor + shadow·LightColor·HeadColor·max(n·l, 0).
 // `shadow` is the light that arrives: 1 − 0.75·opacity (the thesis maps opacity [0, 1] to [1, 0.25]).
 #pragma once

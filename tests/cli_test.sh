@@ -170,6 +170,20 @@ run_default)
   (cd "$tmp" && HAIRGEN_DATA="$src" expect_rc 0 "$tmp/lonely/hairgen" run -o "$tmp/viaenv" --no-render --quiet \
     --set Hairstyle.HairDensity=5) || exit 1
   ;;
+anjyo_errors)
+  printf 'Model cantilever\nHairLengths 0.2\nForce 1 0 0 sideways\n' > "$tmp/h.txt"
+  printf 'HairstyleInfo h.txt\nWickModel %s\n' "$src/configs/assets/wick.obj" > "$tmp/setup.txt"
+  expect_rc 2 "$hairgen" grow "$tmp/setup.txt" -o "$tmp/g.hair"
+  grep -q "h.txt:3: .*region 'sideways'" "$tmp/err" || fail "bad Force not located: $(cat "$tmp/err")"
+  printf 'Model cantilever\nHairLengths 0.2\nCut 0 90 nan 0.1\n' > "$tmp/h.txt"
+  expect_rc 2 "$hairgen" grow "$tmp/setup.txt" -o "$tmp/g.hair"
+  grep -q "h.txt:3:" "$tmp/err" || fail "bad Cut not located: $(cat "$tmp/err")"
+  printf 'Model cantilever\nHairLengths 0.2\nSegments 10\nCut -180 180 180 0.12\n' > "$tmp/h.txt"
+  expect_rc 0 "$hairgen" grow "$tmp/setup.txt" -o "$tmp/g.hair" --quiet
+  expect_rc 0 "$hairgen" interpolate "$tmp/setup.txt" --guides "$tmp/g.hair" -o "$tmp/c.hair" --quiet \
+    --set Hairstyle.HairDensity=5
+  [ ! -e "$tmp/g.hair.tmp" ] && [ -s "$tmp/c.hair" ] || fail "cut guides did not interpolate"
+  ;;
 wick_info)
   expect_rc 0 "$hairgen" info "$src/configs/assets/wick.obj"
   grep -q "759 vertices, 1443 triangles, area" "$tmp/out" || fail "wick info: $(cat "$tmp/out")"

@@ -52,8 +52,8 @@ glm::dvec3 onPlane(const RenderSettings& r, int x, int y) {
   return glm::dvec3(px * r.cameraPosition.z, py * r.cameraPosition.z, 0.0);
 }
 
-TEST(Render, StraightStrandMatchesKajiyaKayOnTheCpu) {
-  for (ShadingModel model : {ShadingModel::kKajiyaKay, ShadingModel::kThesis}) {
+TEST(Render, StraightStrandMatchesKajiyaKayThesisAndAnjyoOnTheCpu) {
+  for (ShadingModel model : {ShadingModel::kKajiyaKay, ShadingModel::kThesis, ShadingModel::kAnjyo}) {
     Strands s;
     addStraight(s, {-0.05f, 0, 0}, {0.05f, 0, 0});
     RenderSettings r = frontCamera(96, 1);
