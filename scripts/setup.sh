@@ -9,6 +9,7 @@ packages=(
   build-essential cmake ninja-build pkg-config git
   libglm-dev libcli11-dev libtinyobjloader-dev libtinygltf-dev nlohmann-json3-dev libstb-dev
   libopenexr-dev openexr libopenimageio-dev openimageio-tools libtbb-dev zlib1g-dev
+  libopenvdb-dev libopenvdb-tools
   libegl-dev libgl-dev libopengl-dev libegl1 libopengl0 libegl-mesa0 libgl1-mesa-dri libgbm1
   libgtest-dev libgmock-dev libbenchmark-dev
 )

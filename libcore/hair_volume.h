@@ -1,0 +1,56 @@
+// Petrovic, Henne and Anderson 2005 (Pixar), §3-4: hair as a volume. Strand points are splatted onto a
+// density grid with a tent kernel; the isosurface of a chosen density is the hair's shell; the signed
+// distance S to it (|∇S| = 1, S = 0 on the shell, negative inside) has gradient N = ∇S, a shading
+// normal that makes the hair shade like one body, with terminators that line up with the head's.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include "libcore/strands.h"
+
+namespace hairgen {
+
+// Values at the nodes of a regular grid: node (i, j, k) sits at origin + h·(i, j, k).
+struct Grid {
+  glm::dvec3 origin{0.0};
+  double voxel = 1.0;
+  glm::ivec3 size{0};
+  std::vector<float> values;
+  size_t index(int i, int j, int k) const { return (size_t(k) * size.y + j) * size.x + i; }
+  float at(int i, int j, int k) const { return values[index(i, j, k)]; }
+  // Trilinear value at a world point (clamped to the grid).
+  double sample(const glm::dvec3& p) const;
+  // Central-difference gradient, trilinearly interpolated at a world point.
+  glm::dvec3 gradient(const glm::dvec3& p) const;
+};
+
+// A grid around `points` with `padding` empty nodes on every side.
+Grid gridAround(const std::vector<glm::vec3>& points, double voxel, int padding);
+
+// Splats every point with the tent (trilinear) kernel of the paper's (1): each point adds weights
+// summing to 1 to the 8 nodes around it, so the grid sums to the number of points inside it.
+void splat(Grid& density, const std::vector<glm::vec3>& points);
+
+// One pass of a separable binomial [1 2 1]/4 filter (mass-preserving away from the edges).
+Grid smoothed(const Grid& grid);
+
+// The signed distance to the isosurface density = `iso` of the smoothed density (negative inside), by
+// fast sweeping from |φ|/|∇φ| at the nodes next to the shell.
+Grid signedDistance(const Grid& density, double iso);
+
+// Shading normals ∇S/|∇S| at every strand vertex.
+std::vector<glm::vec3> volumeNormals(const Grid& distance, const Strands& strands);
+
+// Parallel-transport frames: at the root (t, u, t×u) with u the direction from the root toward the
+// centroid of all roots, made normal to t (fixed to the follicle and moving rigidly with the coupe),
+// then carried vertex to vertex by the minimal rotation between tangents. Returns u per vertex.
+std::vector<glm::vec3> transportFrames(const Strands& strands);
+
+// Re-poses the rest coupe's normals onto a deformed coupe of the same strands and vertex counts: each
+// normal is written in its rest frame and read back in the deformed one.
+std::vector<glm::vec3> reposeNormals(const Strands& rest, const Strands& deformed);
+
+}  // namespace hairgen

@@ -1,0 +1,95 @@
+// The volumetric hair model: splatting, the hair shell's signed distance, shading normals and their
+// re-posing by parallel transport.
+#include <gtest/gtest.h>
+
+#include <map>
+#include <random>
+
+#include <glm/gtc/matrix_transform.hpp>
+
+#include "libcore/hair_volume.h"
+#include "libcore/obj_io.h"
+#include "libcore/setup.h"
+#include "stages/grow.h"
+#include "stages/interpolate.h"
+#include "tests/test_util.h"
+
+namespace hairgen {
+namespace {
+
+TEST(Volume, TheSplatConservesMass) {
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<float> u(-0.05f, 0.05f);
+  std::vector<glm::vec3> points;
+  for (int i = 0; i < 20000; ++i) points.push_back({u(rng), u(rng) + 0.1f, u(rng)});
+  Grid g = gridAround(points, 0.004, 2);
+  splat(g, points);
+  double sum = 0.0;
+  for (float v : g.values) sum += v;
+  EXPECT_NEAR(sum, 20000.0, 20000.0 * 1e-6);
+}
+
+struct Coupe3 {
+  Config config;
+  Mesh wick;
+  Strands coupe;
+  Coupe3() : config(loadConfig(test::sourceDir() / "configs/thesis/coupe3/setup.txt", {}, SetupUse::kGrow)) {
+    wick = readObj(config.setup.wickModel.path);
+    Hairstyle h = config.hairstyle;
+    h.hairDensity = 20;
+    coupe = interpolate(wick, grow(wick, h, config.collision, {}).guides, h, config.collision, {});
+  }
+};
+const Coupe3& coupe3() {
+  static const Coupe3 c;
+  return c;
+}
+
+TEST(Volume, Coupe3NormalsPointAwayFromTheHeadOnTheOutside) {
+  const Strands& coupe = coupe3().coupe;
+  Grid density = gridAround(coupe.points, 0.004, 3);
+  splat(density, coupe.points);
+  Grid sdf = signedDistance(density, 0.5);
+  std::vector<glm::vec3> normals = volumeNormals(sdf, coupe);
+  // The outermost vertices: those in the outer tenth of the hair's distances from the head centre,
+  // direction by direction (binned by azimuth and elevation).
+  const glm::dvec3 head = coupe3().config.collision.shapes[0].centre;
+  std::map<std::pair<int, int>, double> farthest;
+  auto bin = [&](const glm::dvec3& d) {
+    return std::make_pair(int(std::floor(std::atan2(d.x, d.z) / 0.2)), int(std::floor(std::asin(d.y / glm::length(d)) / 0.2)));
+  };
+  for (const glm::vec3& p : coupe.points) {
+    glm::dvec3 d = glm::dvec3(p) - head;
+    double& f = farthest[bin(d)];
+    f = std::max(f, glm::length(d));
+  }
+  int outer = 0, away = 0;
+  for (size_t i = 0; i < coupe.pointCount(); ++i) {
+    glm::dvec3 d = glm::dvec3(coupe.points[i]) - head;
+    if (glm::length(d) < farthest[bin(d)] - 0.005) continue;
+    ++outer;
+    away += glm::dot(glm::dvec3(normals[i]), d) > 0.0;
+  }
+  ASSERT_GT(outer, 500);
+  EXPECT_GE(double(away) / outer, 0.95) << away << " of " << outer;
+}
+
+TEST(Volume, ReposingRestNormalsOnARotatedCoupeRotatesThem) {
+  Strands rest = coupe3().coupe;
+  Grid density = gridAround(rest.points, 0.004, 3);
+  splat(density, rest.points);
+  rest.normals = volumeNormals(signedDistance(density, 0.5), rest);
+  const glm::dmat3 r = glm::dmat3(glm::rotate(glm::dmat4(1.0), 0.7, glm::normalize(glm::dvec3(0.3, 1.0, -0.4))));
+  Strands moved = rest;
+  for (glm::vec3& p : moved.points) p = glm::vec3(r * glm::dvec3(p) + glm::dvec3(0.1, -0.2, 0.05));
+  for (glm::vec3& t : moved.tangents) t = glm::vec3(r * glm::dvec3(t));
+  moved.normals.clear();
+  std::vector<glm::vec3> reposed = reposeNormals(rest, moved);
+  double worst = 0.0;
+  for (size_t i = 0; i < reposed.size(); ++i)
+    worst = std::max(worst, glm::length(glm::dvec3(reposed[i]) - r * glm::dvec3(rest.normals[i])));
+  EXPECT_LT(worst, 1e-5);
+}
+
+}  // namespace
+}  // namespace hairgen
