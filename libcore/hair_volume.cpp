@@ -8,40 +8,40 @@
 
 namespace hairgen {
 
-double Grid::sample(const glm::dvec3& p) const {
-  glm::dvec3 g = glm::clamp((p - origin) / voxel, glm::dvec3(0.0), glm::dvec3(size - 1) - 1e-9);
+namespace {
+
+// Σ over the 8 nodes around p of their trilinear weight times value(i, j, k) (p clamped to the grid).
+template <class T, class Value>
+T trilinear(const Grid& grid, const glm::dvec3& p, Value value) {
+  glm::dvec3 g = glm::clamp((p - grid.origin) / grid.voxel, glm::dvec3(0.0), glm::dvec3(grid.size - 1) - 1e-9);
   glm::ivec3 c = glm::ivec3(glm::floor(g));
   glm::dvec3 f = g - glm::dvec3(c);
-  double v = 0.0;
+  T out(0.0);
   for (int dz = 0; dz < 2; ++dz)
     for (int dy = 0; dy < 2; ++dy)
       for (int dx = 0; dx < 2; ++dx) {
         double w = (dx ? f.x : 1 - f.x) * (dy ? f.y : 1 - f.y) * (dz ? f.z : 1 - f.z);
-        v += w * at(std::min(c.x + dx, size.x - 1), std::min(c.y + dy, size.y - 1), std::min(c.z + dz, size.z - 1));
+        out += w * value(std::min(c.x + dx, grid.size.x - 1), std::min(c.y + dy, grid.size.y - 1),
+                         std::min(c.z + dz, grid.size.z - 1));
       }
-  return v;
+  return out;
+}
+
+}  // namespace
+
+double Grid::sample(const glm::dvec3& p) const {
+  return trilinear<double>(*this, p, [&](int i, int j, int k) { return double(at(i, j, k)); });
 }
 
 glm::dvec3 Grid::gradient(const glm::dvec3& p) const {
   // The trilinear interpolant of the nodes' central differences.
-  glm::dvec3 g = glm::clamp((p - origin) / voxel, glm::dvec3(0.0), glm::dvec3(size - 1) - 1e-9);
-  glm::ivec3 c = glm::ivec3(glm::floor(g));
-  glm::dvec3 f = g - glm::dvec3(c);
-  auto node = [&](int i, int j, int k) {
-    auto v = [&](int a, int b, int d) {
-      return double(at(std::clamp(a, 0, size.x - 1), std::clamp(b, 0, size.y - 1), std::clamp(d, 0, size.z - 1)));
-    };
+  auto v = [&](int a, int b, int d) {
+    return double(at(std::clamp(a, 0, size.x - 1), std::clamp(b, 0, size.y - 1), std::clamp(d, 0, size.z - 1)));
+  };
+  return trilinear<glm::dvec3>(*this, p, [&](int i, int j, int k) {
     return glm::dvec3(v(i + 1, j, k) - v(i - 1, j, k), v(i, j + 1, k) - v(i, j - 1, k), v(i, j, k + 1) - v(i, j, k - 1)) /
            (2.0 * voxel);
-  };
-  glm::dvec3 out(0.0);
-  for (int dz = 0; dz < 2; ++dz)
-    for (int dy = 0; dy < 2; ++dy)
-      for (int dx = 0; dx < 2; ++dx) {
-        double w = (dx ? f.x : 1 - f.x) * (dy ? f.y : 1 - f.y) * (dz ? f.z : 1 - f.z);
-        out += w * node(std::min(c.x + dx, size.x - 1), std::min(c.y + dy, size.y - 1), std::min(c.z + dz, size.z - 1));
-      }
-  return out;
+  });
 }
 
 Grid gridAround(const std::vector<glm::vec3>& points, double voxel, int padding) {
