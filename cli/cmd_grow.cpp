@@ -66,10 +66,8 @@ void registerGrow(CLI::App& app, int& exitCode) {
     exitCode = runCommand("grow", options->common, [&] {
       Stats stats("grow");
       hairFormatOf(options->output);
-      std::vector<Override> overrides = parseOverrides(options->common);
-      stats.setOverrides(overrides);
       Stopwatch clock;
-      Config config = loadConfig(options->setup, overrides, SetupUse::kGrow);
+      Config config = loadStageConfig(options->setup, options->common, SetupUse::kGrow, stats);
       Mesh wick = readObj(config.setup.wickModel.path);
       stats.time("read", clock.lap());
       GrowResult result = growStage(options->common, config, wick, stats);

@@ -27,10 +27,8 @@ void registerInterpolate(CLI::App& app, int& exitCode) {
     exitCode = runCommand("interpolate", options->common, [&] {
       Stats stats("interpolate");
       hairFormatOf(options->output);
-      std::vector<Override> overrides = parseOverrides(options->common);
-      stats.setOverrides(overrides);
       Stopwatch clock;
-      Config config = loadConfig(options->setup, overrides, SetupUse::kInterpolate);
+      Config config = loadStageConfig(options->setup, options->common, SetupUse::kInterpolate, stats);
       Mesh wick = readObj(config.setup.wickModel.path);
       Strands guides = readStrands(options->guides);
       stats.time("read", clock.lap());

@@ -11,19 +11,15 @@
 #include "libcore/hair_cache.h"
 #include "libcore/obj_io.h"
 #include "libcore/setup.h"
+#include "libcore/text.h"
 
 namespace hairgen::cli {
 namespace {
 
 namespace fs = std::filesystem;
 
-std::string lower(std::string s) {
-  for (char& c : s) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-  return s;
-}
-
 void requireExtension(const std::string& file, const char* extension, const char* flag) {
-  if (lower(fs::path(file).extension().string()) != extension)
+  if (toLower(fs::path(file).extension().string()) != extension)
     throw InputError(std::string(flag) + " " + file + ": expected a " + extension + " file");
 }
 
@@ -43,9 +39,9 @@ void conform(Strands& hair, const std::string& upAxis, double scale) {
 // Keeps the camera's and the light's directions and distances in proportion, but aims them at the
 // hair and backs the camera off until the bounding sphere fits the view.
 void frameHair(RenderSettings& r, const Strands& hair) {
-  glm::dvec3 lo(HUGE_VAL), hi(-HUGE_VAL);
-  for (const glm::vec3& p : hair.points) lo = glm::min(lo, glm::dvec3(p)), hi = glm::max(hi, glm::dvec3(p));
-  if (!(lo.x <= hi.x)) return;
+  if (hair.points.empty()) return;
+  const Bounds box = bounds(hair.points);
+  const glm::dvec3 lo(box.min), hi(box.max);
   const glm::dvec3 centre = (lo + hi) * 0.5;
   const double radius = std::max(glm::length(hi - lo) * 0.5, 1e-3);
   const double fov = glm::radians(r.fieldOfView) * std::min(1.0, double(r.resolution.x) / r.resolution.y);
@@ -156,10 +152,8 @@ void registerRender(CLI::App& app, int& exitCode) {
       if (!options->dom.empty()) requireExtension(options->dom, ".exr", "--dom");
       if (!options->preview.empty()) requireExtension(options->preview, ".png", "--preview");
       Stats stats("render");
-      std::vector<Override> overrides = parseOverrides(options->common);
-      stats.setOverrides(overrides);
       Stopwatch clock;
-      Config config = loadConfig(options->setup, overrides, SetupUse::kRender);
+      Config config = loadStageConfig(options->setup, options->common, SetupUse::kRender, stats);
       Strands hair = readStrands(options->hair);
       conform(hair, options->upAxis, options->scale);
       std::optional<Mesh> head;

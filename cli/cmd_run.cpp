@@ -59,12 +59,10 @@ void registerRun(CLI::App& app, int& exitCode) {
   cmd->callback([options, &exitCode] {
     exitCode = runCommand("run", options->common, [&] {
       Stats stats("run");
-      std::vector<Override> overrides = parseOverrides(options->common);
-      stats.setOverrides(overrides);
       fs::path setup = options->setup.empty() ? defaultSetup() : fs::path(options->setup);
       fs::path out = options->outDir.empty() ? fs::path("out") / fs::absolute(setup).parent_path().filename() : fs::path(options->outDir);
       Stopwatch clock;
-      Config config = loadConfig(setup, overrides, SetupUse::kRun);
+      Config config = loadStageConfig(setup, options->common, SetupUse::kRun, stats);
       stats.time("read", clock.lap());
       std::error_code made;
       fs::create_directories(out, made);
@@ -77,7 +75,7 @@ void registerRun(CLI::App& app, int& exitCode) {
                                   std::to_string(coupe.strandCount()) + " strands)");
       } else {
         Mesh wick = readObj(config.setup.wickModel.path);
-        stats.time("read", stats.json()["seconds"]["read"].get<double>() + clock.lap());
+        stats.add("read", clock.lap());
         GrowResult grown = growStage(options->common, config, wick, stats);
         const fs::path guidesFile = out / "guides.hair";
         clock.lap();
@@ -93,7 +91,7 @@ void registerRun(CLI::App& app, int& exitCode) {
         coupe = shadeStage(options->common, config, coupe, stats);
         clock.lap();
         writeStrands(out / "shaded.hair", coupe);
-        stats.time("write", stats.json()["seconds"].value("write", 0.0) + clock.lap());
+        stats.add("write", clock.lap());
       }
       if (config.setup.save) {
         writeStrands(config.setup.saveFile.path, coupe);
@@ -105,7 +103,7 @@ void registerRun(CLI::App& app, int& exitCode) {
         RenderOutput image = renderStage(options->common, config, coupe, head ? &*head : nullptr, false, stats);
         clock.lap();
         writeRenderOutputs(config, image, (out / "beauty.exr").string(), "", (out / "beauty.png").string());
-        stats.time("write", stats.json()["seconds"].value("write", 0.0) + clock.lap());
+        stats.add("write", clock.lap());
         note(options->common, "run: wrote " + (out / "beauty.exr").string() + " and " + (out / "beauty.png").string());
       }
       stats.write(options->common);

@@ -36,9 +36,7 @@ void registerShade(CLI::App& app, int& exitCode) {
     exitCode = runCommand("shade", options->common, [&] {
       Stats stats("shade");
       hairFormatOf(options->output);
-      std::vector<Override> overrides = parseOverrides(options->common);
-      stats.setOverrides(overrides);
-      Config config = loadConfig(options->setup, overrides, SetupUse::kRender);
+      Config config = loadStageConfig(options->setup, options->common, SetupUse::kRender, stats);
       Strands shaded = shadeStage(options->common, config, readStrands(options->hair), stats);
       writeStrands(options->output, shaded);
       note(options->common, "shade: wrote " + options->output);

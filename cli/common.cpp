@@ -76,6 +76,12 @@ int runCommand(const std::string& command, const CommonOptions& options, const s
   }
 }
 
+Config loadStageConfig(const std::filesystem::path& setup, const CommonOptions& options, SetupUse use, Stats& stats) {
+  std::vector<Override> overrides = parseOverrides(options);
+  stats.setOverrides(overrides);
+  return loadConfig(setup, overrides, use);
+}
+
 std::string formatSeconds(double seconds) {
   char text[32];
   std::snprintf(text, sizeof text, "%.2f s", seconds);

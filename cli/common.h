@@ -12,6 +12,7 @@
 
 #include "libcore/error.h"
 #include "libcore/params.h"
+#include "libcore/setup.h"
 
 namespace hairgen::cli {
 
@@ -34,6 +35,8 @@ class Stats {
  public:
   explicit Stats(std::string command);
   void time(const std::string& phase, double seconds) { json_["seconds"][phase] = seconds; }
+  // Adds to a phase's time (a phase done in several pieces).
+  void add(const std::string& phase, double seconds) { time(phase, json_["seconds"].value(phase, 0.0) + seconds); }
   nlohmann::ordered_json& counts() { return json_["counts"]; }
   nlohmann::ordered_json& json() { return json_; }
   void setOverrides(const std::vector<Override>& overrides);
@@ -66,6 +69,9 @@ std::string formatSeconds(double seconds);
 struct ExitWith {
   ExitCode code;
 };
+
+// Parses --set and --seed, records them in `stats`, and reads the Setup for `use`.
+Config loadStageConfig(const std::filesystem::path& setup, const CommonOptions& options, SetupUse use, Stats& stats);
 
 // Runs one command body with the thread limit applied, catching every error once: prints
 // "hairgen CMD: error: FILE:LINE: message" and returns the documented exit code.

@@ -1,7 +1,6 @@
 #include "libcore/exr_io.h"
 
 #include <cmath>
-#include <random>
 
 #include <ImathMatrix.h>
 #include <OpenEXR/ImfChannelList.h>
@@ -15,26 +14,12 @@
 #include <half.h>
 
 #include "libcore/error.h"
+#include "libcore/file_util.h"
 
 namespace hairgen {
 namespace {
 
 namespace fs = std::filesystem;
-
-// A temporary name beside `target`, renamed over it once the writer has finished.
-fs::path temporaryBeside(const fs::path& target) {
-  std::random_device rd;
-  return target.parent_path() / ("." + target.filename().string() + ".tmp-" + std::to_string(rd()));
-}
-
-void renameInto(const fs::path& temporary, const fs::path& target) {
-  std::error_code ec;
-  fs::rename(temporary, target, ec);
-  if (ec) {
-    fs::remove(temporary, ec);
-    throw IoError("cannot write " + target.string() + ": " + ec.message());
-  }
-}
 
 Imath::M44f toImath(const glm::dmat4& m) {
   // glm is column-major with column vectors; Imath uses row vectors (p' = p M), so M = transpose.
@@ -49,41 +34,37 @@ bool isHalf(const std::string& c) { return c == "R" || c == "G" || c == "B" || c
 }  // namespace
 
 void writeExr(const fs::path& file, const Image& image, const ExrMetadata& metadata) {
-  const fs::path temporary = temporaryBeside(file);
-  try {
-    Imf::Header header(image.width, image.height);
-    header.compression() = Imf::ZIP_COMPRESSION;
-    for (const auto& [key, value] : metadata.strings) header.insert(key, Imf::StringAttribute(value));
-    if (metadata.camera) {
-      Imf::addWorldToCamera(header, toImath(metadata.worldToCamera));
-      Imf::addWorldToNDC(header, toImath(metadata.worldToNdc));
+  Imf::Header header(image.width, image.height);
+  header.compression() = Imf::ZIP_COMPRESSION;
+  for (const auto& [key, value] : metadata.strings) header.insert(key, Imf::StringAttribute(value));
+  if (metadata.camera) {
+    Imf::addWorldToCamera(header, toImath(metadata.worldToCamera));
+    Imf::addWorldToNDC(header, toImath(metadata.worldToNdc));
+  }
+  std::vector<std::vector<half>> halves(image.channels.size());
+  Imf::FrameBuffer frame;
+  for (size_t c = 0; c < image.channels.size(); ++c) {
+    const std::string& name = image.channels[c];
+    if (isHalf(name)) {
+      header.channels().insert(name, Imf::Channel(Imf::HALF));
+      halves[c].assign(image.planes[c].begin(), image.planes[c].end());
+      frame.insert(name, Imf::Slice(Imf::HALF, reinterpret_cast<char*>(halves[c].data()), sizeof(half),
+                                    sizeof(half) * image.width));
+    } else {
+      header.channels().insert(name, Imf::Channel(Imf::FLOAT));
+      frame.insert(name, Imf::Slice(Imf::FLOAT, reinterpret_cast<char*>(const_cast<float*>(image.planes[c].data())),
+                                    sizeof(float), sizeof(float) * image.width));
     }
-    std::vector<std::vector<half>> halves(image.channels.size());
-    Imf::FrameBuffer frame;
-    for (size_t c = 0; c < image.channels.size(); ++c) {
-      const std::string& name = image.channels[c];
-      if (isHalf(name)) {
-        header.channels().insert(name, Imf::Channel(Imf::HALF));
-        halves[c].assign(image.planes[c].begin(), image.planes[c].end());
-        frame.insert(name, Imf::Slice(Imf::HALF, reinterpret_cast<char*>(halves[c].data()), sizeof(half),
-                                      sizeof(half) * image.width));
-      } else {
-        header.channels().insert(name, Imf::Channel(Imf::FLOAT));
-        frame.insert(name, Imf::Slice(Imf::FLOAT, reinterpret_cast<char*>(const_cast<float*>(image.planes[c].data())),
-                                      sizeof(float), sizeof(float) * image.width));
-      }
-    }
-    {
+  }
+  writeThroughTemporary(file, [&](const fs::path& temporary) {
+    try {
       Imf::OutputFile out(temporary.c_str(), header);
       out.setFrameBuffer(frame);
       out.writePixels(image.height);
+    } catch (const std::exception& e) {
+      throw IoError("cannot write " + file.string() + ": " + e.what());
     }
-  } catch (const std::exception& e) {
-    std::error_code ec;
-    fs::remove(temporary, ec);
-    throw IoError("cannot write " + file.string() + ": " + e.what());
-  }
-  renameInto(temporary, file);
+  });
 }
 
 Image readImage(const fs::path& file) {
@@ -118,17 +99,14 @@ void writePreview(const fs::path& file, const Image& image) {
       rgb[i * 3 + c] = static_cast<unsigned char>(std::lround(srgb * 255.0));
     }
   }
-  const fs::path temporary = temporaryBeside(file);
   auto out = OIIO::ImageOutput::create(file.string());
   if (!out) throw IoError("cannot write " + file.string() + ": " + OIIO::geterror());
   OIIO::ImageSpec spec(image.width, image.height, 3, OIIO::TypeDesc::UINT8);
   spec.attribute("Software", "hairgen " HAIRGEN_VERSION);
-  if (!out->open(temporary.string(), spec) || !out->write_image(OIIO::TypeDesc::UINT8, rgb.data()) || !out->close()) {
-    std::error_code ec;
-    fs::remove(temporary, ec);
-    throw IoError("cannot write " + file.string() + ": " + out->geterror());
-  }
-  renameInto(temporary, file);
+  writeThroughTemporary(file, [&](const fs::path& temporary) {
+    if (!out->open(temporary.string(), spec) || !out->write_image(OIIO::TypeDesc::UINT8, rgb.data()) || !out->close())
+      throw IoError("cannot write " + file.string() + ": " + out->geterror());
+  });
 }
 
 }  // namespace hairgen

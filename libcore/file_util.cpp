@@ -29,6 +29,26 @@ Container readWhole(const std::filesystem::path& path) {
   return data;
 }
 
+// A fresh name beside `target` (its folder created): TARGET.tmp-PID-N.
+std::filesystem::path temporaryBeside(const std::filesystem::path& target) {
+  static std::atomic<unsigned> counter{0};
+  std::filesystem::path dir = target.parent_path();
+  if (!dir.empty()) {
+    std::error_code ec;
+    std::filesystem::create_directories(dir, ec);
+    if (ec) throw IoError({dir.string(), 0}, "cannot create directory: " + ec.message());
+  }
+  std::filesystem::path temporary = target;
+  temporary += ".tmp-" + std::to_string(::getpid()) + "-" + std::to_string(counter++);
+  return temporary;
+}
+
+void renameInto(const std::filesystem::path& temporary, const std::filesystem::path& target) {
+  std::error_code ec;
+  std::filesystem::rename(temporary, target, ec);
+  if (ec) throw IoError({target.string(), 0}, "cannot rename into place: " + ec.message());
+}
+
 }  // namespace
 
 std::string readFileText(const std::filesystem::path& path) { return readWhole<std::string>(path); }
@@ -37,16 +57,21 @@ std::vector<uint8_t> readFileBytes(const std::filesystem::path& path) {
   return readWhole<std::vector<uint8_t>>(path);
 }
 
-AtomicFile::AtomicFile(std::filesystem::path target) : target_(std::move(target)) {
-  static std::atomic<unsigned> counter{0};
-  std::filesystem::path dir = target_.parent_path();
-  if (!dir.empty()) {
+void writeThroughTemporary(const std::filesystem::path& target,
+                           const std::function<void(const std::filesystem::path&)>& write) {
+  const std::filesystem::path temporary = temporaryBeside(target);
+  try {
+    write(temporary);
+    renameInto(temporary, target);
+  } catch (...) {
     std::error_code ec;
-    std::filesystem::create_directories(dir, ec);
-    if (ec) throw IoError({dir.string(), 0}, "cannot create directory: " + ec.message());
+    std::filesystem::remove(temporary, ec);
+    throw;
   }
-  temporary_ = target_;
-  temporary_ += ".tmp-" + std::to_string(::getpid()) + "-" + std::to_string(counter++);
+}
+
+AtomicFile::AtomicFile(std::filesystem::path target) : target_(std::move(target)) {
+  temporary_ = temporaryBeside(target_);
   stream_.open(temporary_, std::ios::binary | std::ios::trunc);
   if (!stream_)
     throw IoError({target_.string(), 0}, std::string("cannot write: ") + std::strerror(errno));
@@ -64,9 +89,7 @@ void AtomicFile::commit() {
   bool ok = static_cast<bool>(stream_);
   stream_.close();
   if (!ok || stream_.fail()) throw IoError({target_.string(), 0}, "write failed (disk full?)");
-  std::error_code ec;
-  std::filesystem::rename(temporary_, target_, ec);
-  if (ec) throw IoError({target_.string(), 0}, "cannot rename into place: " + ec.message());
+  renameInto(temporary_, target_);
   committed_ = true;
 }
 

@@ -3,6 +3,7 @@
 
 #include <cstdint>
 #include <filesystem>
+#include <functional>
 #include <fstream>
 #include <string>
 #include <vector>
@@ -34,6 +35,12 @@ class AtomicFile {
   std::ofstream stream_;
   bool committed_ = false;
 };
+
+// Writes `target` through a temporary file beside it that `write` fills by name (for libraries that
+// want a path, such as OpenEXR and OpenImageIO): renamed into place when `write` returns, removed
+// when it throws. Throws IoError when the rename fails.
+void writeThroughTemporary(const std::filesystem::path& target,
+                           const std::function<void(const std::filesystem::path&)>& write);
 
 // Convenience: AtomicFile with one write.
 void writeFileAtomic(const std::filesystem::path& target, const void* data, size_t size);

@@ -5,6 +5,7 @@
 #include <limits>
 
 #include "libcore/error.h"
+#include "libcore/mesh.h"
 
 namespace hairgen {
 
@@ -46,8 +47,8 @@ glm::dvec3 Grid::gradient(const glm::dvec3& p) const {
 
 Grid gridAround(const std::vector<glm::vec3>& points, double voxel, int padding) {
   if (points.empty()) throw InputError("the coupe has no points to build a volume from");
-  glm::dvec3 lo(points[0]), hi(points[0]);
-  for (const glm::vec3& p : points) lo = glm::min(lo, glm::dvec3(p)), hi = glm::max(hi, glm::dvec3(p));
+  const Bounds box = bounds(points);
+  const glm::dvec3 lo(box.min), hi(box.max);
   Grid g;
   g.voxel = voxel;
   g.origin = lo - double(padding) * voxel;

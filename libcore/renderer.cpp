@@ -335,19 +335,13 @@ class Shader {
 
 struct Texture {
   GLuint id = 0;
-  GLenum target = GL_TEXTURE_2D;
-  Texture(GLenum internal, int w, int h, int samples, GLenum filter = GL_NEAREST) {
-    target = samples > 1 ? GL_TEXTURE_2D_MULTISAMPLE : GL_TEXTURE_2D;
-    glCreateTextures(target, 1, &id);
-    if (samples > 1) {
-      glTextureStorage2DMultisample(id, samples, internal, w, h, GL_TRUE);
-    } else {
-      glTextureStorage2D(id, 1, internal, w, h);
-      glTextureParameteri(id, GL_TEXTURE_MIN_FILTER, filter);
-      glTextureParameteri(id, GL_TEXTURE_MAG_FILTER, filter);
-      glTextureParameteri(id, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
-      glTextureParameteri(id, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
-    }
+  Texture(GLenum internal, int w, int h, GLenum filter = GL_NEAREST) {
+    glCreateTextures(GL_TEXTURE_2D, 1, &id);
+    glTextureStorage2D(id, 1, internal, w, h);
+    glTextureParameteri(id, GL_TEXTURE_MIN_FILTER, filter);
+    glTextureParameteri(id, GL_TEXTURE_MAG_FILTER, filter);
+    glTextureParameteri(id, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+    glTextureParameteri(id, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
   }
   ~Texture() { glDeleteTextures(1, &id); }
   Texture(const Texture&) = delete;
@@ -356,7 +350,7 @@ struct Texture {
 
 struct Framebuffer {
   GLuint id = 0, depth = 0;
-  Framebuffer(std::initializer_list<const Texture*> colours, int w, int h, int samples, bool withDepth) {
+  Framebuffer(std::initializer_list<const Texture*> colours, int w, int h, bool withDepth) {
     glCreateFramebuffers(1, &id);
     std::vector<GLenum> buffers;
     GLenum i = 0;
@@ -367,10 +361,7 @@ struct Framebuffer {
     glNamedFramebufferDrawBuffers(id, static_cast<GLsizei>(buffers.size()), buffers.data());
     if (withDepth) {
       glCreateRenderbuffers(1, &depth);
-      if (samples > 1)
-        glNamedRenderbufferStorageMultisample(depth, samples, GL_DEPTH_COMPONENT24, w, h);
-      else
-        glNamedRenderbufferStorage(depth, GL_DEPTH_COMPONENT24, w, h);
+      glNamedRenderbufferStorage(depth, GL_DEPTH_COMPONENT24, w, h);
       glNamedFramebufferRenderbuffer(id, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, depth);
     }
     if (glCheckNamedFramebufferStatus(id, GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE) fail("framebuffer incomplete");
@@ -495,11 +486,15 @@ struct Sphere {
 };
 
 Sphere boundingSphere(const Strands& hair, const Mesh* head) {
-  glm::dvec3 lo(HUGE_VAL), hi(-HUGE_VAL);
-  for (const glm::vec3& p : hair.points) lo = glm::min(lo, glm::dvec3(p)), hi = glm::max(hi, glm::dvec3(p));
-  if (head)
-    for (const glm::vec3& p : head->positions) lo = glm::min(lo, glm::dvec3(p)), hi = glm::max(hi, glm::dvec3(p));
-  if (!(lo.x <= hi.x)) return {glm::dvec3(0.0), 0.1};
+  std::vector<glm::vec3> corners;
+  for (const std::vector<glm::vec3>* points : {&hair.points, head ? &head->positions : nullptr})
+    if (points && !points->empty()) {
+      const Bounds b = bounds(*points);
+      corners.insert(corners.end(), {b.min, b.max});
+    }
+  if (corners.empty()) return {glm::dvec3(0.0), 0.1};
+  const Bounds box = bounds(corners);
+  const glm::dvec3 lo(box.min), hi(box.max);
   return {(lo + hi) * 0.5, std::max(glm::length(hi - lo) * 0.5, 1e-3)};
 }
 
@@ -625,7 +620,6 @@ RenderOutput renderHair(GlContext&, const RenderInput& in) {
   const HairGeometry hairGeometry(hair, tangentsOf(hair));
   std::unique_ptr<HeadGeometry> headGeometry;
   if (in.head && !in.head->triangles.empty()) headGeometry = std::make_unique<HeadGeometry>(*in.head);
-  const std::string fragmentHeader = "#version 450 core\n";
   const std::string v450 = "#version 450 core\n";
   Shader hairDepth(v450 + kHairVertex, kDepthFragment, "hair depth");
   Shader headDepth(kHeadVertex, kDepthFragment, "head depth");
@@ -635,8 +629,8 @@ RenderOutput renderHair(GlContext&, const RenderInput& in) {
   const double nearest = std::max(glm::length(scene.centre - r.cameraPosition) - scene.radius, 1e-3);
   const bool ribbons = block > 1 || r.strandWidth * camera.focalPx / nearest > 1.5;
   Shader hairShade(v450 + (ribbons ? "#define RIBBON\n" : "") + kHairVertex,
-                   fragmentHeader + kShadowFunction + kHairFragment, "hair shading");
-  Shader headShade(kHeadVertex, fragmentHeader + kShadowFunction + kHeadFragment, "head shading");
+                   v450 + kShadowFunction + kHairFragment, "hair shading");
+  Shader headShade(kHeadVertex, v450 + kShadowFunction + kHeadFragment, "head shading");
   Shader resolve(kFullscreenVertex, kResolveFragment, "resolve");
   checkGl("setting up");
   out.timings.upload = seconds(clock);
@@ -645,12 +639,12 @@ RenderOutput renderHair(GlContext&, const RenderInput& in) {
   const int n = in.domResolution;
   const float far[4] = {kBackgroundZ, kBackgroundZ, kBackgroundZ, kBackgroundZ};
   const float one = 1.0f;
-  Texture headZ(GL_R32F, n, n, 1), startZ(GL_R32F, n, n, 1);
+  Texture headZ(GL_R32F, n, n), startZ(GL_R32F, n, n);
   glEnable(GL_DEPTH_TEST);
   glDepthFunc(GL_LESS);
   glDisable(GL_CULL_FACE);
   {
-    Framebuffer fb({&headZ}, n, n, 1, true);
+    Framebuffer fb({&headZ}, n, n, true);
     fb.bind(n, n);
     glClearBufferfv(GL_COLOR, 0, far);
     glClearBufferfv(GL_DEPTH, 0, &one);
@@ -661,7 +655,7 @@ RenderOutput renderHair(GlContext&, const RenderInput& in) {
     }
   }
   {
-    Framebuffer fb({&startZ}, n, n, 1, true);
+    Framebuffer fb({&startZ}, n, n, true);
     fb.bind(n, n);
     glClearBufferfv(GL_COLOR, 0, far);
     glClearBufferfv(GL_DEPTH, 0, &one);
@@ -674,9 +668,9 @@ RenderOutput renderHair(GlContext&, const RenderInput& in) {
   out.timings.lightDepth = seconds(clock);
 
   // Pass 2: the deep opacity map, four layers from where the hair begins, added up.
-  Texture opacityMap(GL_RGBA32F, n, n, 1, GL_LINEAR);
+  Texture opacityMap(GL_RGBA32F, n, n, GL_LINEAR);
   {
-    Framebuffer fb({&opacityMap}, n, n, 1, false);
+    Framebuffer fb({&opacityMap}, n, n, false);
     fb.bind(n, n);
     const float zero[4] = {0, 0, 0, 0};
     glClearBufferfv(GL_COLOR, 0, zero);
@@ -701,9 +695,9 @@ RenderOutput renderHair(GlContext&, const RenderInput& in) {
   fine.width = sw;
   fine.height = sh;
   fine.focalPx = camera.focalPx * block;
-  Texture colour(GL_RGBA16F, sw, sh, 1), data(GL_RGBA32F, sw, sh, 1);
+  Texture colour(GL_RGBA16F, sw, sh), data(GL_RGBA32F, sw, sh);
   {
-    Framebuffer fb({&colour, &data}, sw, sh, 1, true);
+    Framebuffer fb({&colour, &data}, sw, sh, true);
     fb.bind(sw, sh);
     const float background[4] = {float(r.background.x), float(r.background.y), float(r.background.z), 0.0f};
     const float nothing[4] = {kBackgroundZ, 0.0f, 1.0f, 0.0f};
@@ -750,9 +744,9 @@ RenderOutput renderHair(GlContext&, const RenderInput& in) {
     hairShade.set("uHasColour", hair.colors.empty() ? 0 : 1);
     hairGeometry.draw(ribbons);
   }
-  Texture resolvedColour(GL_RGBA32F, w, h, 1), resolvedData(GL_RGBA32F, w, h, 1);
+  Texture resolvedColour(GL_RGBA32F, w, h), resolvedData(GL_RGBA32F, w, h);
   {
-    Framebuffer fb({&resolvedColour, &resolvedData}, w, h, 1, false);
+    Framebuffer fb({&resolvedColour, &resolvedData}, w, h, false);
     fb.bind(w, h);
     glDisable(GL_DEPTH_TEST);
     resolve.use();

@@ -61,8 +61,7 @@ ForceField readForce(const SectionReader& r, const ConfigLine& line) {
   ForceField f;
   f.where = line.where;
   for (int i = 0; i < 3; ++i) f.acceleration[i] = r.checkReal(line, i, Range::closed(-1e4, 1e4), "acceleration");
-  std::string region = line.values[3];
-  for (char& c : region) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  const std::string region = toLower(line.values[3]);
   const size_t extra = line.values.size() - 4;
   if (region == "all" && extra == 0) {
     f.region = ForceField::Region::kAll;

@@ -132,7 +132,6 @@ size_t cutHair(std::vector<glm::dvec3>& nodes, const Hairstyle& style, const Col
 GrowResult growCantilever(const Mesh& wick, const Hairstyle& style, const Collision& collision,
                           const GrowOptions& options) {
   const size_t count = wick.vertexCount();
-  if (count == 0) throw InputError("the wick has no vertices");
   const CollisionShape* head = nullptr;
   for (const CollisionShape& s : collision.shapes)
     if (s.kind == ShapeKind::kEllipsoid) {

@@ -30,6 +30,7 @@ glm::dvec2 porePolar(const glm::dvec3& pore, const CollisionShape* head);
 size_t cutHair(std::vector<glm::dvec3>& nodes, const Hairstyle& style, const CollisionShape* head);
 
 // The whole grow stage for Model cantilever: one hair per wick vertex, its nodes as the guide's points.
+// grow() checks the wick and dispatches here.
 GrowResult growCantilever(const Mesh& wick, const Hairstyle& style, const Collision& collision,
                           const GrowOptions& options);
 

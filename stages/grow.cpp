@@ -40,6 +40,16 @@ GuideReport growGuide(const RodFrame& root, double envelope, const Hairstyle& st
   return report;
 }
 
+std::vector<double> follicleEnvelopes(const Mesh& wick) {
+  std::vector<double> out(wick.vertexCount(), 0.0);
+  if (out.empty()) return out;
+  const Bounds box = bounds(wick.positions);
+  if (box.max.y > box.min.y)
+    for (size_t i = 0; i < out.size(); ++i)
+      out[i] = (double(wick.positions[i].y) - box.min.y) / (double(box.max.y) - box.min.y);
+  return out;
+}
+
 GrowResult grow(const Mesh& wick, const Hairstyle& style, const Collision& collision, const GrowOptions& options) {
   const size_t count = wick.vertexCount();
   if (count == 0) throw InputError("the wick has no vertices");
@@ -50,17 +60,12 @@ GrowResult grow(const Mesh& wick, const Hairstyle& style, const Collision& colli
       throw InputError("wick vertex " + std::to_string(i) + " has a zero or non-finite normal; a follicle needs a direction");
   }
   if (style.model == StylingModel::kCantilever) return growCantilever(wick, style, collision, options);
-  float yMin = wick.positions[0].y, yMax = yMin;
-  for (const glm::vec3& p : wick.positions) {
-    yMin = std::min(yMin, p.y);
-    yMax = std::max(yMax, p.y);
-  }
-
+  const std::vector<double> envelopes = follicleEnvelopes(wick);
   GrowResult result;
   result.reports.resize(count);
   std::vector<std::string> failures(count);
   tbb::parallel_for(size_t(0), count, [&](size_t i) {
-    double envelope = yMax > yMin ? (double(wick.positions[i].y) - yMin) / (double(yMax) - yMin) : 0.0;
+    const double envelope = envelopes[i];
     RodFrame root = follicleFrame(glm::dvec3(wick.positions[i]), glm::dvec3(wick.normals[i]));
     try {
       result.reports[i] = growGuide(root, envelope, style, collision);

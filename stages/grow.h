@@ -40,6 +40,10 @@ struct GrowResult {
 // not finite.
 GrowResult grow(const Mesh& wick, const Hairstyle& style, const Collision& collision, const GrowOptions& options);
 
+// Each follicle's height fraction in [0, 1] between the lowest and the highest wick vertex: how far
+// its layered envelope reaches (thesis §4.1.2.2). All 0 for a flat wick.
+std::vector<double> follicleEnvelopes(const Mesh& wick);
+
 // One guide, for tests and benchmarks.
 GuideReport growGuide(const RodFrame& root, double envelope, const Hairstyle& style, const Collision& collision);
 

@@ -52,11 +52,6 @@ void resample(const glm::vec3* p, const glm::vec3* t, uint32_t count, const std:
   }
 }
 
-double triangleAreaCm2(const Mesh& wick, const glm::uvec3& tri) {
-  glm::dvec3 a(wick.positions[tri.x]), b(wick.positions[tri.y]), c(wick.positions[tri.z]);
-  return 0.5 * glm::length(glm::cross(b - a, c - a)) * 1e4;
-}
-
 void checkGuides(const Mesh& wick, const Strands& guides, const std::string& name) {
   const FileLoc where{name, 0};
   if (guides.strandCount() != wick.vertexCount())
@@ -127,11 +122,14 @@ void blendStrand(const GuideSpan (&g)[3], uint32_t n, const glm::dvec3& root, co
       p += w[c] * (glm::dvec3(g[c].points[i]) - centre);
       tangent += w[c] * glm::dvec3(g[c].tangents[i]);
     }
-    // Opposed tangents cancel only on a pathological blend; keep the heaviest guide's then.
-    const int heaviest = w.x >= w.y && w.x >= w.z ? 0 : (w.y >= w.z ? 1 : 2);
     const double len = glm::length(tangent);
     points[i] = glm::vec3(p);
-    tangents[i] = len > 1e-12 ? glm::vec3(tangent / len) : g[heaviest].tangents[i];
+    if (len > 1e-12) {
+      tangents[i] = glm::vec3(tangent / len);
+    } else {  // opposed tangents cancel only on a pathological blend: keep the heaviest guide's
+      const int heaviest = w.x >= w.y && w.x >= w.z ? 0 : (w.y >= w.z ? 1 : 2);
+      tangents[i] = g[heaviest].tangents[i];
+    }
   }
 }
 
@@ -154,7 +152,7 @@ Strands interpolate(const Mesh& wick, const Strands& guides, const Hairstyle& st
   uint64_t maxCount = 0;
   for (size_t t = 0; t < triangleCount; ++t) {
     const glm::uvec3& tri = wick.triangles[t];
-    count[t] = strandsInTriangle(triangleAreaCm2(wick, tri), style.hairDensity,
+    count[t] = strandsInTriangle(triangleArea(wick, t) * 1e4, style.hairDensity,
                                  counterUniform(seed, t, kTriangleKey, kCountFraction));
     vertices[t] = std::max({guides.pointsOf(tri.x), guides.pointsOf(tri.y), guides.pointsOf(tri.z)});
     firstStrand[t + 1] = firstStrand[t] + count[t];

@@ -24,12 +24,8 @@ double turnDegrees(const glm::dvec3& a, const glm::dvec3& b) {
   return glm::degrees(std::atan2(glm::length(glm::cross(a, b)), glm::dot(a, b)));
 }
 
-struct Bob {
-  Config config;
-  Mesh wick;
-  Bob() : config(loadConfig(test::sourceDir() / "configs/anjyo/bob/setup.txt", {}, SetupUse::kGrow)) {
-    wick = readObj(config.setup.wickModel.path);
-  }
+struct Bob : test::Job {
+  Bob() : test::Job(test::loadJob("anjyo/bob/setup.txt")) {}
   const CollisionShape* head() const { return &config.collision.shapes.at(0); }
 };
 const Bob& bob() {

@@ -53,8 +53,7 @@ TEST(Grow, WithNegligibleElasticityAGuideHangsStraightDown) {
 }
 
 TEST(Grow, Coupe3LongGuidesHangBelowTheirRootsAndStayOutOfTheHead) {
-  Config c = loadConfig(test::sourceDir() / "configs/thesis/coupe3/setup.txt", {}, SetupUse::kGrow);
-  Mesh wick = readObj(c.setup.wickModel.path);
+  auto [c, wick] = test::loadJob("thesis/coupe3/setup.txt");
   GrowResult g = grow(wick, c.hairstyle, c.collision, {});
   const CollisionShape& head = c.collision.shapes[0];
   size_t below = 0;
@@ -72,21 +71,11 @@ TEST(Grow, Coupe3LongGuidesHangBelowTheirRootsAndStayOutOfTheHead) {
   std::printf("coupe 3: %zu of %zu tips below their roots\n", below, g.guides.strandCount());
 }
 
-// The follicle's height fraction between the lowest and the highest wick vertex, as grow computes it.
-std::vector<double> envelopes(const Mesh& wick) {
-  float lo = wick.positions[0].y, hi = lo;
-  for (const glm::vec3& p : wick.positions) lo = std::min(lo, p.y), hi = std::max(hi, p.y);
-  std::vector<double> e;
-  for (const glm::vec3& p : wick.positions) e.push_back((double(p.y) - lo) / (double(hi) - lo));
-  return e;
-}
-
 TEST(Grow, Coupe3CollisionSamplesStayOutOfTheHeadEnvelope) {
-  Config c = loadConfig(test::sourceDir() / "configs/thesis/coupe3/setup.txt", {}, SetupUse::kGrow);
-  Mesh wick = readObj(c.setup.wickModel.path);
+  auto [c, wick] = test::loadJob("thesis/coupe3/setup.txt");
   GrowResult g = grow(wick, c.hairstyle, c.collision, {});
   const CollisionShape& head = c.collision.shapes[0];
-  std::vector<double> envelope = envelopes(wick);
+  std::vector<double> envelope = follicleEnvelopes(wick);
   std::vector<double> s = sampleArcLengths(c.hairstyle.totalLength(), c.hairstyle.collisionStep, false);
   // A follicle's root sits on the scalp, `extra` inside its own envelope, so the samples near the
   // root are inside it whatever the guide does. A guide leaving at up to 60° from the envelope's
@@ -114,8 +103,7 @@ TEST(Grow, Coupe1ShortGuidesAreHeldByTheirElasticity) {
   // leaves the follicle at ~87°, and no point of it moves by a quarter of the length (1 cm hangs
   // visibly under gravity only when it is held sideways); with a straight rest shape — the "straight spiky hair" the thesis
   // describes for it — the guide stays within 15° of its follicle normal.
-  Config c = loadConfig(test::sourceDir() / "configs/thesis/coupe1/setup.txt", {}, SetupUse::kGrow);
-  Mesh wick = readObj(c.setup.wickModel.path);
+  auto [c, wick] = test::loadJob("thesis/coupe1/setup.txt");
   auto chord = [](const Strands& g, size_t i) {
     return glm::normalize(glm::dvec3(g.points[g.firstPoint[i + 1] - 1] - g.points[g.firstPoint[i]]));
   };
@@ -148,9 +136,8 @@ TEST(Grow, Coupe1ShortGuidesAreHeldByTheirElasticity) {
 
 TEST(Grow, Coupe3MaxIterReachesTheMinimum) {
   // Ten times the stages and no early stop on Epsilon lower no guide's energy by more than 1%.
-  Config c = loadConfig(test::sourceDir() / "configs/thesis/coupe3/setup.txt", {}, SetupUse::kGrow);
-  Mesh wick = readObj(c.setup.wickModel.path);
-  std::vector<double> envelope = envelopes(wick);
+  auto [c, wick] = test::loadJob("thesis/coupe3/setup.txt");
+  std::vector<double> envelope = follicleEnvelopes(wick);
   Hairstyle longer = c.hairstyle;
   longer.maxIter *= 10;
   longer.epsilon = 0.0;
@@ -168,8 +155,7 @@ TEST(Grow, Coupe3MaxIterReachesTheMinimum) {
 }
 
 TEST(Grow, OutputIsIdenticalForAnyThreadCount) {
-  Config c = loadConfig(test::sourceDir() / "configs/thesis/coupe2/setup.txt", {}, SetupUse::kGrow);
-  Mesh wick = readObj(c.setup.wickModel.path);
+  auto [c, wick] = test::loadJob("thesis/coupe2/setup.txt");
   wick.positions.resize(120);
   wick.normals.resize(120);
   wick.triangles.clear();

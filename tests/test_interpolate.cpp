@@ -20,12 +20,9 @@ namespace hairgen {
 namespace {
 
 // Coupe 2 grown once (its guides are the cheapest to grow) and shared by the tests.
-struct Grown {
-  Config config;
-  Mesh wick;
+struct Grown : test::Job {
   Strands guides;
-  Grown() : config(loadConfig(test::sourceDir() / "configs/thesis/coupe2/setup.txt", {}, SetupUse::kInterpolate)) {
-    wick = readObj(config.setup.wickModel.path);
+  Grown() : test::Job(test::loadJob("thesis/coupe2/setup.txt", SetupUse::kInterpolate)) {
     guides = grow(wick, config.hairstyle, config.collision, {}).guides;
   }
 };
@@ -39,11 +36,6 @@ Strands coupeAt(double density, uint64_t seed = 7) {
   h.hairDensity = density;
   h.seed = seed;
   return interpolate(grown().wick, grown().guides, h, grown().config.collision, {});
-}
-
-double areaCm2(const Mesh& m, const glm::uvec3& t) {
-  glm::dvec3 a(m.positions[t.x]), b(m.positions[t.y]), c(m.positions[t.z]);
-  return 0.5 * glm::length(glm::cross(b - a, c - a)) * 1e4;
 }
 
 TEST(Interpolate, EveryRootLiesOnItsTriangle) {
@@ -90,7 +82,7 @@ TEST(Interpolate, CountsFollowAreaTimesDensity) {
   for (uint32_t t : coupe.rootTriangle) ++perTriangle[t];
   double expected = 0.0;
   for (size_t t = 0; t < wick.triangles.size(); ++t) {
-    double n = areaCm2(wick, wick.triangles[t]) * density;
+    double n = triangleArea(wick, t) * 1e4 * density;
     expected += n;
     ASSERT_TRUE(perTriangle[t] == std::floor(n) || perTriangle[t] == std::floor(n) + 1) << "triangle " << t;
   }

@@ -8,11 +8,24 @@
 #include <string>
 
 #include "libcore/config.h"
+#include "libcore/obj_io.h"
+#include "libcore/setup.h"
 #include "libcore/strands.h"
 
 namespace hairgen::test {
 
 inline std::filesystem::path sourceDir() { return HAIRGEN_SOURCE_DIR; }
+// A bundled Setup (a path under configs/) read as a stage would, with its wick.
+struct Job {
+  Config config;
+  Mesh wick;
+};
+inline Job loadJob(const std::string& setup, SetupUse use = SetupUse::kGrow) {
+  Job job{loadConfig(sourceDir() / "configs" / setup, {}, use), {}};
+  job.wick = readObj(job.config.setup.wickModel.path);
+  return job;
+}
+
 inline std::filesystem::path realData() { return sourceDir() / ".." / "shared" / "testdata" / "real"; }
 
 // A fresh directory under the system temp dir, removed on destruction.

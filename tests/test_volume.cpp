@@ -29,12 +29,9 @@ TEST(Volume, TheSplatConservesMass) {
   EXPECT_NEAR(sum, 20000.0, 20000.0 * 1e-6);
 }
 
-struct Coupe3 {
-  Config config;
-  Mesh wick;
+struct Coupe3 : test::Job {
   Strands coupe;
-  Coupe3() : config(loadConfig(test::sourceDir() / "configs/thesis/coupe3/setup.txt", {}, SetupUse::kGrow)) {
-    wick = readObj(config.setup.wickModel.path);
+  Coupe3() : test::Job(test::loadJob("thesis/coupe3/setup.txt")) {
     Hairstyle h = config.hairstyle;
     h.hairDensity = 20;
     coupe = interpolate(wick, grow(wick, h, config.collision, {}).guides, h, config.collision, {});

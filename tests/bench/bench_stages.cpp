@@ -78,11 +78,7 @@ void InterpolateCoupe3(benchmark::State& state) {
   Hairstyle style = c.config.hairstyle;
   style.visualityStep = style.totalLength() / 63.0;  // 64 vertices per guide and strand
   const Strands guides = grow(c.wick, style, c.config.collision, {}).guides;
-  double area = 0.0;
-  for (const glm::uvec3& t : c.wick.triangles) {
-    glm::dvec3 a(c.wick.positions[t.x]), b(c.wick.positions[t.y]), d(c.wick.positions[t.z]);
-    area += 0.5 * glm::length(glm::cross(b - a, d - a)) * 1e4;
-  }
+  const double area = surfaceArea(c.wick) * 1e4;
   style.hairDensity = 150000.0 / area;
   uint64_t strands = 0, points = 0;
   for (auto _ : state) {
@@ -131,11 +127,7 @@ const Strands& coupe3Strands(int strands) {
   Hairstyle style = c.config.hairstyle;
   style.visualityStep = style.totalLength() / 63.0;
   const Strands guides = grow(c.wick, style, c.config.collision, {}).guides;
-  double area = 0.0;
-  for (const glm::uvec3& t : c.wick.triangles) {
-    glm::dvec3 a(c.wick.positions[t.x]), b(c.wick.positions[t.y]), d(c.wick.positions[t.z]);
-    area += 0.5 * glm::length(glm::cross(b - a, d - a)) * 1e4;
-  }
+  const double area = surfaceArea(c.wick) * 1e4;
   style.hairDensity = strands / area;
   return made[strands] = interpolate(c.wick, guides, style, c.config.collision, {});
 }
