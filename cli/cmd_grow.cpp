@@ -53,7 +53,8 @@ void registerGrow(CLI::App& app, int& exitCode) {
   };
   auto options = std::make_shared<Options>();
   CLI::App* cmd = app.add_subcommand(
-      "grow", "Grow one Super-Helix guide per wick vertex at its static equilibrium (elasticity, gravity, collisions)");
+      "grow", "Grow one guide per wick vertex: a Super-Helix at its static equilibrium (elasticity, gravity, "
+      "collisions), or Anjyo's cantilever beam (Model cantilever)");
   cmd->add_option("SETUP", options->setup, "The Setup file")->required();
   cmd->add_option("-o,--output", options->output, "Guides to write: .hair, .gltf or .glb (written atomically)")->required();
   cmd->add_option("--diagnostics", options->diagnostics,

@@ -47,9 +47,9 @@ void registerRun(CLI::App& app, int& exitCode) {
   };
   auto options = std::make_shared<Options>();
   CLI::App* cmd = app.add_subcommand(
-      "run", "Run the stages in one process: grow and interpolate (or Load a saved coupe), then render; writes "
-             "DIR/guides.hair, DIR/coupe.hair, DIR/beauty.exr and DIR/beauty.png, each equal to what the stage run "
-             "alone writes");
+      "run", "Run the stages in one process: grow and interpolate (or Load a saved coupe), shade when the Setup asks, "
+             "then render; writes DIR/guides.hair, DIR/coupe.hair, DIR/shaded.hair, DIR/beauty.exr and DIR/beauty.png, "
+             "each equal to what the stage run alone writes");
   cmd->add_option("SETUP", options->setup, "The Setup file (default: the bundled configs/default/setup.txt)");
   cmd->add_option("-o,--output", options->outDir, "Output folder (default: out/NAME, NAME the Setup's folder)")
       ->type_name("DIR");
