@@ -2,7 +2,11 @@
 
 #include <algorithm>
 #include <cmath>
+#include <atomic>
 #include <limits>
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
 
 #include "libcore/error.h"
 #include "libcore/mesh.h"
@@ -62,20 +66,36 @@ Grid gridAround(const std::vector<glm::vec3>& points, double voxel, int padding)
 }
 
 void splat(Grid& d, const std::vector<glm::vec3>& points) {
-  // One thread, in point order: the sums are the same bits on every run.
-  for (const glm::vec3& point : points) {
-    glm::dvec3 g = (glm::dvec3(point) - d.origin) / d.voxel;
-    glm::ivec3 c = glm::ivec3(glm::floor(g));
-    glm::dvec3 f = g - glm::dvec3(c);
-    for (int dz = 0; dz < 2; ++dz)
-      for (int dy = 0; dy < 2; ++dy)
-        for (int dx = 0; dx < 2; ++dx) {
-          glm::ivec3 n = c + glm::ivec3(dx, dy, dz);
-          if (glm::any(glm::lessThan(n, glm::ivec3(0))) || glm::any(glm::greaterThanEqual(n, d.size))) continue;
-          d.values[d.index(n.x, n.y, n.z)] +=
-              static_cast<float>((dx ? f.x : 1 - f.x) * (dy ? f.y : 1 - f.y) * (dz ? f.z : 1 - f.z));
-        }
-  }
+  // Weights are added as 32.32 fixed-point integers: integer sums do not depend on the order of the
+  // additions, so the threads may race and the grid is the same bits on every run and thread count.
+  // Each point's eight weights are rounded to sum to exactly one (the rounding is given to its
+  // largest weight), so a point inside the grid adds exactly 1 to it.
+  constexpr double kOne = 4294967296.0;  // 2^32
+  std::vector<int64_t> sums(d.values.size(), 0);
+  const glm::ivec3 size = d.size;
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, points.size(), 4096), [&](const tbb::blocked_range<size_t>& r) {
+    for (size_t p = r.begin(); p != r.end(); ++p) {
+      glm::dvec3 g = (glm::dvec3(points[p]) - d.origin) / d.voxel;
+      glm::ivec3 c = glm::ivec3(glm::floor(g));
+      glm::dvec3 f = g - glm::dvec3(c);
+      int64_t w[8];
+      int64_t total = 0;
+      int largest = 0;
+      for (int corner = 0; corner < 8; ++corner) {
+        const int dx = corner & 1, dy = (corner >> 1) & 1, dz = corner >> 2;
+        w[corner] = std::llround((dx ? f.x : 1 - f.x) * (dy ? f.y : 1 - f.y) * (dz ? f.z : 1 - f.z) * kOne);
+        total += w[corner];
+        if (w[corner] > w[largest]) largest = corner;
+      }
+      w[largest] += int64_t(kOne) - total;
+      for (int corner = 0; corner < 8; ++corner) {
+        const glm::ivec3 n = c + glm::ivec3(corner & 1, (corner >> 1) & 1, corner >> 2);
+        if (glm::any(glm::lessThan(n, glm::ivec3(0))) || glm::any(glm::greaterThanEqual(n, size))) continue;
+        std::atomic_ref<int64_t>(sums[d.index(n.x, n.y, n.z)]).fetch_add(w[corner], std::memory_order_relaxed);
+      }
+    }
+  });
+  for (size_t i = 0; i < sums.size(); ++i) d.values[i] += static_cast<float>(double(sums[i]) / kOne);
 }
 
 Grid smoothed(const Grid& g) {
@@ -101,67 +121,113 @@ Grid signedDistance(const Grid& rawDensity, double iso) {
   // The shell of a splat of strands is bumpy at the scale of the strand spacing; one binomial pass
   // leaves the mass where it is and takes the bumps out of the normals.
   const Grid density = smoothed(rawDensity);
-  Grid s = density;
   const glm::ivec3 n = density.size;
-  const double h = density.voxel, inf = std::numeric_limits<double>::infinity();
-  std::vector<double> dist(s.values.size(), inf);
-  std::vector<char> inside(s.values.size());
-  for (size_t i = 0; i < s.values.size(); ++i) inside[i] = density.values[i] > iso;
-  // Nodes next to the shell (an edge to a neighbour crosses it): the distance |φ|/|∇φ| of the linear
-  // approximation of φ = density − iso, from central differences; never more than a voxel.
-  auto phi = [&](int i, int j, int k) {
-    return double(density.at(std::clamp(i, 0, n.x - 1), std::clamp(j, 0, n.y - 1), std::clamp(k, 0, n.z - 1))) - iso;
-  };
-  const glm::ivec3 steps[6] = {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}};
-  for (int k = 0; k < n.z; ++k)
+  const double h = density.voxel;
+  const size_t count = density.values.size();
+  const size_t strideY = size_t(n.x), strideZ = size_t(n.x) * n.y;
+  auto node = [&](int i, int j, int k) { return density.origin + h * glm::dvec3(i, j, k); };
+  std::vector<char> inside(count);
+  for (size_t i = 0; i < count; ++i) inside[i] = density.values[i] > iso;
+
+  // Every node carries the nearest point of the shell it knows of. It starts at the nodes with an
+  // edge across the shell, as the nearest crossing of φ = density − iso along their own edges (by
+  // linear interpolation, which is exact on the trilinear φ).
+  constexpr double kNone = std::numeric_limits<double>::infinity();
+  std::vector<glm::dvec3> nearest(count, glm::dvec3(kNone));
+  std::vector<double> dist2(count, kNone);
+  tbb::parallel_for(0, n.z, [&](int k) {
     for (int j = 0; j < n.y; ++j)
       for (int i = 0; i < n.x; ++i) {
         const size_t id = density.index(i, j, k);
-        bool crossing = false;
-        for (const glm::ivec3& st : steps) {
-          glm::ivec3 b(i + st.x, j + st.y, k + st.z);
-          if (glm::all(glm::greaterThanEqual(b, glm::ivec3(0))) && glm::all(glm::lessThan(b, n)))
-            crossing = crossing || inside[density.index(b.x, b.y, b.z)] != inside[id];
-        }
-        if (!crossing) continue;
-        glm::dvec3 grad((phi(i + 1, j, k) - phi(i - 1, j, k)) / (2 * h), (phi(i, j + 1, k) - phi(i, j - 1, k)) / (2 * h),
-                        (phi(i, j, k + 1) - phi(i, j, k - 1)) / (2 * h));
-        double g = glm::length(grad);
-        dist[id] = g > 0.0 ? std::min(std::abs(phi(i, j, k)) / g, h) : h;
+        const double f = density.values[id] - iso;
+        for (int axis = 0; axis < 3; ++axis)
+          for (int side = -1; side <= 1; side += 2) {
+            glm::ivec3 b(i, j, k);
+            b[axis] += side;
+            if (b[axis] < 0 || b[axis] >= n[axis]) continue;
+            const size_t nb = density.index(b.x, b.y, b.z);
+            if (inside[nb] == inside[id]) continue;
+            const double t = f / (f - (density.values[nb] - iso));
+            if (t * t * h * h >= dist2[id]) continue;
+            nearest[id] = node(i, j, k);
+            nearest[id][axis] += side * t * h;
+            dist2[id] = t * t * h * h;
+          }
       }
-  // Fast sweeping (Zhao 2005): Godunov's upwind update of |∇S| = 1 in 8 sweep orders, twice.
-  auto update = [&](int i, int j, int k) {
-    size_t id = s.index(i, j, k);
-    auto nb = [&](int a, int b, int c) { return dist[s.index(a, b, c)]; };
-    double a = std::min(i > 0 ? nb(i - 1, j, k) : inf, i + 1 < n.x ? nb(i + 1, j, k) : inf);
-    double b = std::min(j > 0 ? nb(i, j - 1, k) : inf, j + 1 < n.y ? nb(i, j + 1, k) : inf);
-    double c = std::min(k > 0 ? nb(i, j, k - 1) : inf, k + 1 < n.z ? nb(i, j, k + 1) : inf);
-    double v[3] = {a, b, c};
-    std::sort(v, v + 3);
-    if (v[0] == inf) return;
-    double x = v[0] + h;
-    if (x > v[1]) {
-      double sum = v[0] + v[1], disc = 2.0 * h * h - (v[0] - v[1]) * (v[0] - v[1]);
-      x = 0.5 * (sum + std::sqrt(std::max(disc, 0.0)));
-      if (x > v[2]) {
-        double s3 = v[0] + v[1] + v[2];
-        double q = v[0] * v[0] + v[1] * v[1] + v[2] * v[2];
-        double d3 = s3 * s3 - 3.0 * (q - h * h);
-        x = (s3 + std::sqrt(std::max(d3, 0.0))) / 3.0;
-      }
-    }
-    if (x < dist[id]) dist[id] = x;
-  };
-  for (int pass = 0; pass < 2; ++pass)
+  });
+
+  // Fast sweeping of the nearest points (a closest-point transform): in each of the 8 orders of the
+  // axes a node takes the nearest point of a neighbour behind it when that is nearer than its own.
+  auto sweep = [&] {  // one round of the 8 orders: the slide below mends what it leaves
     for (int order = 0; order < 8; ++order) {
       const bool fx = order & 1, fy = order & 2, fz = order & 4;
       for (int kk = 0; kk < n.z; ++kk)
         for (int jj = 0; jj < n.y; ++jj)
-          for (int ii = 0; ii < n.x; ++ii)
-            update(fx ? n.x - 1 - ii : ii, fy ? n.y - 1 - jj : jj, fz ? n.z - 1 - kk : kk);
+          for (int ii = 0; ii < n.x; ++ii) {
+            const int i = fx ? n.x - 1 - ii : ii, j = fy ? n.y - 1 - jj : jj, k = fz ? n.z - 1 - kk : kk;
+            const size_t id = density.index(i, j, k);
+            const glm::dvec3 x = node(i, j, k);
+            const bool has[3] = {fx ? i + 1 < n.x : i > 0, fy ? j + 1 < n.y : j > 0, fz ? k + 1 < n.z : k > 0};
+            const size_t behind[3] = {fx ? id + 1 : id - 1, fy ? id + strideY : id - strideY,
+                                      fz ? id + strideZ : id - strideZ};
+            for (int axis = 0; axis < 3; ++axis) {
+              if (!has[axis] || dist2[behind[axis]] == kNone) continue;
+              const glm::dvec3 e = nearest[behind[axis]] - x;
+              const double d2 = glm::dot(e, e);
+              if (d2 < dist2[id]) nearest[id] = nearest[behind[axis]], dist2[id] = d2;
+            }
+          }
     }
-  for (size_t i = 0; i < s.values.size(); ++i) {
-    double d = std::isfinite(dist[i]) ? dist[i] : h * (n.x + n.y + n.z);
+  };
+
+  // A nearest point carried from a neighbour is a shell point near the node's own nearest point, not
+  // that point: off by up to a voxel along the shell, which makes the distance too long and ∇S wrong.
+  // Each node slides its point along the shell until x − p lies along the shell's normal at p, the
+  // condition for the nearest point: a step along the tangent plane, then Newton's steps on the
+  // trilinear φ, p ← p − φ ∇φ/|∇φ|², back onto the shell; kept while the distance falls.
+  const double tolerance = 1e-4 * std::abs(iso) + 1e-12;
+  auto ontoShell = [&](glm::dvec3& p) {
+    double value = density.sample(p) - iso;
+    for (int step = 0; step < 16 && std::abs(value) > tolerance; ++step) {
+      const glm::dvec3 g = density.gradient(p);
+      const double g2 = glm::dot(g, g);
+      if (!(g2 > 0.0)) return false;
+      p -= (value / g2) * g;
+      value = density.sample(p) - iso;
+    }
+    return std::abs(value) <= tolerance;
+  };
+  auto slide = [&] {
+    tbb::parallel_for(0, n.z, [&](int k) {
+      for (int j = 0; j < n.y; ++j)
+        for (int i = 0; i < n.x; ++i) {
+          const size_t id = density.index(i, j, k);
+          if (dist2[id] == kNone) continue;
+          const glm::dvec3 x = node(i, j, k);
+          for (int round = 0; round < 6; ++round) {
+            const glm::dvec3 p = nearest[id], g = density.gradient(p);
+            const double g2 = glm::dot(g, g);
+            if (!(g2 > 0.0)) break;
+            glm::dvec3 across = (x - p) - glm::dot(x - p, g) / g2 * g;
+            const double a2 = glm::dot(across, across);
+            if (a2 <= 1e-6 * dist2[id]) break;
+            if (a2 > h * h) across *= h / std::sqrt(a2);
+            glm::dvec3 q = p + across;
+            if (!ontoShell(q)) break;
+            const double d2 = glm::dot(q - x, q - x);
+            if (!(d2 < dist2[id])) break;
+            nearest[id] = q, dist2[id] = d2;
+          }
+        }
+    });
+  };
+  sweep();
+  slide();
+
+  Grid s = density;
+  const double far = h * (n.x + n.y + n.z);  // a grid without a shell: everything is far outside or inside
+  for (size_t i = 0; i < count; ++i) {
+    const double d = dist2[i] == kNone ? far : std::sqrt(dist2[i]);
     s.values[i] = static_cast<float>(inside[i] ? -d : d);
   }
   return s;

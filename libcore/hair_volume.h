@@ -31,14 +31,16 @@ struct Grid {
 Grid gridAround(const std::vector<glm::vec3>& points, double voxel, int padding);
 
 // Splats every point with the tent (trilinear) kernel of the paper's (1): each point adds weights
-// summing to 1 to the 8 nodes around it, so the grid sums to the number of points inside it.
+// summing to exactly 1 to the 8 nodes around it, so the grid sums to the number of points inside it.
+// Parallel, and the same bits whatever the thread count.
 void splat(Grid& density, const std::vector<glm::vec3>& points);
 
 // One pass of a separable binomial [1 2 1]/4 filter (mass-preserving away from the edges).
 Grid smoothed(const Grid& grid);
 
-// The signed distance to the isosurface density = `iso` of the smoothed density (negative inside), by
-// fast sweeping from |φ|/|∇φ| at the nodes next to the shell.
+// The signed distance to the isosurface density = `iso` of the smoothed density (negative inside): the
+// nodes next to the shell find their nearest shell point from the sub-voxel crossings, and fast
+// sweeping carries nearest points to the rest of the grid.
 Grid signedDistance(const Grid& density, double iso);
 
 // Shading normals ∇S/|∇S| at every strand vertex.
