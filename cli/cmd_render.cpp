@@ -155,6 +155,11 @@ void registerRender(CLI::App& app, int& exitCode) {
       Stopwatch clock;
       Config config = loadStageConfig(options->setup, options->common, SetupUse::kRender, stats);
       Strands hair = readStrands(options->hair);
+      if (config.render.shadingModel == ShadingModel::kVolumetric && config.render.volumetricBlend > 0.0 &&
+          hair.normals.empty())
+        throw InputError({options->hair, 0}, "ShadingModel volumetric needs the coupe's volume normals, and this one has "
+                                             "none; run `hairgen shade SETUP --hair " + options->hair +
+                                             " -o shaded.hair` and render that");
       conform(hair, options->upAxis, options->scale);
       std::optional<Mesh> head;
       if (config.setup.headModel.given()) head = readObj(config.setup.headModel.path);

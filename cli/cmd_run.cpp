@@ -87,8 +87,8 @@ void registerRun(CLI::App& app, int& exitCode) {
         stats.time("write", writing + clock.lap());
         note(options->common, "run: wrote " + guidesFile.string() + " and " + (out / "coupe.hair").string());
       }
-      if (wantsShade(config.visuality)) {
-        coupe = shadeStage(options->common, config, coupe, stats);
+      if (wantsShade(config.visuality, config.render)) {
+        coupe = shadeStage(options->common, config, std::move(coupe), stats).coupe;
         clock.lap();
         writeStrands(out / "shaded.hair", coupe);
         stats.add("write", clock.lap());

@@ -1,45 +1,109 @@
-// hairgen shade SETUP --hair FILE -o OUT: per-strand shading attributes into the cache.
+// hairgen shade SETUP --hair FILE -o OUT [--vdb FILE.vdb]: volumetric shading normals (and Anjyo's
+// per-strand ambient) into the cache.
+// hairgen shade --rest REST IN -o OUT: the rest pose's normals re-posed onto a deformed coupe.
+#include <filesystem>
+#include <sstream>
+
 #include "cli/commands.h"
 #include "cli/common.h"
 #include "libcore/hair_cache.h"
 #include "libcore/setup.h"
 #include "libcore/text.h"
+#include "libcore/vdb_io.h"
 #include "stages/shade.h"
 
 namespace hairgen::cli {
 
-Strands shadeStage(const CommonOptions& common, const Config& config, const Strands& coupe, Stats& stats) {
-  Stopwatch clock;
-  Strands shaded = shade(coupe, config.visuality, config.hairstyle.seed, config.digest());
-  stats.time("shade", clock.lap());
-  note(common, "shade: per-strand ambient from N(" + formatReal(config.visuality.ambientMean) + ", " +
-                   formatReal(config.visuality.ambientDeviation) + ") on " + std::to_string(shaded.strandCount()) +
-                   " strands");
-  return shaded;
+ShadeResult shadeStage(const CommonOptions& common, const Config& config, Strands coupe, Stats& stats) {
+  ShadeResult result = shade(std::move(coupe), config.visuality, config.render, config.hairstyle.seed, config.digest());
+  const Strands& shaded = result.coupe;
+  const Grid& grid = result.volume.density;
+  stats.time("volume", result.timings.volume);
+  stats.time("normals", result.timings.normals);
+  stats.counts()["strands"] = shaded.strandCount();
+  stats.counts()["points"] = shaded.pointCount();
+  stats.counts()["grid"] = {grid.size.x, grid.size.y, grid.size.z};
+  stats.counts()["voxel_size"] = grid.voxel;
+  stats.counts()["shell_density"] = result.volume.iso;
+  std::ostringstream line;
+  line << "shade: " << grid.size.x << "×" << grid.size.y << "×" << grid.size.z << " grid of " << formatReal(grid.voxel * 1000)
+       << " mm voxels, shell at " << formatReal(result.volume.iso) << " points/voxel, normals on "
+       << shaded.pointCount() << " vertices in " << formatSeconds(result.timings.volume + result.timings.normals);
+  if (wantsAmbient(config.visuality))
+    line << "; per-strand ambient from N(" << formatReal(config.visuality.ambientMean) << ", "
+         << formatReal(config.visuality.ambientDeviation) << ")";
+  note(common, line.str());
+  return result;
 }
 
 void registerShade(CLI::App& app, int& exitCode) {
   struct Options {
     CommonOptions common;
-    std::string setup, hair, output;
+    std::string first, hair, rest, output, vdb;
   };
   auto options = std::make_shared<Options>();
   CLI::App* cmd = app.add_subcommand(
-      "shade", "Per-strand shading attributes: an ambient coefficient from N(AmbientMean, AmbientDeviation), stored "
-               "as per-vertex colour");
-  cmd->add_option("SETUP", options->setup, "The Setup file (Visuality Info; Hairstyle's Seed)")->required();
-  cmd->add_option("--hair", options->hair, "The coupe (.hair, .gltf, .glb)")->required();
+      "shade",
+      "Shading attributes into the cache: volumetric normals from the hair's density grid and shell (Render Info's "
+      "VoxelSize, VolumePadding, ShellDensity), and a per-strand ambient from N(AmbientMean, AmbientDeviation) when "
+      "Visuality Info asks. With --rest, re-poses a shaded rest coupe's normals onto a deformed one instead");
+  cmd->add_option("SETUP", options->first,
+                  "The Setup file (Render Info, Visuality Info, Hairstyle's Seed); with --rest, the deformed coupe")
+      ->type_name("SETUP|COUPE");
+  cmd->add_option("--hair", options->hair, "The coupe (.hair, .gltf, .glb)");
+  cmd->add_option("--rest", options->rest, "A coupe shaded at rest; its normals are carried onto the coupe by "
+                                           "parallel-transport frames, with no volume built")
+      ->type_name("REST");
   cmd->add_option("-o,--output", options->output, "Shaded coupe to write (.hair, .gltf, .glb)")->required();
+  cmd->add_option("--vdb", options->vdb, "Also write the density and signed-distance grids as OpenVDB float grids "
+                                         "named 'density' and 'sdf'")
+      ->type_name("FILE.vdb");
   addCommonFlags(*cmd, options->common, true);
   cmd->footer(exitCodeHelp());
   cmd->callback([options, &exitCode] {
     exitCode = runCommand("shade", options->common, [&] {
       Stats stats("shade");
       hairFormatOf(options->output);
-      Config config = loadStageConfig(options->setup, options->common, SetupUse::kRender, stats);
-      Strands shaded = shadeStage(options->common, config, readStrands(options->hair), stats);
-      writeStrands(options->output, shaded);
-      note(options->common, "shade: wrote " + options->output);
+      Stopwatch clock;
+      if (!options->rest.empty()) {
+        if (!options->vdb.empty()) throw InputError("--vdb needs a volume, which --rest does not build");
+        if (!options->hair.empty() && !options->first.empty())
+          throw InputError("with --rest no Setup is read: give the deformed coupe once, as --hair or on its own");
+        const std::string& coupeFile = options->hair.empty() ? options->first : options->hair;
+        if (coupeFile.empty()) throw InputError("--rest needs the deformed coupe: hairgen shade --rest REST COUPE -o OUT");
+        Strands rest = readStrands(options->rest), deformed = readStrands(coupeFile);
+        stats.time("read", clock.lap());
+        Strands out = repose(rest, deformed);
+        stats.time("repose", clock.lap());
+        stats.counts()["strands"] = out.strandCount();
+        stats.counts()["points"] = out.pointCount();
+        writeStrands(options->output, out);
+        stats.time("write", clock.lap());
+        note(options->common, "shade: re-posed " + std::to_string(out.pointCount()) + " normals from " + options->rest +
+                                  "; wrote " + options->output);
+        stats.write(options->common);
+        return;
+      }
+      if (options->first.empty() || options->hair.empty())
+        throw InputError("shade needs a Setup and a coupe: hairgen shade SETUP --hair COUPE -o OUT");
+      if (!options->vdb.empty() && !toLower(options->vdb).ends_with(".vdb"))
+        throw InputError("--vdb " + options->vdb + ": the volume file must end in .vdb");
+      Config config = loadStageConfig(options->first, options->common, SetupUse::kRender, stats);
+      Strands coupe = readStrands(options->hair);
+      stats.time("read", clock.lap());
+      ShadeResult shaded = shadeStage(options->common, config, std::move(coupe), stats);
+      clock.lap();
+      // The volume first: if the coupe then cannot be written, the volume goes too (no partial output).
+      if (!options->vdb.empty()) writeVdb(options->vdb, shaded.volume);
+      try {
+        writeStrands(options->output, shaded.coupe);
+      } catch (...) {
+        std::error_code ignored;
+        if (!options->vdb.empty()) std::filesystem::remove(options->vdb, ignored);
+        throw;
+      }
+      stats.time("write", clock.lap());
+      note(options->common, "shade: wrote " + options->output + (options->vdb.empty() ? "" : " and " + options->vdb));
       stats.write(options->common);
     });
   });

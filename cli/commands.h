@@ -13,6 +13,7 @@
 #include "libcore/strands.h"
 #include "libcore/renderer.h"
 #include "stages/grow.h"
+#include "stages/shade.h"
 
 namespace hairgen::cli {
 
@@ -30,7 +31,7 @@ void registerDiff(CLI::App& app, int& exitCode);
 GrowResult growStage(const CommonOptions& common, const Config& config, const Mesh& wick, Stats& stats);
 Strands interpolateStage(const CommonOptions& common, const Config& config, const Mesh& wick, const Strands& guides,
                          const std::string& guidesName, Stats& stats);
-Strands shadeStage(const CommonOptions& common, const Config& config, const Strands& coupe, Stats& stats);
+ShadeResult shadeStage(const CommonOptions& common, const Config& config, Strands coupe, Stats& stats);
 RenderOutput renderStage(const CommonOptions& common, const Config& config, const Strands& hair, const Mesh* head,
                          bool keepDom, Stats& stats);
 // Writes the EXR, and the light's maps and the preview where named (empty: not wanted).

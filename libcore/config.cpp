@@ -77,7 +77,11 @@ std::vector<SectionSpec> makeSections() {
         key("StrandWidth", "metres, e.g. 0.00008"),
         key("ShadingModel", "kajiya-kay, thesis, anjyo or volumetric"),
         key("Background", "r g b"),
-        key("HeadColor", "r g b, the head's albedo")}},
+        key("HeadColor", "r g b, the head's albedo"),
+        key("VoxelSize", "hairgen shade: metres between density grid nodes, e.g. 0.004"),
+        key("VolumePadding", "hairgen shade: empty voxels around the hair, e.g. 3"),
+        key("ShellDensity", "hairgen shade: the shell's density as a fraction of a typical hair point's, e.g. 0.25"),
+        key("VolumetricBlend", "0 (Kajiya-Kay) to 1 (volumetric), e.g. 1")}},
   };
 }
 

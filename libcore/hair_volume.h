@@ -38,10 +38,24 @@ void splat(Grid& density, const std::vector<glm::vec3>& points);
 // One pass of a separable binomial [1 2 1]/4 filter (mass-preserving away from the edges).
 Grid smoothed(const Grid& grid);
 
-// The signed distance to the isosurface density = `iso` of the smoothed density (negative inside): the
-// nodes next to the shell find their nearest shell point from the sub-voxel crossings, and fast
-// sweeping carries nearest points to the rest of the grid.
+// The signed distance to the isosurface density = `iso` (negative inside): the nodes next to the
+// shell start from its sub-voxel crossings, fast sweeping carries nearest points to the rest of the
+// grid, and each node slides its point along the shell to the true nearest one.
 Grid signedDistance(const Grid& density, double iso);
+
+// The density at a typical hair point: Σd²/Σd over the nodes, the mean density weighted by how much
+// hair sits there. Scale-free shell densities are fractions of it.
+double typicalDensity(const Grid& density);
+
+// What `hairgen shade` builds: the splat, and the signed distance to the shell at
+// `shellFraction`·typicalDensity of the splat after one smoothing pass (the shell of a splat of
+// strands is bumpy at the scale of the strand spacing; the pass keeps the mass where it is).
+struct HairVolume {
+  Grid density;   // strand points per voxel, as splatted
+  Grid distance;  // metres, negative inside the shell
+  double iso = 0.0;
+};
+HairVolume buildVolume(const Strands& strands, double voxel, int padding, double shellFraction);
 
 // Shading normals ∇S/|∇S| at every strand vertex.
 std::vector<glm::vec3> volumeNormals(const Grid& distance, const Strands& strands);

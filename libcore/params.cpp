@@ -112,7 +112,11 @@ std::string Config::canonicalText() const {
       << "Render.StrandWidth " << formatReal(r.strandWidth) << "\n"
       << "Render.ShadingModel " << name(r.shadingModel) << "\n"
       << "Render.Background " << join(r.background) << "\n"
-      << "Render.HeadColor " << join(r.headColor) << "\n";
+      << "Render.HeadColor " << join(r.headColor) << "\n"
+      << "Render.VoxelSize " << formatReal(r.voxelSize) << "\n"
+      << "Render.VolumePadding " << r.volumePadding << "\n"
+      << "Render.ShellDensity " << formatReal(r.shellDensity) << "\n"
+      << "Render.VolumetricBlend " << formatReal(r.volumetricBlend) << "\n";
   return out.str();
 }
 

@@ -118,6 +118,12 @@ struct RenderSettings {
   ShadingModel shadingModel = ShadingModel::kKajiyaKay;
   glm::dvec3 background{0.18, 0.18, 0.20};
   glm::dvec3 headColor{0.72, 0.55, 0.45};     // Lambert albedo of the head
+  // The volumetric model (Petrovic et al. 2005): `hairgen shade` builds the hair's density grid and
+  // shell from these, and `ShadingModel volumetric` mixes its shading with Kajiya-Kay by the blend.
+  double voxelSize = 0.004;     // metres, the density grid's spacing
+  int volumePadding = 3;        // empty voxels around the hair on every side
+  double shellDensity = 0.25;   // the shell's density, as a fraction of the density at a typical hair point
+  double volumetricBlend = 1.0; // 0 = Kajiya-Kay, 1 = volumetric
 };
 
 // A path named by a config file, with where it was named (for "missing file" errors).

@@ -55,11 +55,14 @@ constexpr const char* kHairVertex = R"(
 layout(std430, binding = 0) readonly buffer Points { float pointData[]; };
 layout(std430, binding = 1) readonly buffer Tangents { float tangentData[]; };
 layout(std430, binding = 2) readonly buffer Colours { float colourData[]; };
+layout(std430, binding = 3) readonly buffer Normals { float normalData[]; };
 uniform int uHasColour;
+uniform int uHasNormal;
 #else
 layout(location = 0) in vec3 aPosition;
 layout(location = 1) in vec3 aTangent;
 layout(location = 2) in vec3 aColour;  // (1, 1, 1) when the cache has no colours
+layout(location = 3) in vec3 aNormal;  // (0, 0, 0) when the cache has no normals
 #endif
 uniform mat4 uView;
 uniform mat4 uProj;
@@ -71,6 +74,7 @@ uniform float uMinWidth;  // pixels: the narrowest ribbon
 out vec3 vWorld;
 out vec3 vTangent;
 out vec3 vColour;
+out vec3 vNormal;
 out float vAlpha;
 out float vDepth;         // metres along the view axis
 void main() {
@@ -79,10 +83,12 @@ void main() {
   vec3 p = vec3(pointData[3 * i], pointData[3 * i + 1], pointData[3 * i + 2]);
   vec3 t = vec3(tangentData[3 * i], tangentData[3 * i + 1], tangentData[3 * i + 2]);
   vColour = uHasColour != 0 ? vec3(colourData[3 * i], colourData[3 * i + 1], colourData[3 * i + 2]) : vec3(1.0);
+  vNormal = uHasNormal != 0 ? vec3(normalData[3 * i], normalData[3 * i + 1], normalData[3 * i + 2]) : vec3(0.0);
 #else
   vec3 p = aPosition;
   vec3 t = aTangent;
   vColour = aColour;
+  vNormal = aNormal;
 #endif
   vec4 view = uView * vec4(p, 1.0);
   vec4 clip = uProj * view;
@@ -187,6 +193,7 @@ constexpr const char* kHairFragment = R"(
 in vec3 vWorld;
 in vec3 vTangent;
 in vec3 vColour;
+in vec3 vNormal;
 in float vAlpha;
 in float vDepth;
 uniform vec3 uEye;
@@ -197,7 +204,8 @@ uniform vec3 uAmbientColor;
 uniform vec3 uDiffuseColor;
 uniform vec3 uSpecularColor;
 uniform float uGlossiness;
-uniform int uModel;       // 0 Kajiya-Kay, 1 the thesis' variant, 2 Anjyo
+uniform int uModel;       // 0 Kajiya-Kay, 1 the thesis' variant, 2 Anjyo, 3 volumetric
+uniform float uBlend;     // volumetric: its share against Kajiya-Kay
 uniform int uBlock;       // k: sub-pixels per pixel side
 uniform int uOrder[64];   // the screen door's threshold rank of each sub-pixel of a block, row by row
 layout(location = 0) out vec4 oColor;
@@ -227,6 +235,15 @@ void main() {
   float shadow = lightArriving(vWorld, 0.001);
   vec3 colour = uAmbient * uAmbientColor * vColour +
                 shadow * uLightColor * (uDiffuseColor * vColour * diffuse + uSpecularColor * specular);
+  if (uModel == 3) {
+    // The strand as a point of the hair's surface, lit about the volume normal.
+    vec3 n = dot(vNormal, vNormal) > 0.0 ? normalize(vNormal) : vec3(0.0);
+    float surfaceDiffuse = max(dot(n, l), 0.0);
+    float phong = pow(max(dot(reflect(-l, n), e), 0.0), uGlossiness);
+    vec3 volumetric = uAmbient * uAmbientColor * vColour +
+                      shadow * uLightColor * (uDiffuseColor * vColour * surfaceDiffuse + uSpecularColor * phong);
+    colour = mix(colour, volumetric, uBlend);
+  }
   oColor = vec4(colour, vAlpha);
   oData = vec4(vDepth, 1.0, shadow, 0.0);
 }
@@ -392,8 +409,8 @@ struct Buffer {
 // Hair on the GPU: points and tangents in storage buffers; per strand a line strip (one vertex per
 // point) or a triangle strip (two).
 struct HairGeometry {
-  Buffer points, tangents, colours;
-  bool hasColours;
+  Buffer points, tangents, colours, normals;
+  bool hasColours, hasNormals;
   std::vector<GLint> lineFirsts, ribbonFirsts;
   std::vector<GLsizei> lineCounts, ribbonCounts;
   GLuint vao = 0;
@@ -401,7 +418,9 @@ struct HairGeometry {
       : points(s.points.data(), s.points.size() * sizeof(glm::vec3)),
         tangents(tangentData.data(), tangentData.size() * sizeof(glm::vec3)),
         colours(s.colors.data(), s.colors.size() * sizeof(glm::vec3)),
-        hasColours(!s.colors.empty()) {
+        normals(s.normals.data(), s.normals.size() * sizeof(glm::vec3)),
+        hasColours(!s.colors.empty()),
+        hasNormals(!s.normals.empty()) {
     for (size_t i = 0; i < s.strandCount(); ++i) {
       if (s.pointsOf(i) < 2) continue;
       lineFirsts.push_back(static_cast<GLint>(s.firstPoint[i]));
@@ -413,7 +432,9 @@ struct HairGeometry {
     glVertexArrayVertexBuffer(vao, 0, points.id, 0, sizeof(glm::vec3));
     glVertexArrayVertexBuffer(vao, 1, tangents.id, 0, sizeof(glm::vec3));
     glVertexArrayVertexBuffer(vao, 2, colours.id, 0, sizeof(glm::vec3));
-    for (GLuint a = 0; a < (hasColours ? 3u : 2u); ++a) {
+    glVertexArrayVertexBuffer(vao, 3, normals.id, 0, sizeof(glm::vec3));
+    for (GLuint a = 0; a < 4; ++a) {
+      if ((a == 2 && !hasColours) || (a == 3 && !hasNormals)) continue;  // constant attributes, set in draw()
       glEnableVertexArrayAttrib(vao, a);
       glVertexArrayAttribFormat(vao, a, 3, GL_FLOAT, GL_FALSE, 0);
       glVertexArrayAttribBinding(vao, a, a);
@@ -464,7 +485,9 @@ void HairGeometry::draw(bool ribbon) const {
   glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, points.id);
   glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, tangents.id);
   glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 2, colours.id);
+  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 3, normals.id);
   if (!hasColours) glVertexAttrib3f(2, 1.0f, 1.0f, 1.0f);
+  if (!hasNormals) glVertexAttrib3f(3, 0.0f, 0.0f, 0.0f);
   if (lineFirsts.empty()) return;
   if (ribbon)
     glMultiDrawArrays(GL_TRIANGLE_STRIP, ribbonFirsts.data(), ribbonCounts.data(), static_cast<GLsizei>(ribbonFirsts.size()));
@@ -740,8 +763,13 @@ RenderOutput renderHair(GlContext&, const RenderInput& in) {
     hairShade.set("uDiffuseColor", glm::vec3(in.visuality.diffuseColor));
     hairShade.set("uSpecularColor", glm::vec3(in.visuality.specularColor));
     hairShade.set("uGlossiness", float(in.visuality.glossiness));
-    hairShade.set("uModel", r.shadingModel == ShadingModel::kThesis ? 1 : r.shadingModel == ShadingModel::kAnjyo ? 2 : 0);
+    hairShade.set("uModel", r.shadingModel == ShadingModel::kThesis       ? 1
+                            : r.shadingModel == ShadingModel::kAnjyo      ? 2
+                            : r.shadingModel == ShadingModel::kVolumetric ? 3
+                                                                          : 0);
+    hairShade.set("uBlend", float(r.volumetricBlend));
     hairShade.set("uHasColour", hair.colors.empty() ? 0 : 1);
+    hairShade.set("uHasNormal", hair.normals.empty() ? 0 : 1);
     hairGeometry.draw(ribbons);
   }
   Texture resolvedColour(GL_RGBA32F, w, h), resolvedData(GL_RGBA32F, w, h);

@@ -1,13 +1,22 @@
 #include "stages/shade.h"
 
+#include <chrono>
 #include <cmath>
 
+#include "libcore/error.h"
 #include "libcore/random.h"
 
 namespace hairgen {
 namespace {
 
 constexpr uint64_t kAmbientKey = 0x616d6269656e74ull;  // "ambient": keeps these numbers apart from interpolate's
+
+double secondsSince(std::chrono::steady_clock::time_point& start) {
+  auto now = std::chrono::steady_clock::now();
+  double s = std::chrono::duration<double>(now - start).count();
+  start = now;
+  return s;
+}
 
 }  // namespace
 
@@ -18,15 +27,37 @@ double strandAmbient(uint64_t seed, uint32_t strandId, double mean, double devia
   return std::max(0.0, mean + deviation * normal);
 }
 
-Strands shade(const Strands& coupe, const Visuality& visuality, uint64_t seed, const std::string& configDigest) {
-  Strands out = coupe;
-  out.colors.assign(out.pointCount(), glm::vec3(1.0f));
-  for (size_t s = 0; s < out.strandCount(); ++s) {
-    const uint32_t id = out.strandId.empty() ? static_cast<uint32_t>(s) : out.strandId[s];
-    const float a = static_cast<float>(strandAmbient(seed, id, visuality.ambientMean, visuality.ambientDeviation));
-    for (uint32_t p = out.firstPoint[s]; p < out.firstPoint[s + 1]; ++p) out.colors[p] = glm::vec3(a);
+ShadeResult shade(Strands coupe, const Visuality& visuality, const RenderSettings& render, uint64_t seed,
+                  const std::string& configDigest) {
+  ShadeResult result;
+  auto clock = std::chrono::steady_clock::now();
+  result.volume = buildVolume(coupe, render.voxelSize, render.volumePadding, render.shellDensity);
+  result.timings.volume = secondsSince(clock);
+  Strands& out = result.coupe;
+  out = std::move(coupe);
+  out.normals = volumeNormals(result.volume.distance, out);
+  if (wantsAmbient(visuality)) {
+    out.colors.assign(out.pointCount(), glm::vec3(1.0f));
+    for (size_t s = 0; s < out.strandCount(); ++s) {
+      const uint32_t id = out.strandId.empty() ? static_cast<uint32_t>(s) : out.strandId[s];
+      const float a = static_cast<float>(strandAmbient(seed, id, visuality.ambientMean, visuality.ambientDeviation));
+      for (uint32_t p = out.firstPoint[s]; p < out.firstPoint[s + 1]; ++p) out.colors[p] = glm::vec3(a);
+    }
   }
   out.provenance = {"hairgen " HAIRGEN_VERSION, "shade", seed, configDigest};
+  result.timings.normals = secondsSince(clock);
+  return result;
+}
+
+Strands repose(const Strands& rest, const Strands& deformed) {
+  if (!rest.strandId.empty() && !deformed.strandId.empty() && rest.strandId != deformed.strandId)
+    throw InputError("the rest coupe and the coupe to re-pose hold different strand ids; both must come from the "
+                     "same interpolate run");
+  Strands out = deformed;
+  out.normals = reposeNormals(rest, deformed);
+  if (out.colors.empty()) out.colors = rest.colors;
+  out.provenance = rest.provenance;
+  out.provenance.stage = "shade";
   return out;
 }
 

@@ -44,8 +44,8 @@ TEST(Volume, TheDistanceToABallOfStrandsIsTheDistanceToItsSurface) {
       }
   Grid density = gridAround(points, voxel, 4);
   splat(density, points);
-  const double centreDensity = smoothed(density).sample(centre);
-  const Grid sdf = signedDistance(density, 0.5 * centreDensity);
+  const Grid smooth = smoothed(density);
+  const Grid sdf = signedDistance(smooth, 0.5 * smooth.sample(centre));
   double worst = 0.0, worstGradient = 0.0;
   int checked = 0;
   for (int k = 1; k + 1 < sdf.size.z; ++k)
@@ -80,10 +80,7 @@ const Coupe3& coupe3() {
 
 TEST(Volume, Coupe3NormalsPointAwayFromTheHeadOnTheOutside) {
   const Strands& coupe = coupe3().coupe;
-  Grid density = gridAround(coupe.points, 0.004, 3);
-  splat(density, coupe.points);
-  Grid sdf = signedDistance(density, 0.5);
-  std::vector<glm::vec3> normals = volumeNormals(sdf, coupe);
+  std::vector<glm::vec3> normals = volumeNormals(buildVolume(coupe, 0.004, 3, 0.25).distance, coupe);
   // The outermost vertices: those in the outer tenth of the hair's distances from the head centre,
   // direction by direction (binned by azimuth and elevation).
   const glm::dvec3 head = coupe3().config.collision.shapes[0].centre;
@@ -109,9 +106,7 @@ TEST(Volume, Coupe3NormalsPointAwayFromTheHeadOnTheOutside) {
 
 TEST(Volume, ReposingRestNormalsOnARotatedCoupeRotatesThem) {
   Strands rest = coupe3().coupe;
-  Grid density = gridAround(rest.points, 0.004, 3);
-  splat(density, rest.points);
-  rest.normals = volumeNormals(signedDistance(density, 0.5), rest);
+  rest.normals = volumeNormals(buildVolume(rest, 0.004, 3, 0.25).distance, rest);
   const glm::dmat3 r = glm::dmat3(glm::rotate(glm::dmat4(1.0), 0.7, glm::normalize(glm::dvec3(0.3, 1.0, -0.4))));
   Strands moved = rest;
   for (glm::vec3& p : moved.points) p = glm::vec3(r * glm::dvec3(p) + glm::dvec3(0.1, -0.2, 0.05));

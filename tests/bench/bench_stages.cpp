@@ -3,6 +3,8 @@
 //                       items_per_second is energy evaluations per second per core.
 //   GrowCoupe3:         the whole grow stage on every core, counters guides/s and evaluations/s.
 //   InterpolateCoupe3:  ~150,000 strands of 64 vertices from coupe 3's guides, every core.
+//   ShadeCoupe3:        `shade` on that 150,000-strand coupe with coupe 3's Render Info (grid, signed
+//                       distance, normals), every core; counters give the grid's size and each part's seconds.
 //   CantileverStyling:  Anjyo's figures, 20,000 hairs of 20 segments bent around the head ellipsoid.
 //   Render/strands/width/height/samples: coupe 3 with the head and shadows, through whatever EGL opens
 //                       (llvmpipe here); counters give each pass's seconds.
@@ -18,6 +20,7 @@
 #include "stages/cantilever.h"
 #include "stages/grow.h"
 #include "stages/interpolate.h"
+#include "stages/shade.h"
 #include "libcore/gl_context.h"
 #include "libcore/renderer.h"
 
@@ -93,6 +96,36 @@ void InterpolateCoupe3(benchmark::State& state) {
   state.counters["vertices/s"] = benchmark::Counter(double(points), benchmark::Counter::kIsRate);
 }
 BENCHMARK(InterpolateCoupe3)->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(3.0);
+
+void ShadeCoupe3(benchmark::State& state) {
+  const Coupe3& c = coupe3();
+  Hairstyle style = c.config.hairstyle;
+  style.visualityStep = style.totalLength() / 63.0;
+  style.hairDensity = 150000.0 / (surfaceArea(c.wick) * 1e4);
+  const Strands coupe = interpolate(c.wick, grow(c.wick, style, c.config.collision, {}).guides, style, c.config.collision, {});
+  ShadeTimings total;
+  glm::ivec3 grid(0);
+  for (auto _ : state) {
+    state.PauseTiming();  // the copy `shade` takes: hairgen shade moves its coupe in
+    Strands input = coupe;
+    state.ResumeTiming();
+    ShadeResult r = shade(std::move(input), c.config.visuality, c.config.render, style.seed, "");
+    total.volume += r.timings.volume;
+    total.normals += r.timings.normals;
+    grid = r.volume.density.size;
+    benchmark::DoNotOptimize(r.coupe.normals.data());
+  }
+  const double n = double(state.iterations());
+  state.counters["strands"] = double(coupe.strandCount());
+  state.counters["vertices"] = double(coupe.pointCount());
+  state.counters["grid_x"] = grid.x;
+  state.counters["grid_y"] = grid.y;
+  state.counters["grid_z"] = grid.z;
+  state.counters["voxel_mm"] = c.config.render.voxelSize * 1000.0;
+  state.counters["volume_s"] = total.volume / n;
+  state.counters["normals_s"] = total.normals / n;
+}
+BENCHMARK(ShadeCoupe3)->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(3.0);
 
 void CantileverStyling(benchmark::State& state) {
   // 20,000 pores spread evenly over the upper head ellipsoid (a Fibonacci lattice), normals outward.
