@@ -2,6 +2,7 @@
 // per-strand ambient) into the cache.
 // hairgen shade --rest REST IN -o OUT: the rest pose's normals re-posed onto a deformed coupe.
 #include <filesystem>
+#include <iomanip>
 #include <sstream>
 
 #include "cli/commands.h"
@@ -27,7 +28,7 @@ ShadeResult shadeStage(const CommonOptions& common, const Config& config, Strand
   stats.counts()["shell_density"] = result.volume.iso;
   std::ostringstream line;
   line << "shade: " << grid.size.x << "×" << grid.size.y << "×" << grid.size.z << " grid of " << formatReal(grid.voxel * 1000)
-       << " mm voxels, shell at " << formatReal(result.volume.iso) << " points/voxel, normals on "
+       << " mm voxels, shell at " << std::setprecision(3) << result.volume.iso << std::setprecision(6) << " points/voxel, normals on "
        << shaded.pointCount() << " vertices in " << formatSeconds(result.timings.volume + result.timings.normals);
   if (wantsAmbient(config.visuality))
     line << "; per-strand ambient from N(" << formatReal(config.visuality.ambientMean) << ", "

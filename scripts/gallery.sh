@@ -1,13 +1,27 @@
 #!/usr/bin/env bash
-# Remakes the README gallery: docs/coupe1-4.png, docs/bob.png and docs/default.png, each `hairgen run` of a bundled
-# coupe at 320x320 with its own density. Look at them before committing.
+# Remakes the README gallery: docs/coupe1-4.png, docs/coupe3-volumetric.png, docs/bob.png and
+# docs/default.png, each `hairgen run` of a bundled coupe at 320x320 with its own density. Look at them
+# before committing.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/setup.sh
 mkdir -p docs
-for name in default thesis/coupe1 thesis/coupe2 thesis/coupe3 thesis/coupe4 anjyo/bob; do
-  out="build/gallery/$(basename "$name")"
-  ./build/hairgen run "configs/$name/setup.txt" -o "$out" --quiet --set "Render.Resolution=320 320"
-  cp "$out/beauty.png" "docs/$(basename "$name").png"
-  echo "gallery: docs/$(basename "$name").png" >&2
+# Each entry: the Setup's folder under configs/, the picture's name, and any --set for the run.
+entries=(
+  "default default"
+  "thesis/coupe1 coupe1"
+  "thesis/coupe2 coupe2"
+  "thesis/coupe3 coupe3"
+  "thesis/coupe3 coupe3-volumetric Render.ShadingModel=volumetric"
+  "thesis/coupe4 coupe4"
+  "anjyo/bob bob"
+)
+for entry in "${entries[@]}"; do
+  read -r name picture sets <<<"$entry"
+  out="build/gallery/$picture"
+  extra=()
+  for s in $sets; do extra+=(--set "$s"); done
+  ./build/hairgen run "configs/$name/setup.txt" -o "$out" --quiet --set "Render.Resolution=320 320" "${extra[@]}"
+  cp "$out/beauty.png" "docs/$picture.png"
+  echo "gallery: docs/$picture.png" >&2
 done

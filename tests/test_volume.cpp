@@ -104,6 +104,17 @@ TEST(Volume, Coupe3NormalsPointAwayFromTheHeadOnTheOutside) {
   EXPECT_GE(double(away) / outer, 0.95) << away << " of " << outer;
 }
 
+TEST(Volume, ReposingOntoTheRestPoseGivesTheRestNormals) {
+  Strands rest = coupe3().coupe;
+  rest.normals = volumeNormals(buildVolume(rest, 0.004, 3, 0.25).distance, rest);
+  Strands same = rest;
+  same.normals.clear();
+  std::vector<glm::vec3> reposed = reposeNormals(rest, same);
+  double worst = 0.0;
+  for (size_t i = 0; i < reposed.size(); ++i) worst = std::max(worst, double(glm::length(reposed[i] - rest.normals[i])));
+  EXPECT_LT(worst, 1e-6);
+}
+
 TEST(Volume, ReposingRestNormalsOnARotatedCoupeRotatesThem) {
   Strands rest = coupe3().coupe;
   rest.normals = volumeNormals(buildVolume(rest, 0.004, 3, 0.25).distance, rest);
