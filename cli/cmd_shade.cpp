@@ -27,8 +27,8 @@ ShadeResult shadeStage(const CommonOptions& common, const Config& config, Strand
   stats.counts()["voxel_size"] = grid.voxel;
   stats.counts()["shell_density"] = result.volume.iso;
   std::ostringstream line;
-  line << "shade: " << grid.size.x << "×" << grid.size.y << "×" << grid.size.z << " grid of " << formatReal(grid.voxel * 1000)
-       << " mm voxels, shell at " << std::setprecision(3) << result.volume.iso << std::setprecision(6) << " points/voxel, normals on "
+  line << "shade: " << grid.size.x << "×" << grid.size.y << "×" << grid.size.z << " grid (VoxelSize " << formatReal(grid.voxel)
+       << "), shell at " << std::setprecision(3) << result.volume.iso << std::setprecision(6) << " points/voxel, normals on "
        << shaded.pointCount() << " vertices in " << formatSeconds(result.timings.volume + result.timings.normals);
   if (wantsAmbient(config.visuality))
     line << "; per-strand ambient from N(" << formatReal(config.visuality.ambientMean) << ", "
@@ -92,7 +92,13 @@ void registerShade(CLI::App& app, int& exitCode) {
       Config config = loadStageConfig(options->first, options->common, SetupUse::kRender, stats);
       Strands coupe = readStrands(options->hair);
       stats.time("read", clock.lap());
-      ShadeResult shaded = shadeStage(options->common, config, std::move(coupe), stats);
+      ShadeResult shaded;
+      try {
+        shaded = shadeStage(options->common, config, std::move(coupe), stats);
+      } catch (const InputError& e) {  // what is wrong with the coupe, said of its file
+        if (!e.where().file.empty()) throw;
+        throw InputError({options->hair, 0}, e.message());
+      }
       clock.lap();
       // The volume first: if the coupe then cannot be written, the volume goes too (no partial output).
       if (!options->vdb.empty()) writeVdb(options->vdb, shaded.volume);

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <atomic>
+#include <cstdio>
 #include <limits>
 
 #include <tbb/blocked_range.h>
@@ -83,9 +84,13 @@ Grid gridAround(const std::vector<glm::vec3>& points, double voxel, int padding)
   g.voxel = voxel;
   g.origin = lo - double(padding) * voxel;
   glm::dvec3 cells = glm::ceil((hi - lo) / voxel) + 1.0 + 2.0 * padding;
-  if (cells.x * cells.y * cells.z > 4.0e8)
-    throw InputError("the volume would need " + std::to_string(int64_t(cells.x * cells.y * cells.z)) +
-                     " voxels; raise VoxelSize");
+  if (cells.x * cells.y * cells.z > 4.0e8) {
+    const glm::dvec3 span = hi - lo;
+    char text[160];
+    std::snprintf(text, sizeof text, "the hair spans %.3g x %.3g x %.3g, which at VoxelSize %.3g is %.3g voxels (4e8 at most)",
+                  span.x, span.y, span.z, voxel, cells.x * cells.y * cells.z);
+    throw InputError(std::string(text) + "; raise Render.VoxelSize, or check the cache is in metres");
+  }
   g.size = glm::ivec3(cells);
   g.values.assign(size_t(g.size.x) * g.size.y * g.size.z, 0.0f);
   return g;

@@ -246,7 +246,7 @@ RenderSettings readRender(const ConfigText& text, const std::vector<Override>& o
                                            : ShadingModel::kKajiyaKay;
   s.background = r.vec3("Background", s.background, Range::closed(0.0, 1e6));
   s.headColor = r.vec3("HeadColor", s.headColor, Range::closed(0.0, 1.0));
-  s.voxelSize = r.real("VoxelSize", s.voxelSize, {0.0, 1.0, true, false});
+  s.voxelSize = r.real("VoxelSize", s.voxelSize, {0.0, 1000.0, true, false});  // large for caches in cm or mm
   s.volumePadding = static_cast<int>(r.integer("VolumePadding", s.volumePadding, 1, 64));
   s.shellDensity = r.real("ShellDensity", s.shellDensity, {0.0, 100.0, true, false});
   s.volumetricBlend = r.real("VolumetricBlend", s.volumetricBlend, Range::closed(0.0, 1.0));
