@@ -39,21 +39,10 @@ double Grid::sample(const glm::dvec3& p) const {
   return trilinear<double>(*this, p, [&](int i, int j, int k) { return double(at(i, j, k)); });
 }
 
-glm::dvec3 Grid::gradient(const glm::dvec3& p) const {
-  // The trilinear interpolant of the nodes' central differences.
-  auto v = [&](int a, int b, int d) {
-    return double(at(std::clamp(a, 0, size.x - 1), std::clamp(b, 0, size.y - 1), std::clamp(d, 0, size.z - 1)));
-  };
-  return trilinear<glm::dvec3>(*this, p, [&](int i, int j, int k) {
-    return glm::dvec3(v(i + 1, j, k) - v(i - 1, j, k), v(i, j + 1, k) - v(i, j - 1, k), v(i, j, k + 1) - v(i, j, k - 1)) /
-           (2.0 * voxel);
-  });
-}
-
 namespace {
 
-// Grid::gradient's central differences at every node, computed once: the trilinear interpolant of
-// these is the same field at 8 lookups a point instead of 48.
+// Central differences at every node, computed once; the gradient at a point is their trilinear
+// interpolant (sampleGradient), 8 lookups.
 std::vector<glm::vec3> nodeGradients(const Grid& grid) {
   const glm::ivec3 n = grid.size;
   const float scale = float(1.0 / (2.0 * grid.voxel));

@@ -23,8 +23,6 @@ struct Grid {
   float at(int i, int j, int k) const { return values[index(i, j, k)]; }
   // Trilinear value at a world point (clamped to the grid).
   double sample(const glm::dvec3& p) const;
-  // Central-difference gradient, trilinearly interpolated at a world point.
-  glm::dvec3 gradient(const glm::dvec3& p) const;
 };
 
 // A grid around `points` with `padding` empty nodes on every side.
