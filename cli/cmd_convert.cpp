@@ -20,13 +20,11 @@ void registerConvert(CLI::App& app, int& exitCode) {
     exitCode = runCommand("convert", options->common, [&] {
       Stats stats("convert");
       hairFormatOf(options->output);  // reject a bad extension before reading anything
-      auto t0 = std::chrono::steady_clock::now();
+      Stopwatch clock;
       Strands strands = readStrands(options->input);
-      auto t1 = std::chrono::steady_clock::now();
+      stats.time("read", clock.lap());
       writeStrands(options->output, strands);
-      auto t2 = std::chrono::steady_clock::now();
-      stats.time("read", std::chrono::duration<double>(t1 - t0).count());
-      stats.time("write", std::chrono::duration<double>(t2 - t1).count());
+      stats.time("write", clock.lap());
       stats.counts()["strands"] = strands.strandCount();
       stats.counts()["points"] = strands.pointCount();
       note(options->common, "wrote " + options->output + " (" + std::to_string(strands.strandCount()) + " strands, " +

@@ -13,6 +13,7 @@
 #include "libcore/error.h"
 #include "libcore/params.h"
 #include "libcore/setup.h"
+#include "libcore/stopwatch.h"
 
 namespace hairgen::cli {
 
@@ -46,20 +47,6 @@ class Stats {
  private:
   std::chrono::steady_clock::time_point start_;
   nlohmann::ordered_json json_;
-};
-
-// Seconds since construction or the last lap.
-class Stopwatch {
- public:
-  double lap() {
-    auto now = std::chrono::steady_clock::now();
-    double s = std::chrono::duration<double>(now - last_).count();
-    last_ = now;
-    return s;
-  }
-
- private:
-  std::chrono::steady_clock::time_point last_ = std::chrono::steady_clock::now();
 };
 
 // "1.23 s"

@@ -108,14 +108,7 @@ void splat(Grid& d, const std::vector<glm::vec3>& points) {
         if (w[corner] > w[largest]) largest = corner;
       }
       w[largest] += int64_t(kOne) - total;
-      if (glm::all(glm::greaterThanEqual(c, glm::ivec3(0))) && glm::all(glm::lessThan(c + 1, size))) {
-        const size_t base = d.index(c.x, c.y, c.z), dy = size_t(size.x), dz = size_t(size.x) * size.y;
-        const size_t at[8] = {base, base + 1, base + dy, base + dy + 1, base + dz, base + dz + 1, base + dz + dy, base + dz + dy + 1};
-        for (int corner = 0; corner < 8; ++corner)
-          std::atomic_ref<int64_t>(sums[at[corner]]).fetch_add(w[corner], std::memory_order_relaxed);
-        continue;
-      }
-      for (int corner = 0; corner < 8; ++corner) {  // a point on the grid's edge: its outer corners fall away
+      for (int corner = 0; corner < 8; ++corner) {  // on the grid's edge, the outer corners fall away
         const glm::ivec3 n = c + glm::ivec3(corner & 1, (corner >> 1) & 1, corner >> 2);
         if (glm::any(glm::lessThan(n, glm::ivec3(0))) || glm::any(glm::greaterThanEqual(n, size))) continue;
         std::atomic_ref<int64_t>(sums[d.index(n.x, n.y, n.z)]).fetch_add(w[corner], std::memory_order_relaxed);

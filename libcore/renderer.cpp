@@ -13,7 +13,6 @@
 #include "libcore/renderer.h"
 
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 #include <stdexcept>
 
@@ -24,6 +23,7 @@
 
 #include "libcore/error.h"
 #include "libcore/gl_context.h"
+#include "libcore/stopwatch.h"
 
 namespace hairgen {
 
@@ -608,12 +608,10 @@ std::vector<int> ditherOrder(int k) {
   return order;
 }
 
-double seconds(std::chrono::steady_clock::time_point& last) {
+// A pass's time: the GPU's queue drained first, so the time is the pass's and not the next one's.
+double seconds(Stopwatch& clock) {
   glFinish();
-  auto now = std::chrono::steady_clock::now();
-  double s = std::chrono::duration<double>(now - last).count();
-  last = now;
-  return s;
+  return clock.lap();
 }
 
 }  // namespace
@@ -622,7 +620,7 @@ RenderOutput renderHair(GlContext&, const RenderInput& in) {
   const RenderSettings& r = in.settings;
   const Strands& hair = *in.hair;
   RenderOutput out;
-  auto clock = std::chrono::steady_clock::now();
+  Stopwatch clock;
   while (glGetError() != GL_NO_ERROR) {
   }
 

@@ -1,22 +1,15 @@
 #include "stages/shade.h"
 
-#include <chrono>
 #include <cmath>
 
 #include "libcore/error.h"
 #include "libcore/random.h"
+#include "libcore/stopwatch.h"
 
 namespace hairgen {
 namespace {
 
 constexpr uint64_t kAmbientKey = 0x616d6269656e74ull;  // "ambient": keeps these numbers apart from interpolate's
-
-double secondsSince(std::chrono::steady_clock::time_point& start) {
-  auto now = std::chrono::steady_clock::now();
-  double s = std::chrono::duration<double>(now - start).count();
-  start = now;
-  return s;
-}
 
 }  // namespace
 
@@ -30,9 +23,9 @@ double strandAmbient(uint64_t seed, uint32_t strandId, double mean, double devia
 ShadeResult shade(Strands coupe, const Visuality& visuality, const RenderSettings& render, uint64_t seed,
                   const std::string& configDigest) {
   ShadeResult result;
-  auto clock = std::chrono::steady_clock::now();
+  Stopwatch clock;
   result.volume = buildVolume(coupe, render.voxelSize, render.volumePadding, render.shellDensity);
-  result.timings.volume = secondsSince(clock);
+  result.timings.volume = clock.lap();
   Strands& out = result.coupe;
   out = std::move(coupe);
   out.normals = volumeNormals(result.volume.distance, out);
@@ -45,7 +38,7 @@ ShadeResult shade(Strands coupe, const Visuality& visuality, const RenderSetting
     }
   }
   out.provenance = {"hairgen " HAIRGEN_VERSION, "shade", seed, configDigest};
-  result.timings.normals = secondsSince(clock);
+  result.timings.normals = clock.lap();
   return result;
 }
 
