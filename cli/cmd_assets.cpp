@@ -1,7 +1,7 @@
 // hairgen assets -o DIR: regenerate the bundled head and wick meshes from their generator.
 #include "cli/commands.h"
 #include "cli/common.h"
-#include "libcore/head_generator.h"
+#include "libcore/assets/head_generator.h"
 
 namespace hairgen::cli {
 

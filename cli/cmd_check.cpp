@@ -3,8 +3,8 @@
 
 #include "cli/commands.h"
 #include "cli/common.h"
-#include "libcore/obj_io.h"
-#include "libcore/setup.h"
+#include "libcore/io/obj_io.h"
+#include "libcore/config/setup.h"
 
 namespace hairgen::cli {
 

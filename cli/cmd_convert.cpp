@@ -1,7 +1,7 @@
 // hairgen convert IN OUT: between .hair, .gltf and .glb, keeping every attribute both formats carry.
 #include "cli/commands.h"
 #include "cli/common.h"
-#include "libcore/hair_cache.h"
+#include "libcore/io/hair_cache.h"
 
 namespace hairgen::cli {
 

@@ -8,8 +8,8 @@
 
 #include "cli/commands.h"
 #include "cli/common.h"
-#include "libcore/error.h"
-#include "libcore/exr_io.h"
+#include "libcore/util/error.h"
+#include "libcore/io/exr_io.h"
 
 namespace hairgen::cli {
 namespace {

@@ -1,10 +1,10 @@
 // hairgen grow SETUP -o guides.{hair,gltf,glb}: one Super-Helix guide per wick vertex.
 #include "cli/commands.h"
 #include "cli/common.h"
-#include "libcore/file_util.h"
-#include "libcore/hair_cache.h"
-#include "libcore/obj_io.h"
-#include "libcore/setup.h"
+#include "libcore/util/file_util.h"
+#include "libcore/io/hair_cache.h"
+#include "libcore/io/obj_io.h"
+#include "libcore/config/setup.h"
 #include "stages/grow.h"
 
 namespace hairgen::cli {

@@ -3,7 +3,7 @@
 
 #include "cli/commands.h"
 #include "cli/common.h"
-#include "libcore/info.h"
+#include "libcore/io/info.h"
 
 namespace hairgen::cli {
 

@@ -1,10 +1,10 @@
 // hairgen interpolate SETUP --guides FILE -o coupe.{hair,gltf,glb}: the full coupe from the guides.
 #include "cli/commands.h"
 #include "cli/common.h"
-#include "libcore/hair_cache.h"
-#include "libcore/obj_io.h"
-#include "libcore/setup.h"
-#include "libcore/text.h"
+#include "libcore/io/hair_cache.h"
+#include "libcore/io/obj_io.h"
+#include "libcore/config/setup.h"
+#include "libcore/util/text.h"
 #include "stages/interpolate.h"
 
 namespace hairgen::cli {

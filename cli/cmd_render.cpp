@@ -5,13 +5,13 @@
 
 #include "cli/commands.h"
 #include "cli/common.h"
-#include "libcore/error.h"
-#include "libcore/exr_io.h"
-#include "libcore/gl_context.h"
-#include "libcore/hair_cache.h"
-#include "libcore/obj_io.h"
-#include "libcore/setup.h"
-#include "libcore/text.h"
+#include "libcore/util/error.h"
+#include "libcore/io/exr_io.h"
+#include "libcore/render/gl_context.h"
+#include "libcore/io/hair_cache.h"
+#include "libcore/io/obj_io.h"
+#include "libcore/config/setup.h"
+#include "libcore/util/text.h"
 
 namespace hairgen::cli {
 namespace {

@@ -7,10 +7,10 @@
 
 #include "cli/commands.h"
 #include "cli/common.h"
-#include "libcore/error.h"
-#include "libcore/hair_cache.h"
-#include "libcore/obj_io.h"
-#include "libcore/setup.h"
+#include "libcore/util/error.h"
+#include "libcore/io/hair_cache.h"
+#include "libcore/io/obj_io.h"
+#include "libcore/config/setup.h"
 #include "stages/shade.h"
 
 namespace hairgen::cli {

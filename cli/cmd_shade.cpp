@@ -7,10 +7,10 @@
 
 #include "cli/commands.h"
 #include "cli/common.h"
-#include "libcore/hair_cache.h"
-#include "libcore/setup.h"
-#include "libcore/text.h"
-#include "libcore/vdb_io.h"
+#include "libcore/io/hair_cache.h"
+#include "libcore/config/setup.h"
+#include "libcore/util/text.h"
+#include "libcore/io/vdb_io.h"
 #include "stages/shade.h"
 
 namespace hairgen::cli {

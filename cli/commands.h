@@ -8,10 +8,10 @@
 #include <CLI/CLI.hpp>
 
 #include "cli/common.h"
-#include "libcore/mesh.h"
-#include "libcore/params.h"
-#include "libcore/strands.h"
-#include "libcore/renderer.h"
+#include "libcore/model/mesh.h"
+#include "libcore/config/params.h"
+#include "libcore/model/strands.h"
+#include "libcore/render/renderer.h"
 #include "stages/grow.h"
 #include "stages/shade.h"
 

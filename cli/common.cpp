@@ -6,9 +6,9 @@
 #include <tbb/global_control.h>
 #include <tbb/info.h>
 
-#include "libcore/config.h"
-#include "libcore/error.h"
-#include "libcore/file_util.h"
+#include "libcore/config/config.h"
+#include "libcore/util/error.h"
+#include "libcore/util/file_util.h"
 
 namespace hairgen::cli {
 

@@ -10,10 +10,10 @@
 #include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
 
-#include "libcore/error.h"
-#include "libcore/params.h"
-#include "libcore/setup.h"
-#include "libcore/stopwatch.h"
+#include "libcore/util/error.h"
+#include "libcore/config/params.h"
+#include "libcore/config/setup.h"
+#include "libcore/util/stopwatch.h"
 
 namespace hairgen::cli {
 

@@ -5,7 +5,7 @@
 
 #include <tbb/parallel_for.h>
 
-#include "libcore/error.h"
+#include "libcore/util/error.h"
 
 namespace hairgen {
 namespace {

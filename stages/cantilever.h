@@ -8,8 +8,8 @@
 
 #include <glm/glm.hpp>
 
-#include "libcore/mesh.h"
-#include "libcore/params.h"
+#include "libcore/model/mesh.h"
+#include "libcore/config/params.h"
 #include "stages/grow.h"
 
 namespace hairgen {

@@ -6,7 +6,7 @@
 
 #include <tbb/parallel_for.h>
 
-#include "libcore/error.h"
+#include "libcore/util/error.h"
 #include "stages/cantilever.h"
 
 namespace hairgen {

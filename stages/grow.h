@@ -5,12 +5,12 @@
 #include <string>
 #include <vector>
 
-#include "libcore/mesh.h"
-#include "libcore/params.h"
-#include "libcore/progress.h"
-#include "libcore/rosenbrock.h"
-#include "libcore/strand_energy.h"
-#include "libcore/strands.h"
+#include "libcore/model/mesh.h"
+#include "libcore/config/params.h"
+#include "libcore/util/progress.h"
+#include "libcore/physics/rosenbrock.h"
+#include "libcore/physics/strand_energy.h"
+#include "libcore/model/strands.h"
 
 namespace hairgen {
 

@@ -10,8 +10,8 @@
 
 #include <tbb/parallel_for.h>
 
-#include "libcore/error.h"
-#include "libcore/random.h"
+#include "libcore/util/error.h"
+#include "libcore/util/random.h"
 
 namespace hairgen {
 namespace {

@@ -8,10 +8,10 @@
 
 #include <glm/glm.hpp>
 
-#include "libcore/mesh.h"
-#include "libcore/params.h"
-#include "libcore/progress.h"
-#include "libcore/strands.h"
+#include "libcore/model/mesh.h"
+#include "libcore/config/params.h"
+#include "libcore/util/progress.h"
+#include "libcore/model/strands.h"
 
 namespace hairgen {
 

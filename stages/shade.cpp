@@ -2,9 +2,10 @@
 
 #include <cmath>
 
-#include "libcore/error.h"
-#include "libcore/random.h"
-#include "libcore/stopwatch.h"
+#include "libcore/util/error.h"
+#include "libcore/util/random.h"
+#include "libcore/model/strand_frames.h"
+#include "libcore/util/stopwatch.h"
 
 namespace hairgen {
 namespace {

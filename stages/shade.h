@@ -13,9 +13,9 @@
 #include <cstdint>
 #include <string>
 
-#include "libcore/hair_volume.h"
-#include "libcore/params.h"
-#include "libcore/strands.h"
+#include "libcore/volume/hair_volume.h"
+#include "libcore/config/params.h"
+#include "libcore/model/strands.h"
 
 namespace hairgen {
 

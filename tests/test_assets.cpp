@@ -3,9 +3,9 @@
 
 #include <sstream>
 
-#include "libcore/file_util.h"
-#include "libcore/head_generator.h"
-#include "libcore/obj_io.h"
+#include "libcore/util/file_util.h"
+#include "libcore/assets/head_generator.h"
+#include "libcore/io/obj_io.h"
 #include "tests/test_util.h"
 
 namespace hairgen {

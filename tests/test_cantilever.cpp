@@ -3,8 +3,8 @@
 
 #include <cmath>
 
-#include "libcore/obj_io.h"
-#include "libcore/setup.h"
+#include "libcore/io/obj_io.h"
+#include "libcore/config/setup.h"
 #include "stages/cantilever.h"
 #include "stages/shade.h"
 #include "tests/test_util.h"

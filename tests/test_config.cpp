@@ -4,7 +4,7 @@
 
 #include <fstream>
 
-#include "libcore/setup.h"
+#include "libcore/config/setup.h"
 #include "tests/test_util.h"
 
 namespace hairgen {

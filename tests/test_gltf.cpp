@@ -1,10 +1,10 @@
 // glTF caches: round trips through .glb and .gltf, and files hairgen must refuse.
 #include <gtest/gtest.h>
 
-#include "libcore/error.h"
-#include "libcore/file_util.h"
-#include "libcore/gltf_io.h"
-#include "libcore/hair_io.h"
+#include "libcore/util/error.h"
+#include "libcore/util/file_util.h"
+#include "libcore/io/gltf_io.h"
+#include "libcore/io/hair_io.h"
 #include "tests/test_util.h"
 
 namespace hairgen {

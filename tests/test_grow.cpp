@@ -3,9 +3,9 @@
 
 #include <tbb/global_control.h>
 
-#include "libcore/error.h"
-#include "libcore/obj_io.h"
-#include "libcore/setup.h"
+#include "libcore/util/error.h"
+#include "libcore/io/obj_io.h"
+#include "libcore/config/setup.h"
 #include "stages/grow.h"
 #include "tests/test_util.h"
 

@@ -8,10 +8,10 @@
 
 #include <tbb/global_control.h>
 
-#include "libcore/error.h"
-#include "libcore/obj_io.h"
-#include "libcore/random.h"
-#include "libcore/setup.h"
+#include "libcore/util/error.h"
+#include "libcore/io/obj_io.h"
+#include "libcore/util/random.h"
+#include "libcore/config/setup.h"
 #include "stages/grow.h"
 #include "stages/interpolate.h"
 #include "tests/test_util.h"

@@ -6,11 +6,11 @@
 #include <random>
 #include <sstream>
 
-#include "libcore/error.h"
-#include "libcore/gltf_io.h"
-#include "libcore/hair_io.h"
-#include "libcore/obj_io.h"
-#include "libcore/setup.h"
+#include "libcore/util/error.h"
+#include "libcore/io/gltf_io.h"
+#include "libcore/io/hair_io.h"
+#include "libcore/io/obj_io.h"
+#include "libcore/config/setup.h"
 #include "tests/test_util.h"
 
 namespace hairgen {

@@ -3,8 +3,8 @@
 
 #include <sstream>
 
-#include "libcore/error.h"
-#include "libcore/obj_io.h"
+#include "libcore/util/error.h"
+#include "libcore/io/obj_io.h"
 #include "tests/test_util.h"
 
 namespace hairgen {

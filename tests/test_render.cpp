@@ -2,9 +2,9 @@
 // between strands and onto the head, the background's AOVs, and what supersampling changes.
 #include <gtest/gtest.h>
 
-#include "libcore/gl_context.h"
-#include "libcore/renderer.h"
-#include "libcore/shading.h"
+#include "libcore/render/gl_context.h"
+#include "libcore/render/renderer.h"
+#include "libcore/render/shading.h"
 
 namespace hairgen {
 namespace {

@@ -3,7 +3,7 @@
 
 #include <cmath>
 
-#include "libcore/rosenbrock.h"
+#include "libcore/physics/rosenbrock.h"
 
 namespace hairgen {
 namespace {

@@ -5,8 +5,8 @@
 
 #include <glm/gtc/matrix_transform.hpp>
 
-#include "libcore/strand_energy.h"
-#include "libcore/super_helix.h"
+#include "libcore/physics/strand_energy.h"
+#include "libcore/physics/super_helix.h"
 
 namespace hairgen {
 namespace {

@@ -7,10 +7,10 @@
 #include <random>
 #include <string>
 
-#include "libcore/config.h"
-#include "libcore/obj_io.h"
-#include "libcore/setup.h"
-#include "libcore/strands.h"
+#include "libcore/config/config.h"
+#include "libcore/io/obj_io.h"
+#include "libcore/config/setup.h"
+#include "libcore/model/strands.h"
 
 namespace hairgen::test {
 

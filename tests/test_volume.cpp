@@ -7,9 +7,10 @@
 
 #include <glm/gtc/matrix_transform.hpp>
 
-#include "libcore/hair_volume.h"
-#include "libcore/obj_io.h"
-#include "libcore/setup.h"
+#include "libcore/volume/hair_volume.h"
+#include "libcore/model/strand_frames.h"
+#include "libcore/io/obj_io.h"
+#include "libcore/config/setup.h"
 #include "stages/grow.h"
 #include "stages/interpolate.h"
 #include "tests/test_util.h"

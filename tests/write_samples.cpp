@@ -1,7 +1,7 @@
 // Writes .glb and .gltf files covering every attribute hairgen stores, for the Khronos validator test.
 #include <iostream>
 
-#include "libcore/gltf_io.h"
+#include "libcore/io/gltf_io.h"
 #include "tests/test_util.h"
 
 int main(int argc, char** argv) {

@@ -15,14 +15,14 @@
 #include <tbb/global_control.h>
 #include <tbb/info.h>
 
-#include "libcore/obj_io.h"
-#include "libcore/setup.h"
+#include "libcore/io/obj_io.h"
+#include "libcore/config/setup.h"
 #include "stages/cantilever.h"
 #include "stages/grow.h"
 #include "stages/interpolate.h"
 #include "stages/shade.h"
-#include "libcore/gl_context.h"
-#include "libcore/renderer.h"
+#include "libcore/render/gl_context.h"
+#include "libcore/render/renderer.h"
 
 namespace hairgen {
 namespace {

@@ -1,0 +1,170 @@
+// The parameters of hairgen's four thesis config files plus Render Info (DESIGN §4), as plain structs
+// with defaults and units. Defaults are physically measured values (thesis Tables 1-3) wherever the
+// thesis' example files carry something else, so a file that omits a key gets real hair.
+#pragma once
+
+#include <cstdint>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include "libcore/util/error.h"
+
+namespace hairgen {
+
+enum class StylingModel { kSuperHelix, kCantilever };
+enum class ShadingModel { kKajiyaKay, kThesis, kAnjyo, kVolumetric };
+
+const char* name(StylingModel model);
+const char* name(ShadingModel model);
+
+// Anjyo's styling extras (Hairstyle Info, repeatable lines). A force field adds an acceleration
+// (m/s², like Gravity) to the segments whose start node lies in its region.
+struct ForceField {
+  enum class Region { kAll, kAbove, kBelow, kSide, kBox };
+  glm::dvec3 acceleration{0.0};
+  Region region = Region::kAll;
+  double level = 0.0;          // kAbove / kBelow: a height, metres
+  glm::dvec3 side{0.0};        // kSide: a unit axis (±x or ±z); the region is where p·side > 0
+  glm::dvec3 lo{0.0}, hi{0.0}; // kBox
+  FileLoc where;
+  bool contains(const glm::dvec3& p) const;
+};
+
+// A cut: for pores whose azimuth (degrees from the face, +z, toward +x) lies in [azimuthFrom,
+// azimuthTo] and whose zenith (degrees from the top) is at most zenithMax, on the head ellipsoid's
+// polar coordinates, the hair ends at its first node below `height` (metres).
+struct HairCut {
+  double azimuthFrom = 0.0, azimuthTo = 0.0, zenithMax = 0.0, height = 0.0;
+  FileLoc where;
+};
+
+// Hairstyle Info: the mechanics of one hair and the density of the coupe.
+struct Hairstyle {
+  double visualityStep = 0.0025;    // metres of arc length between output vertices
+  double collisionStep = 0.005;     // metres of arc length between collision samples
+  int maxIter = 20;                 // Rosenbrock stages at most
+  double epsilon = 1.0e-4;          // stop when a stage lowers the energy by less (relative)
+  std::vector<double> hairLengths;  // metres, one per Super-Helix element; required
+  double hairDensity = 100.0;       // strands per square centimetre of wick
+  double hairRadius1 = 35.0e-6;     // metres, semi-axis a of the elliptic cross-section (Table 1)
+  double hairRadius2 = 34.5e-6;     // metres, semi-axis b = a·sqrt(1 − e²), e = 0.17 (Table 1)
+  double helixRadius = 0.0;         // metres, r_h of the rest helix; 0 = straight (Table 2, smooth)
+  double helixStep = 0.0;           // metres, Δ_h, the rise per turn of the rest helix
+  double poisson = 0.48;            // σ, dimensionless (Table 1)
+  double young = 2.0e9;             // E, pascals (Table 1, Caucasian)
+  double density = 1300.0;          // ρ, kilograms per cubic metre (Table 3)
+  double gravity = 9.81;            // g, newtons per kilogram (Table 3)
+  StylingModel model = StylingModel::kSuperHelix;
+  double clump = 0.25;              // tip weights v1, v2 drawn in [0, Clump): 0 gathers tips at the nearest guide
+  bool strayHairs = true;           // true = the thesis' barycentric assignment (§4.1.4.4)
+  uint64_t seed = 0;                // keys every random number; --seed overrides it
+  // Model cantilever (Anjyo et al. 1992):
+  int segments = 20;                // equal segments per hair, over the whole of HairLengths
+  double flexuralRigidity = 0.0;    // E·I in N·m²; 0 = Young × π a b³/4
+  double jointLimit = 180.0;        // degrees: the largest turn between consecutive segments
+  int jointLimitFrom = 1;           // the first node (1 = the first after the pore) the limit applies to
+  std::vector<ForceField> forces;
+  std::vector<HairCut> cuts;
+
+  double totalLength() const;       // metres
+};
+
+enum class ShapeKind { kSphere, kEllipsoid, kCuboid };
+const char* name(ShapeKind kind);
+
+// One collision body of Collision Info.
+struct CollisionShape {
+  ShapeKind kind = ShapeKind::kSphere;
+  double volume = 0.0;              // metres: envelope growth from the lowest to the highest follicle
+  double penalty = 0.0;             // k of the penalty ½k·max(dent + extra, 0)²
+  glm::dvec3 centre{0.0};           // metres
+  glm::dvec3 halfExtents{0.0};      // metres: radius, semi-axes or half-extents along `axes`
+  glm::dmat3 axes{1.0};             // columns: the body's unit axes (orthonormalised on read)
+  FileLoc where;                    // the config line it came from
+};
+
+struct Collision {
+  std::vector<CollisionShape> shapes;
+};
+
+// Visuality Info: Kajiya-Kay reflectance.
+struct Visuality {
+  glm::dvec3 ambientColor{0.10, 0.10, 0.10};
+  glm::dvec3 diffuseColor{0.45, 0.25, 0.00};
+  glm::dvec3 specularColor{0.20, 0.20, 0.20};
+  double glossiness = 60.0;  // specular exponent p
+  // `hairgen shade`: a per-strand coefficient a ~ N(AmbientMean, AmbientDeviation), clamped at 0,
+  // multiplies the strand's colour (stored per vertex in the cache).
+  double ambientMean = 1.0, ambientDeviation = 0.0;
+};
+
+// Render Info (new in hairgen): camera, light and film.
+struct RenderSettings {
+  glm::ivec2 resolution{640, 640};            // pixels
+  glm::dvec3 cameraPosition{0.32, 0.16, 0.52}; // metres; frames the bundled head from front-right
+  glm::dvec3 cameraTarget{0.0, 0.03, 0.0};
+  glm::dvec3 cameraUp{0.0, 1.0, 0.0};
+  double fieldOfView = 38.0;                  // degrees, vertical
+  glm::dvec3 lightPosition{0.6, 1.0, 0.8};    // metres
+  glm::dvec3 lightColor{1.0, 1.0, 1.0};
+  double ambientIntensity = 0.2;
+  int samples = 4;                            // antialiasing sub-pixels per pixel (k² for k×k)
+  glm::dvec4 layerSizes{0.002, 0.006, 0.015, 0.04};  // metres: the 4 deep-opacity layer depths
+  double strandOpacity = 0.7;                 // opacity of one strand, 0-1
+  double strandWidth = 8.0e-5;                // metres, on-screen diameter of a strand
+  ShadingModel shadingModel = ShadingModel::kKajiyaKay;
+  glm::dvec3 background{0.18, 0.18, 0.20};
+  glm::dvec3 headColor{0.72, 0.55, 0.45};     // Lambert albedo of the head
+  // The volumetric model (Petrovic et al. 2005): `hairgen shade` builds the hair's density grid and
+  // shell from these, and `ShadingModel volumetric` mixes its shading with Kajiya-Kay by the blend.
+  double voxelSize = 0.004;     // metres, the density grid's spacing
+  int volumePadding = 3;        // empty voxels around the hair on every side
+  double shellDensity = 0.25;   // the shell's density, as a fraction of the density at a typical hair point
+  double volumetricBlend = 1.0; // 0 = Kajiya-Kay, 1 = volumetric
+};
+
+// A path named by a config file, with where it was named (for "missing file" errors).
+struct PathRef {
+  std::filesystem::path path;  // resolved against the naming file's directory
+  FileLoc where;
+  bool given() const { return !path.empty(); }
+};
+
+// Setup: which files make up a job.
+struct Setup {
+  std::filesystem::path file;  // the setup file itself
+  bool load = false;           // read the coupe from loadFile instead of growing it
+  bool save = false;           // write the coupe to saveFile
+  PathRef loadFile, saveFile;
+  PathRef hairstyleInfo, collisionInfo, visualityInfo, renderInfo;
+  PathRef wickModel, headModel;
+  PathRef hairVert, hairFrag, headVert, headFrag;  // optional GLSL overrides
+};
+
+// A command-line override `--set Section.Key=VALUE`.
+struct Override {
+  std::string section;  // canonical: Setup, Hairstyle, Collision, Visuality, Render
+  std::string key;      // as written
+  std::vector<std::string> values;
+  std::string text;     // the argument as given
+};
+
+// Everything a job reads, after overrides.
+struct Config {
+  Setup setup;
+  Hairstyle hairstyle;
+  Collision collision;
+  Visuality visuality;
+  RenderSettings render;
+  std::vector<Override> overrides;  // as applied, for --stats
+
+  // Canonical text of every value that shapes the output (not the paths), one `Section.Key value` a
+  // line; and its 64-bit FNV-1a digest in hex. Two configs with equal digests give equal output.
+  std::string canonicalText() const;
+  std::string digest() const;
+};
+
+}  // namespace hairgen

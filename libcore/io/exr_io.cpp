@@ -1,0 +1,112 @@
+#include "libcore/io/exr_io.h"
+
+#include <cmath>
+
+#include <ImathMatrix.h>
+#include <OpenEXR/ImfChannelList.h>
+#include <OpenEXR/ImfFrameBuffer.h>
+#include <OpenEXR/ImfHeader.h>
+#include <OpenEXR/ImfMatrixAttribute.h>
+#include <OpenEXR/ImfOutputFile.h>
+#include <OpenEXR/ImfStandardAttributes.h>
+#include <OpenEXR/ImfStringAttribute.h>
+#include <OpenImageIO/imageio.h>
+#include <half.h>
+
+#include "libcore/util/error.h"
+#include "libcore/util/file_util.h"
+
+namespace hairgen {
+namespace {
+
+namespace fs = std::filesystem;
+
+Imath::M44f toImath(const glm::dmat4& m) {
+  // glm is column-major with column vectors; Imath uses row vectors (p' = p M), so M = transpose.
+  Imath::M44f r;
+  for (int row = 0; row < 4; ++row)
+    for (int col = 0; col < 4; ++col) r[row][col] = static_cast<float>(m[row][col]);
+  return r;
+}
+
+bool isHalf(const std::string& c) { return c == "R" || c == "G" || c == "B" || c == "A"; }
+
+}  // namespace
+
+void writeExr(const fs::path& file, const Image& image, const ExrMetadata& metadata) {
+  Imf::Header header(image.width, image.height);
+  header.compression() = Imf::ZIP_COMPRESSION;
+  for (const auto& [key, value] : metadata.strings) header.insert(key, Imf::StringAttribute(value));
+  if (metadata.camera) {
+    Imf::addWorldToCamera(header, toImath(metadata.worldToCamera));
+    Imf::addWorldToNDC(header, toImath(metadata.worldToNdc));
+  }
+  std::vector<std::vector<half>> halves(image.channels.size());
+  Imf::FrameBuffer frame;
+  for (size_t c = 0; c < image.channels.size(); ++c) {
+    const std::string& name = image.channels[c];
+    if (isHalf(name)) {
+      header.channels().insert(name, Imf::Channel(Imf::HALF));
+      halves[c].assign(image.planes[c].begin(), image.planes[c].end());
+      frame.insert(name, Imf::Slice(Imf::HALF, reinterpret_cast<char*>(halves[c].data()), sizeof(half),
+                                    sizeof(half) * image.width));
+    } else {
+      header.channels().insert(name, Imf::Channel(Imf::FLOAT));
+      frame.insert(name, Imf::Slice(Imf::FLOAT, reinterpret_cast<char*>(const_cast<float*>(image.planes[c].data())),
+                                    sizeof(float), sizeof(float) * image.width));
+    }
+  }
+  writeThroughTemporary(file, [&](const fs::path& temporary) {
+    try {
+      Imf::OutputFile out(temporary.c_str(), header);
+      out.setFrameBuffer(frame);
+      out.writePixels(image.height);
+    } catch (const std::exception& e) {
+      throw IoError("cannot write " + file.string() + ": " + e.what());
+    }
+  });
+}
+
+Image readImage(const fs::path& file) {
+  auto in = OIIO::ImageInput::open(file.string());
+  if (!in) throw InputError({file.string(), 0}, "cannot read image: " + OIIO::geterror());
+  const OIIO::ImageSpec& spec = in->spec();
+  Image image;
+  image.width = spec.width;
+  image.height = spec.height;
+  const size_t pixels = size_t(spec.width) * spec.height;
+  std::vector<float> interleaved(pixels * spec.nchannels);
+  if (!in->read_image(0, 0, 0, spec.nchannels, OIIO::TypeDesc::FLOAT, interleaved.data()))
+    throw InputError({file.string(), 0}, "cannot read image: " + in->geterror());
+  for (int c = 0; c < spec.nchannels; ++c) {
+    image.channels.push_back(spec.channelnames[c]);
+    std::vector<float> plane(pixels);
+    for (size_t i = 0; i < pixels; ++i) plane[i] = interleaved[i * spec.nchannels + c];
+    image.planes.push_back(std::move(plane));
+  }
+  return image;
+}
+
+void writePreview(const fs::path& file, const Image& image) {
+  const size_t pixels = size_t(image.width) * image.height;
+  std::vector<unsigned char> rgb(pixels * 3);
+  const char* names[3] = {"R", "G", "B"};
+  for (int c = 0; c < 3; ++c) {
+    const std::vector<float>& plane = image.plane(names[c]);
+    for (size_t i = 0; i < pixels; ++i) {
+      double v = std::clamp(double(plane[i]), 0.0, 1.0);
+      double srgb = v <= 0.0031308 ? 12.92 * v : 1.055 * std::pow(v, 1.0 / 2.4) - 0.055;
+      rgb[i * 3 + c] = static_cast<unsigned char>(std::lround(srgb * 255.0));
+    }
+  }
+  auto out = OIIO::ImageOutput::create(file.string());
+  if (!out) throw IoError("cannot write " + file.string() + ": " + OIIO::geterror());
+  OIIO::ImageSpec spec(image.width, image.height, 3, OIIO::TypeDesc::UINT8);
+  spec.attribute("Software", "hairgen " HAIRGEN_VERSION);
+  writeThroughTemporary(file, [&](const fs::path& temporary) {
+    if (!out->open(temporary.string(), spec) || !out->write_image(OIIO::TypeDesc::UINT8, rgb.data()) || !out->close())
+      throw IoError("cannot write " + file.string() + ": " + out->geterror());
+  });
+}
+
+}  // namespace hairgen

@@ -1,0 +1,29 @@
+// OpenEXR output (DESIGN §6): one part; R G B A as half, every other channel as float; producer,
+// config digest and camera in the header. Written beside the target and renamed into place.
+#pragma once
+
+#include <filesystem>
+#include <map>
+#include <string>
+
+#include <glm/glm.hpp>
+
+#include "libcore/render/renderer.h"
+
+namespace hairgen {
+
+struct ExrMetadata {
+  std::map<std::string, std::string> strings;  // e.g. "producer", "hairgen:configDigest"
+  glm::dmat4 worldToCamera{1.0}, worldToNdc{1.0};
+  bool camera = false;                         // write worldToCamera / worldToNDC
+};
+
+void writeExr(const std::filesystem::path& file, const Image& image, const ExrMetadata& metadata);
+
+// Any image OpenImageIO reads, every channel as float. Throws InputError naming the file.
+Image readImage(const std::filesystem::path& file);
+
+// A tone-mapped 8-bit sRGB PNG of R G B (clamped to [0, 1]) for people to look at.
+void writePreview(const std::filesystem::path& file, const Image& image);
+
+}  // namespace hairgen

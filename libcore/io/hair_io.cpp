@@ -1,0 +1,310 @@
+#include "libcore/io/hair_io.h"
+
+#include <cstring>
+#include <limits>
+
+#include <zlib.h>
+
+#include "libcore/util/error.h"
+#include "libcore/util/file_util.h"
+
+namespace hairgen {
+namespace {
+
+constexpr uint32_t kSegments = 1, kPoints = 2, kThickness = 4, kTransparency = 8, kColor = 16;
+constexpr size_t kHeaderSize = 128, kInfoSize = 88;
+constexpr uint32_t kBlockVersion = 1;
+
+class Writer {
+ public:
+  void bytes(const void* p, size_t n) {
+    const uint8_t* b = static_cast<const uint8_t*>(p);
+    out.insert(out.end(), b, b + n);
+  }
+  void u16(uint16_t v) { uint8_t b[2] = {uint8_t(v), uint8_t(v >> 8)}; bytes(b, 2); }
+  void u32(uint32_t v) {
+    uint8_t b[4];
+    for (int i = 0; i < 4; ++i) b[i] = uint8_t(v >> (8 * i));
+    bytes(b, 4);
+  }
+  void u64(uint64_t v) {
+    u32(uint32_t(v));
+    u32(uint32_t(v >> 32));
+  }
+  void f32(float v) {
+    uint32_t bits;
+    std::memcpy(&bits, &v, 4);
+    u32(bits);
+  }
+  void vec(const glm::vec3& v) { f32(v.x); f32(v.y); f32(v.z); }
+  std::vector<uint8_t> out;
+};
+
+class Reader {
+ public:
+  Reader(const uint8_t* data, size_t size, const std::string& name) : data_(data), size_(size), name_(name) {}
+  size_t remaining() const { return size_ - pos_; }
+  size_t position() const { return pos_; }
+  void need(uint64_t n, const std::string& what) const {
+    if (n > remaining())
+      throw InputError({name_, 0}, "truncated: " + what + " needs " + std::to_string(n) + " bytes at offset " +
+                                       std::to_string(pos_) + " but only " + std::to_string(remaining()) + " remain");
+  }
+  const uint8_t* take(size_t n) {
+    const uint8_t* p = data_ + pos_;
+    pos_ += n;
+    return p;
+  }
+  uint16_t u16() { const uint8_t* b = take(2); return uint16_t(b[0] | b[1] << 8); }
+  uint32_t u32() {
+    const uint8_t* b = take(4);
+    return uint32_t(b[0]) | uint32_t(b[1]) << 8 | uint32_t(b[2]) << 16 | uint32_t(b[3]) << 24;
+  }
+  uint64_t u64() {
+    uint64_t lo = u32();
+    return lo | uint64_t(u32()) << 32;
+  }
+  float f32() {
+    uint32_t bits = u32();
+    float v;
+    std::memcpy(&v, &bits, 4);
+    return v;
+  }
+  glm::vec3 vec() {
+    float x = f32(), y = f32();
+    return {x, y, f32()};
+  }
+
+ private:
+  const uint8_t* data_;
+  size_t size_;
+  size_t pos_ = 0;
+  const std::string& name_;
+};
+
+void chunk(Writer& w, const char tag[4], const std::vector<uint8_t>& payload) {
+  Writer head;
+  head.bytes(tag, 4);
+  head.u64(payload.size());
+  uLong crc = crc32(0L, head.out.data(), static_cast<uInt>(head.out.size()));
+  crc = crc32_z(crc, payload.data(), payload.size());
+  w.bytes(head.out.data(), head.out.size());
+  w.bytes(payload.data(), payload.size());
+  w.u32(static_cast<uint32_t>(crc));
+}
+
+template <typename Fn>
+std::vector<uint8_t> payload(Fn fill) {
+  Writer w;
+  fill(w);
+  return std::move(w.out);
+}
+
+std::string provenanceText(const Provenance& p) {
+  return "producer=" + p.producer + "\nstage=" + p.stage + "\nseed=" + std::to_string(p.seed) +
+         "\nconfig=" + p.configDigest + "\n";
+}
+
+Provenance parseProvenance(const std::string& text, const std::string& name) {
+  Provenance p;
+  size_t pos = 0;
+  while (pos < text.size()) {
+    size_t end = text.find('\n', pos);
+    if (end == std::string::npos) end = text.size();
+    std::string line = text.substr(pos, end - pos);
+    pos = end + 1;
+    size_t eq = line.find('=');
+    if (eq == std::string::npos) throw InputError({name, 0}, "PROV chunk: line without '='");
+    std::string key = line.substr(0, eq), value = line.substr(eq + 1);
+    if (key == "producer") p.producer = value;
+    else if (key == "stage") p.stage = value;
+    else if (key == "config") p.configDigest = value;
+    else if (key == "seed") {
+      char* end2 = nullptr;
+      p.seed = std::strtoull(value.c_str(), &end2, 10);
+      if (value.empty() || *end2 != '\0') throw InputError({name, 0}, "PROV chunk: seed '" + value + "' is not a number");
+    }
+  }
+  return p;
+}
+
+}  // namespace
+
+std::vector<uint8_t> encodeHair(const Strands& s) {
+  s.validate("strands to write");
+  const size_t strandCount = s.strandCount(), pointCount = s.pointCount();
+  if (strandCount > std::numeric_limits<uint32_t>::max() || pointCount > std::numeric_limits<uint32_t>::max())
+    throw InputError("too many strands or points for a .hair file (at most 2^32 - 1 each)");
+
+  bool uniform = strandCount > 0;
+  for (size_t i = 0; i < strandCount; ++i) {
+    uint32_t n = s.pointsOf(i);
+    if (n == 0) throw InputError("strand " + std::to_string(i) + " has no points; a .hair file cannot store it");
+    if (n - 1 > 0xffff)
+      throw InputError("strand " + std::to_string(i) + " has " + std::to_string(n) + " points; .hair allows 65536");
+    if (n != s.pointsOf(0)) uniform = false;
+  }
+  uint32_t flags = kPoints | (uniform ? 0 : kSegments) | (s.thickness.empty() ? 0 : kThickness) |
+                   (s.transparency.empty() ? 0 : kTransparency) | (s.colors.empty() ? 0 : kColor);
+
+  Writer w;
+  w.bytes("HAIR", 4);
+  w.u32(static_cast<uint32_t>(strandCount));
+  w.u32(static_cast<uint32_t>(pointCount));
+  w.u32(flags);
+  w.u32(uniform ? s.pointsOf(0) - 1 : 0);
+  w.f32(s.defaultThickness);
+  w.f32(s.defaultTransparency);
+  w.vec(s.defaultColor);
+  char info[kInfoSize] = {};
+  std::string text = "hairgen " HAIRGEN_VERSION " .hair (cyHair layout + hairgen chunks)";
+  std::memcpy(info, text.data(), std::min(text.size(), kInfoSize - 1));
+  w.bytes(info, kInfoSize);
+
+  if (flags & kSegments)
+    for (size_t i = 0; i < strandCount; ++i) w.u16(static_cast<uint16_t>(s.pointsOf(i) - 1));
+  for (const glm::vec3& p : s.points) w.vec(p);
+  for (float t : s.thickness) w.f32(t);
+  for (float t : s.transparency) w.f32(t);
+  for (const glm::vec3& c : s.colors) w.vec(c);
+
+  std::vector<std::pair<const char*, std::vector<uint8_t>>> chunks;
+  auto vec3s = [](const std::vector<glm::vec3>& v) { return payload([&](Writer& p) { for (auto& x : v) p.vec(x); }); };
+  auto u32s = [](const std::vector<uint32_t>& v) { return payload([&](Writer& p) { for (auto x : v) p.u32(x); }); };
+  if (!s.tangents.empty()) chunks.emplace_back("TANG", vec3s(s.tangents));
+  if (!s.normals.empty()) chunks.emplace_back("NORM", vec3s(s.normals));
+  if (!s.strandId.empty()) chunks.emplace_back("SIDS", u32s(s.strandId));
+  if (!s.rootTriangle.empty()) chunks.emplace_back("RTRI", u32s(s.rootTriangle));
+  if (!s.rootBary.empty()) chunks.emplace_back("RBAR", vec3s(s.rootBary));
+  if (!s.rootUv.empty())
+    chunks.emplace_back("RUVS", payload([&](Writer& p) { for (auto& x : s.rootUv) { p.f32(x.x); p.f32(x.y); } }));
+  if (!s.guideIds.empty())
+    chunks.emplace_back("GIDS", payload([&](Writer& p) { for (auto& x : s.guideIds) { p.u32(x.x); p.u32(x.y); p.u32(x.z); } }));
+  if (!s.guideWeights.empty()) chunks.emplace_back("GWTS", vec3s(s.guideWeights));
+  if (!s.provenance.empty()) {
+    std::string prov = provenanceText(s.provenance);
+    chunks.emplace_back("PROV", std::vector<uint8_t>(prov.begin(), prov.end()));
+  }
+  w.bytes("HGEN", 4);
+  w.u32(kBlockVersion);
+  w.u32(static_cast<uint32_t>(chunks.size()));
+  for (const auto& [tag, bytes] : chunks) chunk(w, tag, bytes);
+  return std::move(w.out);
+}
+
+Strands decodeHair(const uint8_t* data, size_t size, const std::string& name, HairHeader* headerOut) {
+  Reader r(data, size, name);
+  HairHeader header;
+  r.need(kHeaderSize, "the 128-byte header");
+  if (std::memcmp(r.take(4), "HAIR", 4) != 0)
+    throw InputError({name, 0}, "not a .hair file: it does not start with \"HAIR\"");
+  const uint64_t strandCount = r.u32(), pointCount = r.u32();
+  header.flags = r.u32();
+  header.defaultSegments = r.u32();
+  Strands s;
+  s.defaultThickness = r.f32();
+  s.defaultTransparency = r.f32();
+  s.defaultColor = r.vec();
+  const char* info = reinterpret_cast<const char*>(r.take(kInfoSize));
+  header.info.assign(info, strnlen(info, kInfoSize));
+  if (!(header.flags & kPoints)) throw InputError({name, 0}, "the file has no points array (flag 2 is not set)");
+
+  // Everything the flags promise must fit in the file before any array is allocated.
+  uint64_t arrays = (header.flags & kSegments ? 2 * strandCount : 0) + 12 * pointCount +
+                    (header.flags & kThickness ? 4 * pointCount : 0) +
+                    (header.flags & kTransparency ? 4 * pointCount : 0) + (header.flags & kColor ? 12 * pointCount : 0);
+  r.need(arrays, "the arrays for " + std::to_string(strandCount) + " strands and " + std::to_string(pointCount) + " points");
+
+  if (strandCount > pointCount)
+    throw InputError({name, 0}, "the header declares " + std::to_string(strandCount) + " strands but only " +
+                                    std::to_string(pointCount) + " points; every strand needs at least one");
+  s.firstPoint.resize(strandCount + 1);
+  s.firstPoint[0] = 0;
+  uint64_t total = 0;
+  for (uint64_t i = 0; i < strandCount; ++i) {
+    uint64_t segments = header.flags & kSegments ? r.u16() : header.defaultSegments;
+    total += segments + 1;
+    if (total > pointCount)
+      throw InputError({name, 0}, "the strands' segment counts need more than the " + std::to_string(pointCount) +
+                                      " points the header declares (strand " + std::to_string(i) + ")");
+    s.firstPoint[i + 1] = static_cast<uint32_t>(total);
+  }
+  if (total != pointCount)
+    throw InputError({name, 0}, "the strands' segment counts cover " + std::to_string(total) +
+                                    " points but the header declares " + std::to_string(pointCount));
+  s.points.resize(pointCount);
+  for (glm::vec3& p : s.points) p = r.vec();
+  if (header.flags & kThickness) { s.thickness.resize(pointCount); for (float& t : s.thickness) t = r.f32(); }
+  if (header.flags & kTransparency) { s.transparency.resize(pointCount); for (float& t : s.transparency) t = r.f32(); }
+  if (header.flags & kColor) { s.colors.resize(pointCount); for (glm::vec3& c : s.colors) c = r.vec(); }
+
+  if (r.remaining() > 0) {
+    r.need(12, "the hairgen chunk block header");
+    if (std::memcmp(r.take(4), "HGEN", 4) != 0)
+      throw InputError({name, 0}, std::to_string(r.remaining() + 4) +
+                                      " unexpected bytes after the cyHair arrays (not a hairgen chunk block)");
+    uint32_t version = r.u32();
+    if (version != kBlockVersion)
+      throw InputError({name, 0}, "chunk block version " + std::to_string(version) + " is not supported (this hairgen reads 1)");
+    uint32_t chunkCount = r.u32();
+    for (uint32_t c = 0; c < chunkCount; ++c) {
+      r.need(12, "chunk " + std::to_string(c) + "'s header");
+      const uint8_t* head = r.take(12);
+      std::string tag(reinterpret_cast<const char*>(head), 4);
+      uint64_t length = 0;
+      for (int i = 0; i < 8; ++i) length |= uint64_t(head[4 + i]) << (8 * i);
+      r.need(length, "chunk '" + tag + "'");
+      r.need(length + 4, "chunk '" + tag + "' and its CRC");
+      const uint8_t* bytes = r.take(length);
+      uint32_t stored = r.u32();
+      uLong crc = crc32_z(crc32(0L, head, 12), bytes, length);
+      if (static_cast<uint32_t>(crc) != stored) throw InputError({name, 0}, "chunk '" + tag + "' fails its CRC-32 check: the file is corrupt");
+      for (const std::string& seen : header.chunks)
+        if (seen == tag) throw InputError({name, 0}, "chunk '" + tag + "' appears twice");
+      header.chunks.push_back(tag);
+
+      Reader p(bytes, length, name);
+      auto expect = [&](uint64_t count, uint64_t bytesEach) {
+        if (length != count * bytesEach)
+          throw InputError({name, 0}, "chunk '" + tag + "' holds " + std::to_string(length) + " bytes, expected " +
+                                          std::to_string(count * bytesEach));
+      };
+      auto readVec3 = [&](std::vector<glm::vec3>& v, uint64_t count) { expect(count, 12); v.resize(count); for (auto& x : v) x = p.vec(); };
+      auto readU32 = [&](std::vector<uint32_t>& v, uint64_t count) { expect(count, 4); v.resize(count); for (auto& x : v) x = p.u32(); };
+      if (tag == "TANG") readVec3(s.tangents, pointCount);
+      else if (tag == "NORM") readVec3(s.normals, pointCount);
+      else if (tag == "SIDS") readU32(s.strandId, strandCount);
+      else if (tag == "RTRI") readU32(s.rootTriangle, strandCount);
+      else if (tag == "RBAR") readVec3(s.rootBary, strandCount);
+      else if (tag == "GWTS") readVec3(s.guideWeights, strandCount);
+      else if (tag == "RUVS") {
+        expect(strandCount, 8);
+        s.rootUv.resize(strandCount);
+        for (auto& x : s.rootUv) { x.x = p.f32(); x.y = p.f32(); }
+      } else if (tag == "GIDS") {
+        expect(strandCount, 12);
+        s.guideIds.resize(strandCount);
+        for (auto& x : s.guideIds) { x.x = p.u32(); x.y = p.u32(); x.z = p.u32(); }
+      } else if (tag == "PROV") {
+        s.provenance = parseProvenance(std::string(reinterpret_cast<const char*>(bytes), length), name);
+      }
+    }
+    if (r.remaining() > 0)
+      throw InputError({name, 0}, std::to_string(r.remaining()) + " unexpected bytes after the last chunk");
+  }
+  s.validate(name);
+  if (headerOut) *headerOut = std::move(header);
+  return s;
+}
+
+Strands readHair(const std::filesystem::path& file, HairHeader* header) {
+  std::vector<uint8_t> bytes = readFileBytes(file);
+  return decodeHair(bytes.data(), bytes.size(), file.string(), header);
+}
+
+void writeHair(const std::filesystem::path& file, const Strands& strands) {
+  std::vector<uint8_t> bytes = encodeHair(strands);
+  writeFileAtomic(file, bytes.data(), bytes.size());
+}
+
+}  // namespace hairgen

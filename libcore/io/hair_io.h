@@ -1,0 +1,44 @@
+// The .hair cache: Cem Yuksel's cyHair layout, then hairgen's own chunk block (DESIGN §6).
+//
+// Layout, all little-endian:
+//   128-byte header   "HAIR", uint32 strands, uint32 points, uint32 array flags
+//                     (1 segments, 2 points, 4 thickness, 8 transparency, 16 colour),
+//                     uint32 default segments, float default thickness, float default transparency,
+//                     float[3] default colour, char[88] info text
+//   cyHair arrays     uint16 segments[strands] (points − 1 per strand), float[3] points,
+//                     float thickness, float transparency, float[3] colour; each only if its flag is set
+//   chunk block       "HGEN", uint32 block version (1), uint32 chunk count, then per chunk:
+//                     char tag[4], uint64 payload bytes, payload, uint32 CRC-32 of tag+length+payload
+// Chunks: TANG/NORM float[3] per point; SIDS/RTRI uint32 per strand; RBAR float[3] per strand;
+// RUVS float[2] per strand; GIDS uint32[3] per strand; GWTS float[3] per strand; PROV "key=value\n" text.
+// cyHair readers stop after the arrays and never see the block. Unknown chunks are skipped (after
+// their CRC is checked), so newer files stay readable.
+#pragma once
+
+#include <cstdint>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "libcore/model/strands.h"
+
+namespace hairgen {
+
+// The header fields that `Strands` does not carry, for `hairgen info`.
+struct HairHeader {
+  uint32_t flags = 0;
+  uint32_t defaultSegments = 0;
+  std::string info;                 // the 88-byte info text, up to its first NUL
+  std::vector<std::string> chunks;  // tags of the chunk block, in file order
+};
+
+std::vector<uint8_t> encodeHair(const Strands& strands);
+
+// Decodes a .hair image. Every count is checked against `size` before anything is allocated; a
+// truncated, corrupt or inconsistent file is an InputError naming `name`.
+Strands decodeHair(const uint8_t* data, size_t size, const std::string& name, HairHeader* header = nullptr);
+
+Strands readHair(const std::filesystem::path& file, HairHeader* header = nullptr);
+void writeHair(const std::filesystem::path& file, const Strands& strands);  // atomic
+
+}  // namespace hairgen

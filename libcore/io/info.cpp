@@ -1,0 +1,143 @@
+#include "libcore/io/info.h"
+
+#include <cmath>
+#include <sstream>
+
+#include "libcore/util/error.h"
+#include "libcore/io/gltf_io.h"
+#include "libcore/io/hair_cache.h"
+#include "libcore/io/hair_io.h"
+#include "libcore/io/obj_io.h"
+#include "libcore/util/text.h"
+
+namespace hairgen {
+namespace {
+
+nlohmann::ordered_json boundsJson(const std::vector<glm::vec3>& points) {
+  Bounds b = bounds(points);
+  return {{"min", {b.min.x, b.min.y, b.min.z}}, {"max", {b.max.x, b.max.y, b.max.z}}};
+}
+
+nlohmann::ordered_json describeStrands(const Strands& s) {
+  nlohmann::ordered_json j;
+  j["strands"] = s.strandCount();
+  j["points"] = s.pointCount();
+  uint32_t minPoints = UINT32_MAX, maxPoints = 0;
+  double totalLength = 0.0;
+  for (size_t i = 0; i < s.strandCount(); ++i) {
+    minPoints = std::min(minPoints, s.pointsOf(i));
+    maxPoints = std::max(maxPoints, s.pointsOf(i));
+    for (uint32_t p = s.firstPoint[i] + 1; p < s.firstPoint[i + 1]; ++p)
+      totalLength += glm::length(glm::dvec3(s.points[p]) - glm::dvec3(s.points[p - 1]));
+  }
+  j["pointsPerStrand"] = {{"min", s.strandCount() ? minPoints : 0}, {"max", maxPoints}};
+  j["meanStrandLength"] = s.strandCount() ? totalLength / double(s.strandCount()) : 0.0;
+  j["bounds"] = boundsJson(s.points);
+  std::vector<std::string> arrays;
+  auto note = [&](bool present, const char* label) { if (present) arrays.push_back(label); };
+  note(!s.tangents.empty(), "tangents");
+  note(!s.normals.empty(), "normals");
+  note(!s.colors.empty(), "colors");
+  note(!s.thickness.empty(), "thickness");
+  note(!s.transparency.empty(), "transparency");
+  note(!s.strandId.empty(), "strandId");
+  note(!s.rootTriangle.empty(), "rootTriangle");
+  note(!s.rootBary.empty(), "rootBary");
+  note(!s.rootUv.empty(), "rootUv");
+  note(!s.guideIds.empty(), "guideIds");
+  note(!s.guideWeights.empty(), "guideWeights");
+  j["attributes"] = arrays;
+  j["defaults"] = {{"thickness", s.defaultThickness},
+                   {"transparency", s.defaultTransparency},
+                   {"color", {s.defaultColor.x, s.defaultColor.y, s.defaultColor.z}}};
+  if (!s.provenance.empty())
+    j["provenance"] = {{"producer", s.provenance.producer},
+                       {"stage", s.provenance.stage},
+                       {"seed", s.provenance.seed},
+                       {"configDigest", s.provenance.configDigest}};
+  return j;
+}
+
+}  // namespace
+
+nlohmann::ordered_json describeFile(const std::filesystem::path& file) {
+  std::string ext = toLower(file.extension().string());
+  nlohmann::ordered_json j;
+  j["file"] = file.string();
+  if (ext == ".obj") {
+    MeshReadStats stats;
+    Mesh mesh = readObj(file, &stats);
+    j["format"] = "obj";
+    j["vertices"] = mesh.vertexCount();
+    j["triangles"] = mesh.triangleCount();
+    j["area_m2"] = surfaceArea(mesh);
+    j["area_cm2"] = surfaceArea(mesh) * 1e4;
+    double edge = 0.0;
+    for (const glm::uvec3& t : mesh.triangles)
+      for (int c = 0; c < 3; ++c) edge += glm::length(mesh.positions[t[c]] - mesh.positions[t[(c + 1) % 3]]);
+    j["meanEdgeLength"] = edge / (3.0 * double(mesh.triangleCount()));
+    j["bounds"] = boundsJson(mesh.positions);
+    j["uvs"] = !mesh.uvs.empty();
+    j["normals"] = stats.normalsFromFile ? (stats.normalsReindexed ? "from file, averaged per position" : "from file")
+                                         : "computed (area-weighted)";
+    j["polygonsTriangulated"] = stats.polygonsTriangulated;
+    j["degenerateFacesDropped"] = stats.degenerateDropped;
+    j["unreferencedVerticesDropped"] = stats.unreferencedDropped;
+    return j;
+  }
+  HairFormat format = hairFormatOf(file);
+  if (format == HairFormat::kHair) {
+    HairHeader header;
+    Strands s = readHair(file, &header);
+    j["format"] = "hair";
+    j.update(describeStrands(s));
+    j["cyHair"] = {{"flags", header.flags}, {"defaultSegments", header.defaultSegments}, {"info", header.info}};
+    j["chunks"] = header.chunks;
+    return j;
+  }
+  Strands s = readGltf(file);
+  j["format"] = format == HairFormat::kGlb ? "glb" : "gltf";
+  j.update(describeStrands(s));
+  return j;
+}
+
+std::string formatDescription(const nlohmann::ordered_json& j) {
+  std::ostringstream out;
+  auto num = [](const nlohmann::ordered_json& v) {
+    if (v.is_number_float()) {
+      char buffer[32];
+      std::snprintf(buffer, sizeof buffer, "%.6g", v.get<double>());
+      return std::string(buffer);
+    }
+    return v.dump();
+  };
+  auto box = [&](const nlohmann::ordered_json& b) {
+    return "(" + num(b["min"][0]) + ", " + num(b["min"][1]) + ", " + num(b["min"][2]) + ") to (" + num(b["max"][0]) +
+           ", " + num(b["max"][1]) + ", " + num(b["max"][2]) + ")";
+  };
+  out << j["file"].get<std::string>() << ": " << j["format"].get<std::string>() << "\n";
+  if (j["format"] == "obj") {
+    out << "  " << j["vertices"] << " vertices, " << j["triangles"] << " triangles, area " << num(j["area_cm2"])
+        << " cm² (" << num(j["area_m2"]) << " m²), mean edge " << num(j["meanEdgeLength"]) << " m\n"
+        << "  bounds " << box(j["bounds"]) << "\n"
+        << "  normals " << j["normals"].get<std::string>() << (j["uvs"].get<bool>() ? ", UVs" : ", no UVs") << "\n"
+        << "  " << j["polygonsTriangulated"] << " polygons triangulated, " << j["degenerateFacesDropped"]
+        << " degenerate faces dropped, " << j["unreferencedVerticesDropped"] << " unreferenced vertices dropped\n";
+    return out.str();
+  }
+  out << "  " << j["strands"] << " strands, " << j["points"] << " points (" << j["pointsPerStrand"]["min"] << " to "
+      << j["pointsPerStrand"]["max"] << " per strand), mean strand length " << num(j["meanStrandLength"]) << "\n"
+      << "  bounds " << box(j["bounds"]) << "\n";
+  std::string attributes;
+  for (const auto& a : j["attributes"]) attributes += (attributes.empty() ? "" : ", ") + a.get<std::string>();
+  out << "  attributes: " << (attributes.empty() ? "positions only" : attributes) << "\n";
+  if (j.contains("cyHair"))
+    out << "  cyHair flags " << j["cyHair"]["flags"] << ", default segments " << j["cyHair"]["defaultSegments"]
+        << ", info \"" << j["cyHair"]["info"].get<std::string>() << "\"\n";
+  if (j.contains("provenance"))
+    out << "  made by " << j["provenance"]["producer"].get<std::string>() << " (" << j["provenance"]["stage"].get<std::string>()
+        << "), seed " << j["provenance"]["seed"] << ", config " << j["provenance"]["configDigest"].get<std::string>() << "\n";
+  return out.str();
+}
+
+}  // namespace hairgen

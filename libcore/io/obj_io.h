@@ -1,0 +1,34 @@
+// Wavefront OBJ meshes: the wick and the head.
+#pragma once
+
+#include <filesystem>
+#include <ostream>
+#include <string>
+#include <string_view>
+
+#include "libcore/model/mesh.h"
+
+namespace hairgen {
+
+// What reading a mesh changed, for `info` and --stats.
+struct MeshReadStats {
+  size_t facesRead = 0;             // faces as written (polygons count once)
+  size_t polygonsTriangulated = 0;  // faces with more than three corners
+  size_t degenerateDropped = 0;     // triangles with a repeated corner or no area
+  size_t unreferencedDropped = 0;   // vertices no face uses (a wick vertex is a follicle only on a face)
+  bool normalsFromFile = false;     // false: area-weighted normals were computed
+  bool normalsReindexed = false;    // normals were indexed apart from positions and averaged per vertex
+};
+
+// Reads an OBJ: triangles and polygons (triangulated), normals and UVs indexed apart from positions
+// (averaged, resp. first seen, per position, so each position stays one follicle), missing normals
+// computed area-weighted. Malformed numbers, out-of-range indices and meshes with no vertices or no
+// faces are InputErrors naming file:line.
+Mesh readObj(const std::filesystem::path& file, MeshReadStats* stats = nullptr);
+Mesh parseObj(std::string_view text, const std::string& name, MeshReadStats* stats = nullptr);
+
+// Writes positions, normals, UVs (when present) and triangles; floats in shortest round-trip form so
+// the same mesh always gives the same bytes.
+void writeObj(const Mesh& mesh, std::ostream& out, const std::string& headerComment);
+
+}  // namespace hairgen

@@ -1,0 +1,22 @@
+// Frames carried along strands by parallel transport, and shading normals re-posed through them onto a
+// deformed coupe of the same strands (Petrovic et al. 2005 §4, for animated hair).
+#pragma once
+
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include "libcore/model/strands.h"
+
+namespace hairgen {
+
+// Parallel-transport frames: at the root (t, u, t×u) with u the direction from the root toward the
+// centroid of all roots, made normal to t (fixed to the follicle and moving rigidly with the coupe),
+// then carried vertex to vertex by the minimal rotation between tangents. Returns u per vertex.
+std::vector<glm::vec3> transportFrames(const Strands& strands);
+
+// Re-poses the rest coupe's normals onto a deformed coupe of the same strands and vertex counts: each
+// normal is written in its rest frame and read back in the deformed one.
+std::vector<glm::vec3> reposeNormals(const Strands& rest, const Strands& deformed);
+
+}  // namespace hairgen

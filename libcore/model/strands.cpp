@@ -1,0 +1,74 @@
+#include "libcore/model/strands.h"
+
+#include <cmath>
+
+#include "libcore/util/error.h"
+
+namespace hairgen {
+namespace {
+
+bool finite(const glm::vec3& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
+bool finite(const glm::vec2& v) { return std::isfinite(v.x) && std::isfinite(v.y); }
+bool finite(float v) { return std::isfinite(v); }
+bool finite(uint32_t) { return true; }
+bool finite(const glm::uvec3&) { return true; }
+
+template <typename T>
+void checkArray(const std::string& source, const char* name, const std::vector<T>& values, size_t expected) {
+  if (values.empty()) return;
+  if (values.size() != expected)
+    throw InputError({source, 0}, std::string(name) + " has " + std::to_string(values.size()) +
+                                      " entries, expected " + std::to_string(expected));
+  for (size_t i = 0; i < values.size(); ++i)
+    if (!finite(values[i]))
+      throw InputError({source, 0}, std::string(name) + " entry " + std::to_string(i) + " is not finite");
+}
+
+}  // namespace
+
+void Strands::addStrand(const std::vector<glm::vec3>& strandPoints) {
+  points.insert(points.end(), strandPoints.begin(), strandPoints.end());
+  firstPoint.push_back(static_cast<uint32_t>(points.size()));
+}
+
+void Strands::validate(const std::string& source) const {
+  if (firstPoint.empty() || firstPoint.front() != 0)
+    throw InputError({source, 0}, "strand offsets must start at 0");
+  for (size_t s = 0; s + 1 < firstPoint.size(); ++s)
+    if (firstPoint[s + 1] < firstPoint[s])
+      throw InputError({source, 0}, "strand " + std::to_string(s) + " has a negative point count");
+  if (firstPoint.back() != points.size())
+    throw InputError({source, 0}, "strand offsets cover " + std::to_string(firstPoint.back()) +
+                                      " points but there are " + std::to_string(points.size()));
+  size_t n = points.size(), s = strandCount();
+  checkArray(source, "points", points, n);
+  checkArray(source, "tangents", tangents, n);
+  checkArray(source, "normals", normals, n);
+  checkArray(source, "colors", colors, n);
+  checkArray(source, "thickness", thickness, n);
+  checkArray(source, "transparency", transparency, n);
+  checkArray(source, "strand ids", strandId, s);
+  checkArray(source, "root triangles", rootTriangle, s);
+  checkArray(source, "root barycentrics", rootBary, s);
+  checkArray(source, "root UVs", rootUv, s);
+  checkArray(source, "guide ids", guideIds, s);
+  checkArray(source, "guide weights", guideWeights, s);
+  if (!std::isfinite(defaultThickness) || !std::isfinite(defaultTransparency) || !finite(defaultColor))
+    throw InputError({source, 0}, "header defaults are not finite");
+}
+
+std::vector<glm::vec3> polylineTangents(const Strands& s) {
+  std::vector<glm::vec3> t(s.pointCount(), glm::vec3(0.0f, 1.0f, 0.0f));
+  for (size_t i = 0; i < s.strandCount(); ++i) {
+    const uint32_t first = s.firstPoint[i], last = s.firstPoint[i + 1];
+    glm::vec3 previous(0.0f, 1.0f, 0.0f);
+    for (uint32_t p = first; p < last; ++p) {
+      glm::vec3 d = p + 1 < last ? s.points[p + 1] - s.points[p] : (p > first ? s.points[p] - s.points[p - 1] : previous);
+      float len = glm::length(d);
+      t[p] = previous = len > 0.0f ? d / len : previous;
+    }
+  }
+  return t;
+}
+
+}  // namespace hairgen

@@ -1,0 +1,71 @@
+// Potential energy of one Super-Helix guide (Lansink 2010 §4.1.1.3, §4.1.2):
+//   E = E_elastic + E_gravity + E_collision
+// E_elastic = Σ_Q ℓ_Q [E I1/2 (κ1 − κ1⁰)² + E I2/2 (κ2 − κ2⁰)² + μ J/2 (τ − τ⁰)²], I1 = π a b³/4,
+//             I2 = π b a³/4, J = π a b (a² + b²)/4, μ = E/(2(1 + σ));
+// E_gravity = ρ S g ∫ (z(s) − z(0)) ds in closed form, S = π a b;
+// E_collision = Δs Σ_samples Σ_shapes ½ k max(dent + extra, 0)², samples every CollisionStep after the
+//               root, extra = volume · (y_follicle − y_min)/(y_max − y_min) (layered envelopes).
+// Joules throughout.
+#pragma once
+
+#include <span>
+#include <vector>
+
+#include "libcore/config/params.h"
+#include "libcore/physics/super_helix.h"
+
+namespace hairgen {
+
+// Penetration depth (metres, positive inside) of `p` into a shape, as the thesis defines it per kind.
+double penetration(const CollisionShape& shape, const glm::dvec3& p);
+
+struct EnergyTerms {
+  double elastic = 0.0, gravity = 0.0, collision = 0.0;
+  double total() const { return elastic + gravity + collision; }
+};
+
+class StrandEnergy {
+ public:
+  // `envelope` is the follicle's height fraction in [0, 1] between the lowest and highest follicle.
+  StrandEnergy(const Hairstyle& style, const Collision& collision, const RodFrame& root, double envelope);
+
+  double operator()(std::span<const double> q) const { return terms(q).total(); }
+  EnergyTerms terms(std::span<const double> q) const;
+
+  // The rest shape's coordinates (the minimiser's start) and the energy scale used for Epsilon:
+  // ρ S g L²/2 (the strand's weight times half its length) + E I1 / L (bending it by one radian).
+  std::vector<double> restCoordinates() const;
+  double energyScale() const;
+  // Initial Rosenbrock steps: a quarter radian of bend or twist over each element.
+  std::vector<double> initialSteps() const;
+
+ private:
+  struct Shape {
+    CollisionShape shape;
+    double extra;
+    double reach2;  // (bounding radius + extra)²: a point farther from the centre cannot touch
+    // Ellipsoids: the axes divided by their semi-axes, and the squared "ratio" |local/half|² beyond
+    // which dent + extra ≤ 0 (dist ≥ ratio·min semi-axis bounds the dent by −min·(ratio − 1)).
+    glm::dvec3 scaledAxes[3];
+    double ratio2Outside;
+  };
+  // The collision samples of one element: a grid u = first + j·CollisionStep, j < gridCount, and
+  // the samples off that grid (the tip, when CollisionStep does not divide the length).
+  struct ElementSamples {
+    double first = 0.0;
+    size_t gridCount = 0;
+    std::vector<double> offGrid;
+  };
+  double penalty(const glm::dvec3& p) const;
+
+  std::vector<double> lengths_;
+  RodFrame root_;
+  RestShape rest_;
+  double bend1_, bend2_, twist_;  // E I1 / 2, E I2 / 2, μ J / 2
+  double weight_;                 // ρ S g, newtons per metre
+  std::vector<Shape> shapes_;
+  std::vector<ElementSamples> samples_;
+  double collisionStep_;
+};
+
+}  // namespace hairgen

@@ -1,0 +1,190 @@
+#include "libcore/render/gl_context.h"
+
+#include <cstdio>
+#include <cstring>
+
+#include <EGL/egl.h>
+#include <EGL/eglext.h>
+#define GL_GLEXT_PROTOTYPES 1
+#include <GL/glcorearb.h>
+
+#include "libcore/util/error.h"
+
+namespace hairgen {
+namespace {
+
+const char* eglErrorName(EGLint e) {
+  switch (e) {
+    case EGL_SUCCESS: return "EGL_SUCCESS";
+    case EGL_NOT_INITIALIZED: return "EGL_NOT_INITIALIZED";
+    case EGL_BAD_ACCESS: return "EGL_BAD_ACCESS";
+    case EGL_BAD_ALLOC: return "EGL_BAD_ALLOC";
+    case EGL_BAD_ATTRIBUTE: return "EGL_BAD_ATTRIBUTE";
+    case EGL_BAD_CONFIG: return "EGL_BAD_CONFIG";
+    case EGL_BAD_CONTEXT: return "EGL_BAD_CONTEXT";
+    case EGL_BAD_CURRENT_SURFACE: return "EGL_BAD_CURRENT_SURFACE";
+    case EGL_BAD_DISPLAY: return "EGL_BAD_DISPLAY";
+    case EGL_BAD_MATCH: return "EGL_BAD_MATCH";
+    case EGL_BAD_NATIVE_PIXMAP: return "EGL_BAD_NATIVE_PIXMAP";
+    case EGL_BAD_NATIVE_WINDOW: return "EGL_BAD_NATIVE_WINDOW";
+    case EGL_BAD_PARAMETER: return "EGL_BAD_PARAMETER";
+    case EGL_BAD_SURFACE: return "EGL_BAD_SURFACE";
+    case EGL_CONTEXT_LOST: return "EGL_CONTEXT_LOST";
+  }
+  return "unknown EGL error";
+}
+
+std::string eglFailure(const char* call) {
+  const EGLint error = eglGetError();
+  char code[16];
+  std::snprintf(code, sizeof code, "0x%04x", static_cast<unsigned>(error));
+  return std::string(call) + " failed (" + eglErrorName(error) + ", " + code + ")";
+}
+
+// Initialises `display` and makes a 4.5 core context current on it without a surface.
+bool openOn(EGLDisplay display, EGLContext& context, std::string& error) {
+  if (display == EGL_NO_DISPLAY) {
+    error = eglFailure("eglGetPlatformDisplay");
+    return false;
+  }
+  EGLint major = 0, minor = 0;
+  if (!eglInitialize(display, &major, &minor)) {
+    error = eglFailure("eglInitialize");
+    return false;
+  }
+  const char* extensions = eglQueryString(display, EGL_EXTENSIONS);
+  if (!extensions || !std::strstr(extensions, "EGL_KHR_surfaceless_context")) {
+    error = "no EGL_KHR_surfaceless_context";
+    eglTerminate(display);
+    return false;
+  }
+  if (!eglBindAPI(EGL_OPENGL_API)) {
+    error = eglFailure("eglBindAPI(EGL_OPENGL_API)");
+    eglTerminate(display);
+    return false;
+  }
+  const EGLint configAttribs[] = {EGL_RENDERABLE_TYPE, EGL_OPENGL_BIT, EGL_NONE};
+  EGLConfig config = nullptr;
+  EGLint count = 0;
+  bool haveConfig = eglChooseConfig(display, configAttribs, &config, 1, &count) && count > 0;
+  const EGLint contextAttribs[] = {EGL_CONTEXT_MAJOR_VERSION, 4, EGL_CONTEXT_MINOR_VERSION, 5,
+                                   EGL_CONTEXT_OPENGL_PROFILE_MASK, EGL_CONTEXT_OPENGL_CORE_PROFILE_BIT, EGL_NONE};
+  context = eglCreateContext(display, haveConfig ? config : EGL_NO_CONFIG_KHR, EGL_NO_CONTEXT, contextAttribs);
+  if (context == EGL_NO_CONTEXT) {
+    error = eglFailure("eglCreateContext(OpenGL 4.5 core)");
+    eglTerminate(display);
+    return false;
+  }
+  if (!eglMakeCurrent(display, EGL_NO_SURFACE, EGL_NO_SURFACE, context)) {
+    error = eglFailure("eglMakeCurrent");
+    eglDestroyContext(display, context);
+    eglTerminate(display);
+    return false;
+  }
+  return true;
+}
+
+struct Platforms {
+  PFNEGLQUERYDEVICESEXTPROC queryDevices = nullptr;
+  PFNEGLQUERYDEVICESTRINGEXTPROC queryDeviceString = nullptr;
+  PFNEGLGETPLATFORMDISPLAYEXTPROC getPlatformDisplay = nullptr;
+  Platforms() {
+    queryDevices = reinterpret_cast<PFNEGLQUERYDEVICESEXTPROC>(eglGetProcAddress("eglQueryDevicesEXT"));
+    queryDeviceString = reinterpret_cast<PFNEGLQUERYDEVICESTRINGEXTPROC>(eglGetProcAddress("eglQueryDeviceStringEXT"));
+    getPlatformDisplay = reinterpret_cast<PFNEGLGETPLATFORMDISPLAYEXTPROC>(eglGetProcAddress("eglGetPlatformDisplayEXT"));
+  }
+  std::vector<EGLDeviceEXT> devices() const {
+    std::vector<EGLDeviceEXT> list;
+    EGLint n = 0;
+    if (!queryDevices || !queryDevices(0, nullptr, &n) || n <= 0) return list;
+    list.resize(static_cast<size_t>(n));
+    if (!queryDevices(n, list.data(), &n)) list.clear();
+    list.resize(static_cast<size_t>(std::max(n, 0)));
+    return list;
+  }
+  std::string describe(EGLDeviceEXT device) const {
+    const char* ext = queryDeviceString ? queryDeviceString(device, EGL_EXTENSIONS) : nullptr;
+    return ext ? ext : "";
+  }
+};
+
+// A device is a real GPU when it is not Mesa's software device.
+bool isSoftware(const std::string& extensions) { return extensions.find("EGL_MESA_device_software") != std::string::npos; }
+
+}  // namespace
+
+struct GlContext::State {
+  EGLDisplay display = EGL_NO_DISPLAY;
+  EGLContext context = EGL_NO_CONTEXT;
+  std::string platform;
+};
+
+GlContext::GlContext() : state_(std::make_unique<State>()) {
+  Platforms p;
+  std::string tried;
+  if (!p.getPlatformDisplay) throw DeviceError("EGL has no eglGetPlatformDisplayEXT; cannot open a headless display");
+  // 1. The EGL device platform: every device but Mesa's software one (that is the surfaceless path).
+  for (EGLDeviceEXT device : p.devices()) {
+    std::string ext = p.describe(device);
+    if (isSoftware(ext)) continue;
+    std::string error;
+    EGLDisplay display = p.getPlatformDisplay(EGL_PLATFORM_DEVICE_EXT, device, nullptr);
+    if (openOn(display, state_->context, error)) {
+      state_->display = display;
+      state_->platform = "device";
+      return;
+    }
+    tried += "  EGL device (" + ext + "): " + error + "\n";
+  }
+  // 2. Mesa's surfaceless platform.
+  {
+    std::string error;
+    EGLDisplay display = p.getPlatformDisplay(EGL_PLATFORM_SURFACELESS_MESA, EGL_DEFAULT_DISPLAY, nullptr);
+    if (openOn(display, state_->context, error)) {
+      state_->display = display;
+      state_->platform = "surfaceless";
+      return;
+    }
+    tried += "  Mesa surfaceless: " + error + "\n";
+  }
+  if (tried.empty()) tried = "  no EGL device and no surfaceless platform\n";
+  throw DeviceError("no OpenGL 4.5 core context through EGL:\n" + tried +
+                    "install Mesa (libegl-mesa0 libgl1-mesa-dri) for software rendering, or a GPU driver with EGL");
+}
+
+GlContext::~GlContext() {
+  if (state_->display == EGL_NO_DISPLAY) return;
+  eglMakeCurrent(state_->display, EGL_NO_SURFACE, EGL_NO_SURFACE, EGL_NO_CONTEXT);
+  eglDestroyContext(state_->display, state_->context);
+  eglTerminate(state_->display);
+}
+
+const std::string& GlContext::platform() const { return state_->platform; }
+std::string GlContext::renderer() const { return reinterpret_cast<const char*>(glGetString(GL_RENDERER)); }
+std::string GlContext::version() const { return reinterpret_cast<const char*>(glGetString(GL_VERSION)); }
+
+std::vector<GlDeviceInfo> GlContext::probe() {
+  std::vector<GlDeviceInfo> out;
+  Platforms p;
+  if (!p.getPlatformDisplay) return out;
+  auto tryOpen = [&](GlDeviceInfo info, EGLDisplay display) {
+    EGLContext context = EGL_NO_CONTEXT;
+    info.opened = openOn(display, context, info.error);
+    if (info.opened) {
+      info.name = std::string(reinterpret_cast<const char*>(glGetString(GL_RENDERER))) + ", OpenGL " +
+                  reinterpret_cast<const char*>(glGetString(GL_VERSION));
+      eglMakeCurrent(display, EGL_NO_SURFACE, EGL_NO_SURFACE, EGL_NO_CONTEXT);
+      eglDestroyContext(display, context);
+      eglTerminate(display);
+    }
+    out.push_back(info);
+  };
+  for (EGLDeviceEXT device : p.devices()) {
+    std::string ext = p.describe(device);
+    tryOpen({"device", ext, false, ""}, p.getPlatformDisplay(EGL_PLATFORM_DEVICE_EXT, device, nullptr));
+  }
+  tryOpen({"surfaceless", "", false, ""}, p.getPlatformDisplay(EGL_PLATFORM_SURFACELESS_MESA, EGL_DEFAULT_DISPLAY, nullptr));
+  return out;
+}
+
+}  // namespace hairgen

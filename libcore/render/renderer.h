@@ -1,0 +1,56 @@
+// The hair renderer (thesis §4.1.5-4.1.6, Appendix A for the method): per light three passes —
+// depth from the light, a deep opacity map of 4 layers with additive blending, and the shading pass
+// from the camera reading both — into framebuffer objects of a headless EGL context.
+#pragma once
+
+#include <algorithm>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include "libcore/model/image.h"
+#include "libcore/model/mesh.h"
+#include "libcore/config/params.h"
+#include "libcore/model/strands.h"
+
+namespace hairgen {
+
+class GlContext;
+
+// Camera depth (Z) of a pixel where nothing was drawn, metres.
+inline constexpr float kBackgroundZ = 1.0e10f;
+
+struct RenderTimings {
+  double upload = 0.0, lightDepth = 0.0, opacity = 0.0, shading = 0.0, readback = 0.0;  // seconds
+};
+
+struct RenderOutput {
+  Image beauty;  // R G B A (A: coverage of hair and head), Z, opacity (hair coverage), shadow
+  Image dom;     // the light's view: Z (distance along the light's axis where hair begins), layer1-4
+  glm::dmat4 worldToCamera{1.0}, worldToNdc{1.0};
+  glm::dmat4 worldToLight{1.0};
+  RenderTimings timings;
+  int samples = 1;  // the samples used (Samples, clamped to what the device offers)
+};
+
+struct RenderInput {
+  const Strands* hair = nullptr;
+  const Mesh* head = nullptr;  // may be null
+  Visuality visuality;
+  RenderSettings settings;
+  int domResolution = 1024;    // texels per side of the light's maps
+  bool keepDom = false;
+};
+
+// The light's maps for an image: half the image's larger side, at least 1024 and at most 4096 texels
+// (the shadow lookup filters 2×2 texels, so this keeps shadows as sharp as the image needs).
+inline int domResolutionFor(const glm::ivec2& resolution) {
+  return std::clamp(std::max(resolution.x, resolution.y) / 2, 1024, 4096);
+}
+
+// Renders with the current context of `gl`. Deterministic for a given device and driver.
+RenderOutput renderHair(GlContext& gl, const RenderInput& input);
+
+}  // namespace hairgen

@@ -1,0 +1,283 @@
+#include "libcore/volume/hair_volume.h"
+
+#include <algorithm>
+#include <cmath>
+#include <atomic>
+#include <cstdio>
+#include <limits>
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+#include "libcore/util/error.h"
+#include "libcore/model/mesh.h"
+
+namespace hairgen {
+
+namespace {
+
+// Σ over the 8 nodes around p of their trilinear weight times value(i, j, k) (p clamped to the grid).
+template <class T, class Value>
+T trilinear(const Grid& grid, const glm::dvec3& p, Value value) {
+  glm::dvec3 g = glm::clamp((p - grid.origin) / grid.voxel, glm::dvec3(0.0), glm::dvec3(grid.size - 1) - 1e-9);
+  glm::ivec3 c = glm::ivec3(glm::floor(g));
+  glm::dvec3 f = g - glm::dvec3(c);
+  T out(0.0);
+  for (int dz = 0; dz < 2; ++dz)
+    for (int dy = 0; dy < 2; ++dy)
+      for (int dx = 0; dx < 2; ++dx) {
+        double w = (dx ? f.x : 1 - f.x) * (dy ? f.y : 1 - f.y) * (dz ? f.z : 1 - f.z);
+        out += w * value(std::min(c.x + dx, grid.size.x - 1), std::min(c.y + dy, grid.size.y - 1),
+                         std::min(c.z + dz, grid.size.z - 1));
+      }
+  return out;
+}
+
+}  // namespace
+
+double Grid::sample(const glm::dvec3& p) const {
+  return trilinear<double>(*this, p, [&](int i, int j, int k) { return double(at(i, j, k)); });
+}
+
+namespace {
+
+// Central differences at every node, computed once; the gradient at a point is their trilinear
+// interpolant (sampleGradient), 8 lookups.
+std::vector<glm::vec3> nodeGradients(const Grid& grid) {
+  const glm::ivec3 n = grid.size;
+  const float scale = float(1.0 / (2.0 * grid.voxel));
+  std::vector<glm::vec3> out(grid.values.size());
+  tbb::parallel_for(0, n.z, [&](int k) {
+    auto v = [&](int a, int b, int c) {
+      return grid.at(std::clamp(a, 0, n.x - 1), std::clamp(b, 0, n.y - 1), std::clamp(c, 0, n.z - 1));
+    };
+    for (int j = 0; j < n.y; ++j)
+      for (int i = 0; i < n.x; ++i)
+        out[grid.index(i, j, k)] = scale * glm::vec3(v(i + 1, j, k) - v(i - 1, j, k), v(i, j + 1, k) - v(i, j - 1, k),
+                                                     v(i, j, k + 1) - v(i, j, k - 1));
+  });
+  return out;
+}
+
+glm::dvec3 sampleGradient(const Grid& grid, const std::vector<glm::vec3>& gradients, const glm::dvec3& p) {
+  return trilinear<glm::dvec3>(grid, p, [&](int i, int j, int k) { return glm::dvec3(gradients[grid.index(i, j, k)]); });
+}
+
+}  // namespace
+
+Grid gridAround(const std::vector<glm::vec3>& points, double voxel, int padding) {
+  if (points.empty()) throw InputError("the coupe has no points to build a volume from");
+  const Bounds box = bounds(points);
+  const glm::dvec3 lo(box.min), hi(box.max);
+  Grid g;
+  g.voxel = voxel;
+  g.origin = lo - double(padding) * voxel;
+  glm::dvec3 cells = glm::ceil((hi - lo) / voxel) + 1.0 + 2.0 * padding;
+  if (cells.x * cells.y * cells.z > 4.0e8) {
+    const glm::dvec3 span = hi - lo;
+    char text[160];
+    std::snprintf(text, sizeof text, "the hair spans %.3g x %.3g x %.3g, which at VoxelSize %.3g is %.3g voxels (4e8 at most)",
+                  span.x, span.y, span.z, voxel, cells.x * cells.y * cells.z);
+    throw InputError(std::string(text) + "; raise Render.VoxelSize, or check the cache is in metres");
+  }
+  g.size = glm::ivec3(cells);
+  g.values.assign(size_t(g.size.x) * g.size.y * g.size.z, 0.0f);
+  return g;
+}
+
+void splat(Grid& d, const std::vector<glm::vec3>& points) {
+  // Weights are added as 32.32 fixed-point integers: integer sums do not depend on the order of the
+  // additions, so the threads may race and the grid is the same bits on every run and thread count.
+  // Each point's eight weights are rounded to sum to exactly one (the rounding is given to its
+  // largest weight), so a point inside the grid adds exactly 1 to it.
+  constexpr double kOne = 4294967296.0;  // 2^32
+  std::vector<int64_t> sums(d.values.size(), 0);
+  const glm::ivec3 size = d.size;
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, points.size(), 4096), [&](const tbb::blocked_range<size_t>& r) {
+    for (size_t p = r.begin(); p != r.end(); ++p) {
+      glm::dvec3 g = (glm::dvec3(points[p]) - d.origin) / d.voxel;
+      glm::ivec3 c = glm::ivec3(glm::floor(g));
+      glm::dvec3 f = g - glm::dvec3(c);
+      int64_t w[8];
+      int64_t total = 0;
+      int largest = 0;
+      for (int corner = 0; corner < 8; ++corner) {
+        const int dx = corner & 1, dy = (corner >> 1) & 1, dz = corner >> 2;
+        w[corner] = int64_t((dx ? f.x : 1 - f.x) * (dy ? f.y : 1 - f.y) * (dz ? f.z : 1 - f.z) * kOne + 0.5);
+        total += w[corner];
+        if (w[corner] > w[largest]) largest = corner;
+      }
+      w[largest] += int64_t(kOne) - total;
+      for (int corner = 0; corner < 8; ++corner) {  // on the grid's edge, the outer corners fall away
+        const glm::ivec3 n = c + glm::ivec3(corner & 1, (corner >> 1) & 1, corner >> 2);
+        if (glm::any(glm::lessThan(n, glm::ivec3(0))) || glm::any(glm::greaterThanEqual(n, size))) continue;
+        std::atomic_ref<int64_t>(sums[d.index(n.x, n.y, n.z)]).fetch_add(w[corner], std::memory_order_relaxed);
+      }
+    }
+  });
+  for (size_t i = 0; i < sums.size(); ++i) d.values[i] += static_cast<float>(double(sums[i]) / kOne);
+}
+
+Grid smoothed(const Grid& g) {
+  // Separable [1 2 1]/4 along x, y and z, edges clamped.
+  Grid out = g;
+  const glm::ivec3 n = g.size;
+  for (int axis = 0; axis < 3; ++axis) {
+    Grid in = out;
+    for (int k = 0; k < n.z; ++k)
+      for (int j = 0; j < n.y; ++j)
+        for (int i = 0; i < n.x; ++i) {
+          glm::ivec3 c(i, j, k), a = c, b = c;
+          a[axis] = std::max(c[axis] - 1, 0);
+          b[axis] = std::min(c[axis] + 1, n[axis] - 1);
+          out.values[out.index(i, j, k)] =
+              0.25f * in.at(a.x, a.y, a.z) + 0.5f * in.at(i, j, k) + 0.25f * in.at(b.x, b.y, b.z);
+        }
+  }
+  return out;
+}
+
+Grid signedDistance(const Grid& density, double iso) {
+  const glm::ivec3 n = density.size;
+  const double h = density.voxel;
+  const size_t count = density.values.size();
+  const size_t strideY = size_t(n.x), strideZ = size_t(n.x) * n.y;
+  auto node = [&](int i, int j, int k) { return density.origin + h * glm::dvec3(i, j, k); };
+  std::vector<char> inside(count);
+  for (size_t i = 0; i < count; ++i) inside[i] = density.values[i] > iso;
+
+  // Every node carries the nearest point of the shell it knows of. It starts at the nodes with an
+  // edge across the shell, as the nearest crossing of φ = density − iso along their own edges (by
+  // linear interpolation, which is exact on the trilinear φ).
+  constexpr double kNone = std::numeric_limits<double>::infinity();
+  std::vector<glm::dvec3> nearest(count, glm::dvec3(kNone));
+  std::vector<double> dist2(count, kNone);
+  tbb::parallel_for(0, n.z, [&](int k) {
+    for (int j = 0; j < n.y; ++j)
+      for (int i = 0; i < n.x; ++i) {
+        const size_t id = density.index(i, j, k);
+        const double f = density.values[id] - iso;
+        for (int axis = 0; axis < 3; ++axis)
+          for (int side = -1; side <= 1; side += 2) {
+            glm::ivec3 b(i, j, k);
+            b[axis] += side;
+            if (b[axis] < 0 || b[axis] >= n[axis]) continue;
+            const size_t nb = density.index(b.x, b.y, b.z);
+            if (inside[nb] == inside[id]) continue;
+            const double t = f / (f - (density.values[nb] - iso));
+            if (t * t * h * h >= dist2[id]) continue;
+            nearest[id] = node(i, j, k);
+            nearest[id][axis] += side * t * h;
+            dist2[id] = t * t * h * h;
+          }
+      }
+  });
+
+  // Fast sweeping of the nearest points (a closest-point transform): in each of the 8 orders of the
+  // axes a node takes the nearest point of a neighbour behind it when that is nearer than its own.
+  auto sweep = [&] {  // one round of the 8 orders: the slide below mends what it leaves
+    for (int order = 0; order < 8; ++order) {
+      const bool fx = order & 1, fy = order & 2, fz = order & 4;
+      for (int kk = 0; kk < n.z; ++kk)
+        for (int jj = 0; jj < n.y; ++jj)
+          for (int ii = 0; ii < n.x; ++ii) {
+            const int i = fx ? n.x - 1 - ii : ii, j = fy ? n.y - 1 - jj : jj, k = fz ? n.z - 1 - kk : kk;
+            const size_t id = density.index(i, j, k);
+            const glm::dvec3 x = node(i, j, k);
+            const bool has[3] = {fx ? i + 1 < n.x : i > 0, fy ? j + 1 < n.y : j > 0, fz ? k + 1 < n.z : k > 0};
+            const size_t behind[3] = {fx ? id + 1 : id - 1, fy ? id + strideY : id - strideY,
+                                      fz ? id + strideZ : id - strideZ};
+            for (int axis = 0; axis < 3; ++axis) {
+              if (!has[axis] || dist2[behind[axis]] == kNone) continue;
+              const glm::dvec3 e = nearest[behind[axis]] - x;
+              const double d2 = glm::dot(e, e);
+              if (d2 < dist2[id]) nearest[id] = nearest[behind[axis]], dist2[id] = d2;
+            }
+          }
+    }
+  };
+
+  // A nearest point carried from a neighbour is a shell point near the node's own nearest point, not
+  // that point: off by up to a voxel along the shell, which makes the distance too long and ∇S wrong.
+  // Each node slides its point along the shell until x − p lies along the shell's normal at p, the
+  // condition for the nearest point: a step along the tangent plane, then Newton's steps on the
+  // trilinear φ, p ← p − φ ∇φ/|∇φ|², back onto the shell; kept while the distance falls.
+  const double tolerance = 1e-4 * std::abs(iso) + 1e-12;
+  const std::vector<glm::vec3> gradients = nodeGradients(density);
+  auto ontoShell = [&](glm::dvec3& p) {
+    double value = density.sample(p) - iso;
+    for (int step = 0; step < 16 && std::abs(value) > tolerance; ++step) {
+      const glm::dvec3 g = sampleGradient(density, gradients, p);
+      const double g2 = glm::dot(g, g);
+      if (!(g2 > 0.0)) return false;
+      p -= (value / g2) * g;
+      value = density.sample(p) - iso;
+    }
+    return std::abs(value) <= tolerance;
+  };
+  auto slide = [&] {
+    tbb::parallel_for(0, n.z, [&](int k) {
+      for (int j = 0; j < n.y; ++j)
+        for (int i = 0; i < n.x; ++i) {
+          const size_t id = density.index(i, j, k);
+          if (dist2[id] == kNone) continue;
+          const glm::dvec3 x = node(i, j, k);
+          for (int round = 0; round < 6; ++round) {
+            const glm::dvec3 p = nearest[id], g = sampleGradient(density, gradients, p);
+            const double g2 = glm::dot(g, g);
+            if (!(g2 > 0.0)) break;
+            glm::dvec3 across = (x - p) - glm::dot(x - p, g) / g2 * g;
+            const double a2 = glm::dot(across, across);
+            if (a2 <= 1e-6 * dist2[id]) break;
+            if (a2 > h * h) across *= h / std::sqrt(a2);
+            glm::dvec3 q = p + across;
+            if (!ontoShell(q)) break;
+            const double d2 = glm::dot(q - x, q - x);
+            if (!(d2 < dist2[id])) break;
+            nearest[id] = q, dist2[id] = d2;
+          }
+        }
+    });
+  };
+  sweep();
+  slide();
+
+  Grid s = density;
+  const double far = h * (n.x + n.y + n.z);  // a grid without a shell: everything is far outside or inside
+  for (size_t i = 0; i < count; ++i) {
+    const double d = dist2[i] == kNone ? far : std::sqrt(dist2[i]);
+    s.values[i] = static_cast<float>(inside[i] ? -d : d);
+  }
+  return s;
+}
+
+double typicalDensity(const Grid& density) {
+  double sum = 0.0, squares = 0.0;
+  for (float v : density.values) sum += v, squares += double(v) * v;
+  return sum > 0.0 ? squares / sum : 0.0;
+}
+
+HairVolume buildVolume(const Strands& strands, double voxel, int padding, double shellFraction) {
+  HairVolume volume;
+  volume.density = gridAround(strands.points, voxel, padding);
+  splat(volume.density, strands.points);
+  const Grid smooth = smoothed(volume.density);
+  volume.iso = shellFraction * typicalDensity(smooth);
+  volume.distance = signedDistance(smooth, volume.iso);
+  return volume;
+}
+
+std::vector<glm::vec3> volumeNormals(const Grid& distance, const Strands& strands) {
+  const std::vector<glm::vec3> gradients = nodeGradients(distance);
+  std::vector<glm::vec3> normals(strands.pointCount());
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, strands.pointCount(), 8192), [&](const tbb::blocked_range<size_t>& r) {
+    for (size_t p = r.begin(); p != r.end(); ++p) {
+      const glm::dvec3 g = sampleGradient(distance, gradients, glm::dvec3(strands.points[p]));
+      const double len = glm::length(g);
+      normals[p] = len > 1e-12 ? glm::vec3(g / len) : glm::vec3(0, 1, 0);
+    }
+  });
+  return normals;
+}
+
+}  // namespace hairgen
