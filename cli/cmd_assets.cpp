@@ -12,9 +12,11 @@ void registerAssets(CLI::App& app, int& exitCode) {
   };
   auto options = std::make_shared<Options>();
   CLI::App* cmd = app.add_subcommand(
-      "assets", "Generate the bundled head.obj and wick.obj (fitted to the thesis' head ellipsoid) and assets.txt, "
-                "the generator's parameters");
-  cmd->add_option("-o,--output", options->outputDir, "Directory to write into")->default_val("configs/assets");
+      "assets",
+      "Generate the bundled head.obj and wick.obj (fitted to the thesis' head ellipsoid) and assets.txt, "
+      "the generator's parameters");
+  cmd->add_option("-o,--output", options->outputDir, "Directory to write into")
+      ->default_val("configs/assets");
   addCommonFlags(*cmd, options->common, false);
   cmd->footer(exitCodeHelp());
   cmd->callback([options, &exitCode] {
@@ -27,8 +29,9 @@ void registerAssets(CLI::App& app, int& exitCode) {
       stats.counts()["headTriangles"] = assets.head.triangleCount();
       stats.counts()["wickVertices"] = assets.wick.vertexCount();
       stats.counts()["wickTriangles"] = assets.wick.triangleCount();
-      note(options->common, "wrote " + options->outputDir + "/head.obj (" + std::to_string(assets.head.triangleCount()) +
-                                " triangles) and wick.obj (" + std::to_string(assets.wick.vertexCount()) + " follicles)");
+      note(options->common, "wrote " + options->outputDir + "/head.obj (" +
+                                std::to_string(assets.head.triangleCount()) + " triangles) and wick.obj (" +
+                                std::to_string(assets.wick.vertexCount()) + " follicles)");
       stats.write(options->common);
     });
   });

@@ -3,8 +3,8 @@
 
 #include "cli/commands.h"
 #include "cli/common.h"
-#include "libcore/io/obj_io.h"
 #include "libcore/config/setup.h"
+#include "libcore/io/obj_io.h"
 
 namespace hairgen::cli {
 
@@ -17,10 +17,12 @@ void registerCheck(CLI::App& app, int& exitCode) {
   };
   auto options = std::make_shared<Options>();
   CLI::App* cmd = app.add_subcommand(
-      "check", "Validate a Setup and every file it names (configs, meshes); print the effective values and digest");
+      "check",
+      "Validate a Setup and every file it names (configs, meshes); print the effective values and digest");
   cmd->add_option("SETUP", options->setup, "The Setup file")->required();
   cmd->add_flag("--json", options->json, "Print the report as JSON");
-  cmd->add_flag("--canonical", options->canonical, "Print every effective value, one `Section.Key value` a line");
+  cmd->add_flag("--canonical", options->canonical,
+                "Print every effective value, one `Section.Key value` a line");
   addCommonFlags(*cmd, options->common, true);
   cmd->footer(exitCodeHelp());
   cmd->callback([options, &exitCode] {
@@ -36,12 +38,15 @@ void registerCheck(CLI::App& app, int& exitCode) {
       report["collisionShapes"] = config.collision.shapes.size();
       report["superHelixElements"] = config.hairstyle.hairLengths.size();
       report["hairLength"] = config.hairstyle.totalLength();
-      for (auto [ref, key] : {std::pair{&config.setup.wickModel, "wick"}, {&config.setup.headModel, "head"}}) {
+      for (auto [ref, key] :
+           {std::pair{&config.setup.wickModel, "wick"}, {&config.setup.headModel, "head"}}) {
         if (!ref->given()) continue;
         MeshReadStats meshStats;
         Mesh mesh = readObj(ref->path, &meshStats);
-        report[key] = {{"file", ref->path.string()}, {"vertices", mesh.vertexCount()},
-                       {"triangles", mesh.triangleCount()}, {"area_cm2", surfaceArea(mesh) * 1e4},
+        report[key] = {{"file", ref->path.string()},
+                       {"vertices", mesh.vertexCount()},
+                       {"triangles", mesh.triangleCount()},
+                       {"area_cm2", surfaceArea(mesh) * 1e4},
                        {"degenerateFacesDropped", meshStats.degenerateDropped}};
       }
       stats.json()["report"] = report;
@@ -52,11 +57,13 @@ void registerCheck(CLI::App& app, int& exitCode) {
       } else {
         std::cout << options->setup << ": ok, config digest " << config.digest() << "\n";
         std::cout << "  " << config.hairstyle.hairLengths.size() << " Super-Helix elements, hair length "
-                  << config.hairstyle.totalLength() << " m, " << config.collision.shapes.size() << " collision shapes\n";
+                  << config.hairstyle.totalLength() << " m, " << config.collision.shapes.size()
+                  << " collision shapes\n";
         for (const char* key : {"wick", "head"})
           if (report.contains(key))
-            std::cout << "  " << key << " " << report[key]["file"].get<std::string>() << ": " << report[key]["vertices"]
-                      << " vertices, " << report[key]["triangles"] << " triangles\n";
+            std::cout << "  " << key << " " << report[key]["file"].get<std::string>() << ": "
+                      << report[key]["vertices"] << " vertices, " << report[key]["triangles"]
+                      << " triangles\n";
       }
       stats.write(options->common);
     });

@@ -11,7 +11,8 @@ void registerConvert(CLI::App& app, int& exitCode) {
     std::string input, output;
   };
   auto options = std::make_shared<Options>();
-  CLI::App* cmd = app.add_subcommand("convert", "Convert strands between .hair, .gltf and .glb (format from the extension)");
+  CLI::App* cmd = app.add_subcommand(
+      "convert", "Convert strands between .hair, .gltf and .glb (format from the extension)");
   cmd->add_option("IN", options->input, "Input .hair, .gltf or .glb")->required();
   cmd->add_option("OUT", options->output, "Output .hair, .gltf or .glb (written atomically)")->required();
   addCommonFlags(*cmd, options->common, false);
@@ -27,8 +28,8 @@ void registerConvert(CLI::App& app, int& exitCode) {
       stats.time("write", clock.lap());
       stats.counts()["strands"] = strands.strandCount();
       stats.counts()["points"] = strands.pointCount();
-      note(options->common, "wrote " + options->output + " (" + std::to_string(strands.strandCount()) + " strands, " +
-                                std::to_string(strands.pointCount()) + " points)");
+      note(options->common, "wrote " + options->output + " (" + std::to_string(strands.strandCount()) +
+                                " strands, " + std::to_string(strands.pointCount()) + " points)");
       stats.write(options->common);
     });
   });

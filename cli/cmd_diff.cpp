@@ -8,8 +8,8 @@
 
 #include "cli/commands.h"
 #include "cli/common.h"
-#include "libcore/util/error.h"
 #include "libcore/io/exr_io.h"
+#include "libcore/util/error.h"
 
 namespace hairgen::cli {
 namespace {
@@ -34,16 +34,21 @@ void registerDiff(CLI::App& app, int& exitCode) {
     std::vector<std::string> channels;
   };
   auto options = std::make_shared<Options>();
-  CLI::App* cmd = app.add_subcommand(
-      "diff", "Compare two images channel by channel: mean, RMS and max error, the worst pixel, pass or fail (exit 4)");
+  CLI::App* cmd = app.add_subcommand("diff",
+                                     "Compare two images channel by channel: mean, RMS and max error, the "
+                                     "worst pixel, pass or fail (exit 4)");
   cmd->add_option("A", options->a, "The reference image (any format OpenImageIO reads)")->required();
   cmd->add_option("B", options->b, "The image to check")->required();
-  cmd->add_option("--fail", options->fail, "A pixel fails when a channel differs by more than this")->default_val(0.004);
-  cmd->add_option("--failpercent", options->failPercent, "The images fail when more than this percent of pixels fail")
+  cmd->add_option("--fail", options->fail, "A pixel fails when a channel differs by more than this")
+      ->default_val(0.004);
+  cmd->add_option("--failpercent", options->failPercent,
+                  "The images fail when more than this percent of pixels fail")
       ->default_val(0.02);
-  cmd->add_option("--hardfail", options->hardFail, "The images fail when any channel anywhere differs by more than this")
+  cmd->add_option("--hardfail", options->hardFail,
+                  "The images fail when any channel anywhere differs by more than this")
       ->default_val(0.012);
-  cmd->add_option("--channels", options->channels, "Compare only these channels (default: all)")->delimiter(',');
+  cmd->add_option("--channels", options->channels, "Compare only these channels (default: all)")
+      ->delimiter(',');
   cmd->add_option("--out", options->out, "Write |A - B| per channel")->type_name("DIFF.exr");
   cmd->add_flag("--quiet,-q", options->common.quiet, "Print only the verdict");
   cmd->footer(exitCodeHelp());
@@ -100,23 +105,25 @@ void registerDiff(CLI::App& app, int& exitCode) {
       for (char f : failing) failed += f;
       const double failedPercent = pixels ? 100.0 * double(failed) / double(pixels) : 0.0;
       if (!options->common.quiet) {
-        std::cout << "comparing " << options->a << " and " << options->b << ": " << a.width << "x" << a.height << ", "
-                  << names.size() << " channels\n";
+        std::cout << "comparing " << options->a << " and " << options->b << ": " << a.width << "x" << a.height
+                  << ", " << names.size() << " channels\n";
         for (size_t c = 0; c < names.size(); ++c)
           std::cout << "  " << names[c] << ": mean " << number(stats[c].sum / double(pixels)) << "  RMS "
-                    << number(std::sqrt(stats[c].sum2 / double(pixels))) << "  max " << number(stats[c].max) << "\n";
+                    << number(std::sqrt(stats[c].sum2 / double(pixels))) << "  max " << number(stats[c].max)
+                    << "\n";
         if (worst > 0.0) {
           int x = int(worstPixel % size_t(a.width)), y = int(worstPixel / size_t(a.width));
           const std::string& n = names[worstChannel];
-          std::cout << "  worst pixel (" << x << ", " << y << ") channel " << n << ": " << number(a.plane(n)[worstPixel])
-                    << " vs " << number(b.plane(n)[worstPixel]) << "\n";
+          std::cout << "  worst pixel (" << x << ", " << y << ") channel " << n << ": "
+                    << number(a.plane(n)[worstPixel]) << " vs " << number(b.plane(n)[worstPixel]) << "\n";
         }
         std::cout << "  " << failed << " pixels (" << number(failedPercent) << "%) differ by more than "
                   << number(options->fail) << "\n";
       }
       if (!options->out.empty()) writeExr(options->out, difference, {});
       if (worst > options->hardFail)
-        verdict(false, "a difference of " + number(worst) + " is beyond --hardfail " + number(options->hardFail));
+        verdict(false,
+                "a difference of " + number(worst) + " is beyond --hardfail " + number(options->hardFail));
       else if (failedPercent > options->failPercent)
         verdict(false, number(failedPercent) + "% of pixels are beyond --fail " + number(options->fail) +
                            ", more than --failpercent " + number(options->failPercent));

@@ -1,24 +1,30 @@
 // hairgen grow SETUP -o guides.{hair,gltf,glb}: one Super-Helix guide per wick vertex.
 #include "cli/commands.h"
 #include "cli/common.h"
-#include "libcore/util/file_util.h"
+#include "libcore/config/setup.h"
 #include "libcore/io/hair_cache.h"
 #include "libcore/io/obj_io.h"
-#include "libcore/config/setup.h"
+#include "libcore/util/file_util.h"
 #include "stages/grow.h"
 
 namespace hairgen::cli {
 
 namespace {
 
-void writeDiagnostics(const std::string& file, const std::string& setup, const Config& config, const GrowResult& result) {
+void writeDiagnostics(const std::string& file, const std::string& setup, const Config& config,
+                      const GrowResult& result) {
   nlohmann::ordered_json guides = nlohmann::ordered_json::array();
   auto terms = [](const EnergyTerms& e) {
-    return nlohmann::ordered_json{{"elastic", e.elastic}, {"gravity", e.gravity}, {"collision", e.collision}, {"total", e.total()}};
+    return nlohmann::ordered_json{
+        {"elastic", e.elastic}, {"gravity", e.gravity}, {"collision", e.collision}, {"total", e.total()}};
   };
   for (const GuideReport& r : result.reports)
-    guides.push_back({{"follicle", r.follicle}, {"coordinates", r.coordinates}, {"start", terms(r.start)},
-                      {"end", terms(r.end)}, {"stages", r.stages}, {"evaluations", r.evaluations},
+    guides.push_back({{"follicle", r.follicle},
+                      {"coordinates", r.coordinates},
+                      {"start", terms(r.start)},
+                      {"end", terms(r.end)},
+                      {"stages", r.stages},
+                      {"evaluations", r.evaluations},
                       {"stoppedOn", name(r.stop)}});
   nlohmann::ordered_json doc = {{"setup", setup}, {"configDigest", config.digest()}, {"guides", guides}};
   writeFileAtomic(file, doc.dump(1) + "\n");
@@ -27,7 +33,8 @@ void writeDiagnostics(const std::string& file, const std::string& setup, const C
 }  // namespace
 
 GrowResult growStage(const CommonOptions& common, const Config& config, const Mesh& wick, Stats& stats) {
-  note(common, "grow: " + std::to_string(wick.vertexCount()) + " guides from " + config.setup.wickModel.path.string());
+  note(common, "grow: " + std::to_string(wick.vertexCount()) + " guides from " +
+                   config.setup.wickModel.path.string());
   Stopwatch clock;
   Progress progress("grow", "guides", wick.vertexCount(), !common.quiet);
   GrowResult result = grow(wick, config.hairstyle, config.collision, GrowOptions{config.digest(), &progress});
@@ -53,13 +60,17 @@ void registerGrow(CLI::App& app, int& exitCode) {
   };
   auto options = std::make_shared<Options>();
   CLI::App* cmd = app.add_subcommand(
-      "grow", "Grow one guide per wick vertex: a Super-Helix at its static equilibrium (elasticity, gravity, "
+      "grow",
+      "Grow one guide per wick vertex: a Super-Helix at its static equilibrium (elasticity, gravity, "
       "collisions), or Anjyo's cantilever beam (Model cantilever)");
   cmd->add_option("SETUP", options->setup, "The Setup file")->required();
-  cmd->add_option("-o,--output", options->output, "Guides to write: .hair, .gltf or .glb (written atomically)")->required();
-  cmd->add_option("--diagnostics", options->diagnostics,
-                  "Write per guide: follicle, generalised coordinates, energy terms at start and end, stages, "
-                  "evaluations, why it stopped")
+  cmd->add_option("-o,--output", options->output,
+                  "Guides to write: .hair, .gltf or .glb (written atomically)")
+      ->required();
+  cmd->add_option(
+         "--diagnostics", options->diagnostics,
+         "Write per guide: follicle, generalised coordinates, energy terms at start and end, stages, "
+         "evaluations, why it stopped")
       ->type_name("FILE.json");
   addCommonFlags(*cmd, options->common, true);
   cmd->footer(exitCodeHelp());
@@ -72,7 +83,8 @@ void registerGrow(CLI::App& app, int& exitCode) {
       Mesh wick = readObj(config.setup.wickModel.path);
       stats.time("read", clock.lap());
       GrowResult result = growStage(options->common, config, wick, stats);
-      if (!options->diagnostics.empty()) writeDiagnostics(options->diagnostics, options->setup, config, result);
+      if (!options->diagnostics.empty())
+        writeDiagnostics(options->diagnostics, options->setup, config, result);
       writeStrands(options->output, result.guides);
       stats.time("write", clock.lap());
       note(options->common, "grow: wrote " + options->output);

@@ -1,9 +1,9 @@
 // hairgen interpolate SETUP --guides FILE -o coupe.{hair,gltf,glb}: the full coupe from the guides.
 #include "cli/commands.h"
 #include "cli/common.h"
+#include "libcore/config/setup.h"
 #include "libcore/io/hair_cache.h"
 #include "libcore/io/obj_io.h"
-#include "libcore/config/setup.h"
 #include "libcore/util/text.h"
 #include "stages/interpolate.h"
 
@@ -16,11 +16,14 @@ void registerInterpolate(CLI::App& app, int& exitCode) {
   };
   auto options = std::make_shared<Options>();
   CLI::App* cmd = app.add_subcommand(
-      "interpolate", "Fill every wick triangle with strands blended from its corner guides (clumping, stray hairs)");
+      "interpolate",
+      "Fill every wick triangle with strands blended from its corner guides (clumping, stray hairs)");
   cmd->add_option("SETUP", options->setup, "The Setup file")->required();
-  cmd->add_option("--guides", options->guides, "Guides from `hairgen grow` on the same Setup (.hair, .gltf, .glb)")
+  cmd->add_option("--guides", options->guides,
+                  "Guides from `hairgen grow` on the same Setup (.hair, .gltf, .glb)")
       ->required();
-  cmd->add_option("-o,--output", options->output, "Coupe to write: .hair, .gltf or .glb (written atomically)")->required();
+  cmd->add_option("-o,--output", options->output, "Coupe to write: .hair, .gltf or .glb (written atomically)")
+      ->required();
   addCommonFlags(*cmd, options->common, true);
   cmd->footer(exitCodeHelp());
   cmd->callback([options, &exitCode] {
@@ -41,8 +44,8 @@ void registerInterpolate(CLI::App& app, int& exitCode) {
   });
 }
 
-Strands interpolateStage(const CommonOptions& common, const Config& config, const Mesh& wick, const Strands& guides,
-                         const std::string& guidesName, Stats& stats) {
+Strands interpolateStage(const CommonOptions& common, const Config& config, const Mesh& wick,
+                         const Strands& guides, const std::string& guidesName, Stats& stats) {
   note(common, "interpolate: " + std::to_string(wick.triangles.size()) + " triangles at " +
                    formatReal(config.hairstyle.hairDensity) + " strands/cm²");
   Stopwatch clock;

@@ -5,12 +5,12 @@
 
 #include "cli/commands.h"
 #include "cli/common.h"
-#include "libcore/util/error.h"
+#include "libcore/config/setup.h"
 #include "libcore/io/exr_io.h"
-#include "libcore/render/gl_context.h"
 #include "libcore/io/hair_cache.h"
 #include "libcore/io/obj_io.h"
-#include "libcore/config/setup.h"
+#include "libcore/render/gl_context.h"
+#include "libcore/util/error.h"
 #include "libcore/util/text.h"
 
 namespace hairgen::cli {
@@ -55,13 +55,14 @@ void frameHair(RenderSettings& r, const Strands& hair) {
 
 }  // namespace
 
-RenderOutput renderStage(const CommonOptions& common, const Config& config, const Strands& hair, const Mesh* head,
-                         bool keepDom, Stats& stats) {
+RenderOutput renderStage(const CommonOptions& common, const Config& config, const Strands& hair,
+                         const Mesh* head, bool keepDom, Stats& stats) {
   Stopwatch clock;
   GlContext gl;
   stats.time("device", clock.lap());
-  note(common, "render: " + gl.renderer() + " through EGL " + gl.platform() + ", " + std::to_string(hair.strandCount()) +
-                   " strands at " + std::to_string(config.render.resolution.x) + "x" +
+  note(common, "render: " + gl.renderer() + " through EGL " + gl.platform() + ", " +
+                   std::to_string(hair.strandCount()) + " strands at " +
+                   std::to_string(config.render.resolution.x) + "x" +
                    std::to_string(config.render.resolution.y));
   RenderInput input;
   input.hair = &hair;
@@ -79,15 +80,16 @@ RenderOutput renderStage(const CommonOptions& common, const Config& config, cons
   stats.counts()["strands"] = hair.strandCount();
   stats.counts()["points"] = hair.pointCount();
   stats.counts()["samples"] = out.samples;
-  stats.json()["device"] = {{"platform", gl.platform()}, {"renderer", gl.renderer()}, {"version", gl.version()}};
+  stats.json()["device"] = {
+      {"platform", gl.platform()}, {"renderer", gl.renderer()}, {"version", gl.version()}};
   if (out.samples != config.render.samples)
     note(common, "render: the device offers " + std::to_string(out.samples) + " samples; Samples " +
                      std::to_string(config.render.samples) + " was asked for");
   return out;
 }
 
-void writeRenderOutputs(const Config& config, const RenderOutput& out, const std::string& exr, const std::string& dom,
-                        const std::string& preview) {
+void writeRenderOutputs(const Config& config, const RenderOutput& out, const std::string& exr,
+                        const std::string& dom, const std::string& preview) {
   ExrMetadata meta;
   meta.strings["producer"] = "hairgen " HAIRGEN_VERSION;
   meta.strings["hairgen:configDigest"] = config.digest();
@@ -100,10 +102,9 @@ void writeRenderOutputs(const Config& config, const RenderOutput& out, const std
   if (!dom.empty()) {
     ExrMetadata domMeta;
     domMeta.strings = meta.strings;
-    domMeta.strings["hairgen:layerSizes"] = std::to_string(config.render.layerSizes.x) + " " +
-                                            std::to_string(config.render.layerSizes.y) + " " +
-                                            std::to_string(config.render.layerSizes.z) + " " +
-                                            std::to_string(config.render.layerSizes.w);
+    domMeta.strings["hairgen:layerSizes"] =
+        std::to_string(config.render.layerSizes.x) + " " + std::to_string(config.render.layerSizes.y) + " " +
+        std::to_string(config.render.layerSizes.z) + " " + std::to_string(config.render.layerSizes.w);
     domMeta.camera = true;
     domMeta.worldToCamera = out.worldToLight;
     domMeta.worldToNdc = out.worldToLight;
@@ -121,16 +122,23 @@ void registerRender(CLI::App& app, int& exitCode) {
   };
   auto options = std::make_shared<Options>();
   CLI::App* cmd = app.add_subcommand(
-      "render", "Render a coupe headless (EGL): Kajiya-Kay hair, Lambert head, deep opacity map shadows, to EXR");
+      "render",
+      "Render a coupe headless (EGL): Kajiya-Kay hair, Lambert head, deep opacity map shadows, to EXR");
   cmd->add_option("SETUP", options->setup, "The Setup file (Visuality and Render Info, the head)");
-  cmd->add_option("--hair", options->hair, "The coupe: .hair (also cyHair files made elsewhere), .gltf or .glb");
-  cmd->add_option("-o,--output", options->output, "Image to write: .exr with R G B A (half), Z, opacity, shadow");
-  cmd->add_option("--dom", options->dom, "Also write the light's maps: Z where the hair begins and the 4 opacity layers")
+  cmd->add_option("--hair", options->hair,
+                  "The coupe: .hair (also cyHair files made elsewhere), .gltf or .glb");
+  cmd->add_option("-o,--output", options->output,
+                  "Image to write: .exr with R G B A (half), Z, opacity, shadow");
+  cmd->add_option("--dom", options->dom,
+                  "Also write the light's maps: Z where the hair begins and the 4 opacity layers")
       ->type_name("FILE.exr");
-  cmd->add_option("--preview", options->preview, "Also write a tone-mapped sRGB preview")->type_name("FILE.png");
-  cmd->add_option("--up-axis", options->upAxis, "The hair file's up axis; z turns z-up hair to hairgen's y-up")
+  cmd->add_option("--preview", options->preview, "Also write a tone-mapped sRGB preview")
+      ->type_name("FILE.png");
+  cmd->add_option("--up-axis", options->upAxis,
+                  "The hair file's up axis; z turns z-up hair to hairgen's y-up")
       ->check(CLI::IsMember({"y", "z"}));
-  cmd->add_option("--scale", options->scale, "Multiply the hair's positions and widths (e.g. 0.01 for centimetres)")
+  cmd->add_option("--scale", options->scale,
+                  "Multiply the hair's positions and widths (e.g. 0.01 for centimetres)")
       ->check(CLI::PositiveNumber);
   cmd->add_flag("--frame", options->frame, "Aim the camera and light at the hair and fit it in the view");
   cmd->add_flag("--list-devices", options->listDevices, "List the EGL devices and platforms found, and exit");
@@ -157,20 +165,22 @@ void registerRender(CLI::App& app, int& exitCode) {
       Strands hair = readStrands(options->hair);
       if (config.render.shadingModel == ShadingModel::kVolumetric && config.render.volumetricBlend > 0.0 &&
           hair.normals.empty())
-        throw InputError({options->hair, 0}, "ShadingModel volumetric needs the coupe's volume normals, and this one has "
-                                             "none; run `hairgen shade SETUP --hair " + options->hair +
-                                             " -o shaded.hair` and render that");
+        throw InputError({options->hair, 0},
+                         "ShadingModel volumetric needs the coupe's volume normals, and this one has "
+                         "none; run `hairgen shade SETUP --hair " +
+                             options->hair + " -o shaded.hair` and render that");
       conform(hair, options->upAxis, options->scale);
       std::optional<Mesh> head;
       if (config.setup.headModel.given()) head = readObj(config.setup.headModel.path);
       if (options->frame) frameHair(config.render, hair);
       stats.time("read", clock.lap());
-      RenderOutput out = renderStage(options->common, config, hair, head ? &*head : nullptr, !options->dom.empty(), stats);
+      RenderOutput out =
+          renderStage(options->common, config, hair, head ? &*head : nullptr, !options->dom.empty(), stats);
       clock.lap();
       writeRenderOutputs(config, out, options->output, options->dom, options->preview);
       stats.time("write", clock.lap());
-      note(options->common, "render: wrote " + options->output +
-                                (options->preview.empty() ? "" : " and " + options->preview));
+      note(options->common,
+           "render: wrote " + options->output + (options->preview.empty() ? "" : " and " + options->preview));
       stats.write(options->common);
     });
   });

@@ -1,16 +1,16 @@
 // hairgen run [SETUP] [-o DIR]: the stages in one process, with the same files the stages give when
 // chained by hand. With no SETUP it runs the bundled default coupe.
 #include <cstdlib>
+#include <filesystem>
 #include <iostream>
 #include <optional>
-#include <filesystem>
 
 #include "cli/commands.h"
 #include "cli/common.h"
-#include "libcore/util/error.h"
+#include "libcore/config/setup.h"
 #include "libcore/io/hair_cache.h"
 #include "libcore/io/obj_io.h"
-#include "libcore/config/setup.h"
+#include "libcore/util/error.h"
 #include "stages/shade.h"
 
 namespace hairgen::cli {
@@ -22,7 +22,8 @@ namespace fs = std::filesystem;
 // in an installed share/hairgen.
 fs::path defaultSetup() {
   std::vector<fs::path> candidates;
-  if (const char* data = std::getenv("HAIRGEN_DATA"); data && *data) candidates.push_back(fs::path(data) / "configs/default/setup.txt");
+  if (const char* data = std::getenv("HAIRGEN_DATA"); data && *data)
+    candidates.push_back(fs::path(data) / "configs/default/setup.txt");
   std::error_code ec;
   fs::path exe = fs::read_symlink("/proc/self/exe", ec);
   if (!ec) {
@@ -33,8 +34,9 @@ fs::path defaultSetup() {
   }
   for (const fs::path& c : candidates)
     if (fs::is_regular_file(c, ec)) return c;
-  throw InputError("no SETUP given and the default coupe (configs/default/setup.txt) was not found next to the "
-                   "executable; name a Setup file or set HAIRGEN_DATA to the folder that holds configs/");
+  throw InputError(
+      "no SETUP given and the default coupe (configs/default/setup.txt) was not found next to the "
+      "executable; name a Setup file or set HAIRGEN_DATA to the folder that holds configs/");
 }
 
 }  // namespace
@@ -46,12 +48,15 @@ void registerRun(CLI::App& app, int& exitCode) {
     bool noRender = false;
   };
   auto options = std::make_shared<Options>();
-  CLI::App* cmd = app.add_subcommand(
-      "run", "Run the stages in one process: grow and interpolate (or Load a saved coupe), shade when the Setup asks, "
-             "then render; writes DIR/guides.hair, DIR/coupe.hair, DIR/shaded.hair, DIR/beauty.exr and DIR/beauty.png, "
-             "each equal to what the stage run alone writes");
+  CLI::App* cmd = app.add_subcommand("run",
+                                     "Run the stages in one process: grow and interpolate (or Load a saved "
+                                     "coupe), shade when the Setup asks, "
+                                     "then render; writes DIR/guides.hair, DIR/coupe.hair, DIR/shaded.hair, "
+                                     "DIR/beauty.exr and DIR/beauty.png, "
+                                     "each equal to what the stage run alone writes");
   cmd->add_option("SETUP", options->setup, "The Setup file (default: the bundled configs/default/setup.txt)");
-  cmd->add_option("-o,--output", options->outDir, "Output folder (default: out/NAME, NAME the Setup's folder)")
+  cmd->add_option("-o,--output", options->outDir,
+                  "Output folder (default: out/NAME, NAME the Setup's folder)")
       ->type_name("DIR");
   cmd->add_flag("--no-render", options->noRender, "Stop after the coupe (no EXR, no preview)");
   addCommonFlags(*cmd, options->common, true);
@@ -60,13 +65,15 @@ void registerRun(CLI::App& app, int& exitCode) {
     exitCode = runCommand("run", options->common, [&] {
       Stats stats("run");
       fs::path setup = options->setup.empty() ? defaultSetup() : fs::path(options->setup);
-      fs::path out = options->outDir.empty() ? fs::path("out") / fs::absolute(setup).parent_path().filename() : fs::path(options->outDir);
+      fs::path out = options->outDir.empty() ? fs::path("out") / fs::absolute(setup).parent_path().filename()
+                                             : fs::path(options->outDir);
       Stopwatch clock;
       Config config = loadStageConfig(setup, options->common, SetupUse::kRun, stats);
       stats.time("read", clock.lap());
       std::error_code made;
       fs::create_directories(out, made);
-      if (made) throw InputError("-o " + out.string() + ": cannot create the output folder: " + made.message());
+      if (made)
+        throw InputError("-o " + out.string() + ": cannot create the output folder: " + made.message());
 
       Strands coupe;
       if (config.setup.load) {
@@ -100,11 +107,13 @@ void registerRun(CLI::App& app, int& exitCode) {
       if (!options->noRender) {
         std::optional<Mesh> head;
         if (config.setup.headModel.given()) head = readObj(config.setup.headModel.path);
-        RenderOutput image = renderStage(options->common, config, coupe, head ? &*head : nullptr, false, stats);
+        RenderOutput image =
+            renderStage(options->common, config, coupe, head ? &*head : nullptr, false, stats);
         clock.lap();
         writeRenderOutputs(config, image, (out / "beauty.exr").string(), "", (out / "beauty.png").string());
         stats.add("write", clock.lap());
-        note(options->common, "run: wrote " + (out / "beauty.exr").string() + " and " + (out / "beauty.png").string());
+        note(options->common,
+             "run: wrote " + (out / "beauty.exr").string() + " and " + (out / "beauty.png").string());
       }
       stats.write(options->common);
     });

@@ -7,16 +7,17 @@
 
 #include "cli/commands.h"
 #include "cli/common.h"
-#include "libcore/io/hair_cache.h"
 #include "libcore/config/setup.h"
-#include "libcore/util/text.h"
+#include "libcore/io/hair_cache.h"
 #include "libcore/io/vdb_io.h"
+#include "libcore/util/text.h"
 #include "stages/shade.h"
 
 namespace hairgen::cli {
 
 ShadeResult shadeStage(const CommonOptions& common, const Config& config, Strands coupe, Stats& stats) {
-  ShadeResult result = shade(std::move(coupe), config.visuality, config.render, config.hairstyle.seed, config.digest());
+  ShadeResult result =
+      shade(std::move(coupe), config.visuality, config.render, config.hairstyle.seed, config.digest());
   const Strands& shaded = result.coupe;
   const Grid& grid = result.volume.density;
   stats.time("volume", result.timings.volume);
@@ -27,9 +28,10 @@ ShadeResult shadeStage(const CommonOptions& common, const Config& config, Strand
   stats.counts()["voxel_size"] = grid.voxel;
   stats.counts()["shell_density"] = result.volume.iso;
   std::ostringstream line;
-  line << "shade: " << grid.size.x << "×" << grid.size.y << "×" << grid.size.z << " grid (VoxelSize " << formatReal(grid.voxel)
-       << "), shell at " << std::setprecision(3) << result.volume.iso << std::setprecision(6) << " points/voxel, normals on "
-       << shaded.pointCount() << " vertices in " << formatSeconds(result.timings.volume + result.timings.normals);
+  line << "shade: " << grid.size.x << "×" << grid.size.y << "×" << grid.size.z << " grid (VoxelSize "
+       << formatReal(grid.voxel) << "), shell at " << std::setprecision(3) << result.volume.iso
+       << std::setprecision(6) << " points/voxel, normals on " << shaded.pointCount() << " vertices in "
+       << formatSeconds(result.timings.volume + result.timings.normals);
   if (wantsAmbient(config.visuality))
     line << "; per-strand ambient from N(" << formatReal(config.visuality.ambientMean) << ", "
          << formatReal(config.visuality.ambientDeviation) << ")";
@@ -45,19 +47,24 @@ void registerShade(CLI::App& app, int& exitCode) {
   auto options = std::make_shared<Options>();
   CLI::App* cmd = app.add_subcommand(
       "shade",
-      "Shading attributes into the cache: volumetric normals from the hair's density grid and shell (Render Info's "
-      "VoxelSize, VolumePadding, ShellDensity), and a per-strand ambient from N(AmbientMean, AmbientDeviation) when "
+      "Shading attributes into the cache: volumetric normals from the hair's density grid and shell (Render "
+      "Info's "
+      "VoxelSize, VolumePadding, ShellDensity), and a per-strand ambient from N(AmbientMean, "
+      "AmbientDeviation) when "
       "Visuality Info asks. With --rest, re-poses a shaded rest coupe's normals onto a deformed one instead");
-  cmd->add_option("SETUP", options->first,
-                  "The Setup file (Render Info, Visuality Info, Hairstyle's Seed); with --rest, the deformed coupe")
+  cmd->add_option(
+         "SETUP", options->first,
+         "The Setup file (Render Info, Visuality Info, Hairstyle's Seed); with --rest, the deformed coupe")
       ->type_name("SETUP|COUPE");
   cmd->add_option("--hair", options->hair, "The coupe (.hair, .gltf, .glb)");
-  cmd->add_option("--rest", options->rest, "A coupe shaded at rest; its normals are carried onto the coupe by "
-                                           "parallel-transport frames, with no volume built")
+  cmd->add_option("--rest", options->rest,
+                  "A coupe shaded at rest; its normals are carried onto the coupe by "
+                  "parallel-transport frames, with no volume built")
       ->type_name("REST");
   cmd->add_option("-o,--output", options->output, "Shaded coupe to write (.hair, .gltf, .glb)")->required();
-  cmd->add_option("--vdb", options->vdb, "Also write the density and signed-distance grids as OpenVDB float grids "
-                                         "named 'density' and 'sdf'")
+  cmd->add_option("--vdb", options->vdb,
+                  "Also write the density and signed-distance grids as OpenVDB float grids "
+                  "named 'density' and 'sdf'")
       ->type_name("FILE.vdb");
   addCommonFlags(*cmd, options->common, true);
   cmd->footer(exitCodeHelp());
@@ -69,9 +76,11 @@ void registerShade(CLI::App& app, int& exitCode) {
       if (!options->rest.empty()) {
         if (!options->vdb.empty()) throw InputError("--vdb needs a volume, which --rest does not build");
         if (!options->hair.empty() && !options->first.empty())
-          throw InputError("with --rest no Setup is read: give the deformed coupe once, as --hair or on its own");
+          throw InputError(
+              "with --rest no Setup is read: give the deformed coupe once, as --hair or on its own");
         const std::string& coupeFile = options->hair.empty() ? options->first : options->hair;
-        if (coupeFile.empty()) throw InputError("--rest needs the deformed coupe: hairgen shade --rest REST COUPE -o OUT");
+        if (coupeFile.empty())
+          throw InputError("--rest needs the deformed coupe: hairgen shade --rest REST COUPE -o OUT");
         Strands rest = readStrands(options->rest), deformed = readStrands(coupeFile);
         stats.time("read", clock.lap());
         Strands out = repose(rest, deformed);
@@ -80,8 +89,8 @@ void registerShade(CLI::App& app, int& exitCode) {
         stats.counts()["points"] = out.pointCount();
         writeStrands(options->output, out);
         stats.time("write", clock.lap());
-        note(options->common, "shade: re-posed " + std::to_string(out.pointCount()) + " normals from " + options->rest +
-                                  "; wrote " + options->output);
+        note(options->common, "shade: re-posed " + std::to_string(out.pointCount()) + " normals from " +
+                                  options->rest + "; wrote " + options->output);
         stats.write(options->common);
         return;
       }
@@ -110,7 +119,8 @@ void registerShade(CLI::App& app, int& exitCode) {
         throw;
       }
       stats.time("write", clock.lap());
-      note(options->common, "shade: wrote " + options->output + (options->vdb.empty() ? "" : " and " + options->vdb));
+      note(options->common,
+           "shade: wrote " + options->output + (options->vdb.empty() ? "" : " and " + options->vdb));
       stats.write(options->common);
     });
   });

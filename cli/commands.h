@@ -8,8 +8,8 @@
 #include <CLI/CLI.hpp>
 
 #include "cli/common.h"
-#include "libcore/model/mesh.h"
 #include "libcore/config/params.h"
+#include "libcore/model/mesh.h"
 #include "libcore/model/strands.h"
 #include "libcore/render/renderer.h"
 #include "stages/grow.h"
@@ -29,13 +29,13 @@ void registerShade(CLI::App& app, int& exitCode);
 void registerDiff(CLI::App& app, int& exitCode);
 
 GrowResult growStage(const CommonOptions& common, const Config& config, const Mesh& wick, Stats& stats);
-Strands interpolateStage(const CommonOptions& common, const Config& config, const Mesh& wick, const Strands& guides,
-                         const std::string& guidesName, Stats& stats);
+Strands interpolateStage(const CommonOptions& common, const Config& config, const Mesh& wick,
+                         const Strands& guides, const std::string& guidesName, Stats& stats);
 ShadeResult shadeStage(const CommonOptions& common, const Config& config, Strands coupe, Stats& stats);
-RenderOutput renderStage(const CommonOptions& common, const Config& config, const Strands& hair, const Mesh* head,
-                         bool keepDom, Stats& stats);
+RenderOutput renderStage(const CommonOptions& common, const Config& config, const Strands& hair,
+                         const Mesh* head, bool keepDom, Stats& stats);
 // Writes the EXR, and the light's maps and the preview where named (empty: not wanted).
-void writeRenderOutputs(const Config& config, const RenderOutput& out, const std::string& exr, const std::string& dom,
-                        const std::string& preview);
+void writeRenderOutputs(const Config& config, const RenderOutput& out, const std::string& exr,
+                        const std::string& dom, const std::string& preview);
 
 }  // namespace hairgen::cli

@@ -13,19 +13,24 @@
 namespace hairgen::cli {
 
 void addCommonFlags(CLI::App& command, CommonOptions& options, bool configFlags) {
-  command.add_option("--threads", options.threads, "Worker threads; 0 uses every core (output is identical for any value)")
+  command
+      .add_option("--threads", options.threads,
+                  "Worker threads; 0 uses every core (output is identical for any value)")
       ->default_val(0)
       ->check(CLI::Range(0, 4096));
   command.add_flag("--quiet,-q", options.quiet, "Print nothing but errors");
-  command.add_option("--stats", options.statsFile, "Write timings and counts as JSON to FILE (for farm scripts)")
+  command
+      .add_option("--stats", options.statsFile, "Write timings and counts as JSON to FILE (for farm scripts)")
       ->type_name("FILE.json");
   if (!configFlags) return;
-  command.add_option("--seed", options.seed, "Seed of every random number (overrides Hairstyle.Seed)")->type_name("N");
+  command.add_option("--seed", options.seed, "Seed of every random number (overrides Hairstyle.Seed)")
+      ->type_name("N");
   command
-      .add_option("--set", options.sets,
-                  "Override a config value without editing files, e.g. --set Hairstyle.HairDensity=160 "
-                  "(repeatable; sections Setup, Hairstyle, Collision, Visuality, Render; a repeatable key such as "
-                  "Collision.Sphere replaces all its lines)")
+      .add_option(
+          "--set", options.sets,
+          "Override a config value without editing files, e.g. --set Hairstyle.HairDensity=160 "
+          "(repeatable; sections Setup, Hairstyle, Collision, Visuality, Render; a repeatable key such as "
+          "Collision.Sphere replaces all its lines)")
       ->type_name("Section.Key=VALUE")
       ->take_all()
       ->allow_extra_args(false);
@@ -52,7 +57,8 @@ void Stats::setOverrides(const std::vector<Override>& overrides) {
 }
 
 void Stats::write(const CommonOptions& options) {
-  json_["seconds"]["total"] = std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
+  json_["seconds"]["total"] =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
   if (!options.statsFile.empty()) writeFileAtomic(options.statsFile, json_.dump(2) + "\n");
 }
 
@@ -76,7 +82,8 @@ int runCommand(const std::string& command, const CommonOptions& options, const s
   }
 }
 
-Config loadStageConfig(const std::filesystem::path& setup, const CommonOptions& options, SetupUse use, Stats& stats) {
+Config loadStageConfig(const std::filesystem::path& setup, const CommonOptions& options, SetupUse use,
+                       Stats& stats) {
   std::vector<Override> overrides = parseOverrides(options);
   stats.setOverrides(overrides);
   return loadConfig(setup, overrides, use);

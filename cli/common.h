@@ -10,19 +10,19 @@
 #include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
 
-#include "libcore/util/error.h"
 #include "libcore/config/params.h"
 #include "libcore/config/setup.h"
+#include "libcore/util/error.h"
 #include "libcore/util/stopwatch.h"
 
 namespace hairgen::cli {
 
 struct CommonOptions {
-  int threads = 0;                     // 0 = every core
-  std::optional<uint64_t> seed;        // overrides Hairstyle.Seed
-  std::vector<std::string> sets;       // --set Section.Key=VALUE, as given
+  int threads = 0;                // 0 = every core
+  std::optional<uint64_t> seed;   // overrides Hairstyle.Seed
+  std::vector<std::string> sets;  // --set Section.Key=VALUE, as given
   bool quiet = false;
-  std::string statsFile;               // --stats FILE.json
+  std::string statsFile;  // --stats FILE.json
 };
 
 // Registers --threads, --quiet and --stats; with `configFlags` also --seed and --set.
@@ -37,7 +37,9 @@ class Stats {
   explicit Stats(std::string command);
   void time(const std::string& phase, double seconds) { json_["seconds"][phase] = seconds; }
   // Adds to a phase's time (a phase done in several pieces).
-  void add(const std::string& phase, double seconds) { time(phase, json_["seconds"].value(phase, 0.0) + seconds); }
+  void add(const std::string& phase, double seconds) {
+    time(phase, json_["seconds"].value(phase, 0.0) + seconds);
+  }
   nlohmann::ordered_json& counts() { return json_["counts"]; }
   nlohmann::ordered_json& json() { return json_; }
   void setOverrides(const std::vector<Override>& overrides);
@@ -58,7 +60,8 @@ struct ExitWith {
 };
 
 // Parses --set and --seed, records them in `stats`, and reads the Setup for `use`.
-Config loadStageConfig(const std::filesystem::path& setup, const CommonOptions& options, SetupUse use, Stats& stats);
+Config loadStageConfig(const std::filesystem::path& setup, const CommonOptions& options, SetupUse use,
+                       Stats& stats);
 
 // Runs one command body with the thread limit applied, catching every error once: prints
 // "hairgen CMD: error: FILE:LINE: message" and returns the documented exit code.

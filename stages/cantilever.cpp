@@ -43,7 +43,7 @@ double angleBetween(const glm::dvec3& a, const glm::dvec3& b) {
 double cantileverDeflection(double load, double d, double rigidity, int k, int i) {
   const double span = double(k - i + 1);
   const double moment = -load * d * span * span / 2.0;  // (2)
-  return -0.5 * (moment / rigidity) * d * d;             // (3)
+  return -0.5 * (moment / rigidity) * d * d;            // (3)
 }
 
 std::vector<glm::dvec3> bendHair(const glm::dvec3& pore, const glm::dvec3& normal, const Hairstyle& style,
@@ -51,7 +51,8 @@ std::vector<glm::dvec3> bendHair(const glm::dvec3& pore, const glm::dvec3& norma
   const int k = style.segments;
   const double length = style.totalLength(), d = length / k;
   const double a = style.hairRadius1, b = style.hairRadius2;
-  const double rigidity = style.flexuralRigidity > 0.0 ? style.flexuralRigidity : style.young * M_PI * a * b * b * b / 4.0;
+  const double rigidity =
+      style.flexuralRigidity > 0.0 ? style.flexuralRigidity : style.young * M_PI * a * b * b * b / 4.0;
   const double massPerLength = style.density * M_PI * a * b;
   const double limit = glm::radians(style.jointLimit);
   std::vector<glm::dvec3> p{pore};
@@ -69,8 +70,10 @@ std::vector<glm::dvec3> bendHair(const glm::dvec3& pore, const glm::dvec3& norma
     if (magnitude > 0.0) {
       const glm::dvec3 a1 = across / magnitude;
       const glm::dvec3 a2 = glm::cross(a0, a1);
-      const double y1 = cantileverDeflection(massPerLength * d * glm::dot(acceleration, a1), d, rigidity, k, i);
-      const double y2 = cantileverDeflection(massPerLength * d * glm::dot(acceleration, a2), d, rigidity, k, i);
+      const double y1 =
+          cantileverDeflection(massPerLength * d * glm::dot(acceleration, a1), d, rigidity, k, i);
+      const double y2 =
+          cantileverDeflection(massPerLength * d * glm::dot(acceleration, a2), d, rigidity, k, i);
       deflection = y1 * a1 + y2 * a2;
     }
     glm::dvec3 dir = glm::normalize(d * a0 + deflection);
@@ -107,9 +110,10 @@ std::vector<glm::dvec3> bendHair(const glm::dvec3& pore, const glm::dvec3& norma
 
 glm::dvec2 porePolar(const glm::dvec3& pore, const CollisionShape* head) {
   glm::dvec3 v = head ? pore - head->centre : pore;
-  glm::dvec3 local = head ? glm::dvec3(glm::dot(v, head->axes[0]), glm::dot(v, head->axes[1]), glm::dot(v, head->axes[2])) /
-                                head->halfExtents
-                          : v;
+  glm::dvec3 local =
+      head ? glm::dvec3(glm::dot(v, head->axes[0]), glm::dot(v, head->axes[1]), glm::dot(v, head->axes[2])) /
+                 head->halfExtents
+           : v;
   double azimuth = glm::degrees(std::atan2(local.x, local.z));
   double zenith = glm::degrees(std::atan2(std::hypot(local.x, local.z), local.y));
   return {azimuth, zenith};

@@ -8,8 +8,8 @@
 
 #include <glm/glm.hpp>
 
-#include "libcore/model/mesh.h"
 #include "libcore/config/params.h"
+#include "libcore/model/mesh.h"
 #include "stages/grow.h"
 
 namespace hairgen {

@@ -11,7 +11,8 @@
 
 namespace hairgen {
 
-GuideReport growGuide(const RodFrame& root, double envelope, const Hairstyle& style, const Collision& collision) {
+GuideReport growGuide(const RodFrame& root, double envelope, const Hairstyle& style,
+                      const Collision& collision) {
   StrandEnergy energy(style, collision, root, envelope);
   RosenbrockOptions options;
   options.maxStages = style.maxIter;
@@ -50,14 +51,16 @@ std::vector<double> follicleEnvelopes(const Mesh& wick) {
   return out;
 }
 
-GrowResult grow(const Mesh& wick, const Hairstyle& style, const Collision& collision, const GrowOptions& options) {
+GrowResult grow(const Mesh& wick, const Hairstyle& style, const Collision& collision,
+                const GrowOptions& options) {
   const size_t count = wick.vertexCount();
   if (count == 0) throw InputError("the wick has no vertices");
   if (style.hairLengths.empty()) throw InputError("HairLengths is empty");
   for (size_t i = 0; i < count; ++i) {
     const glm::vec3& n = wick.normals[i];
     if (!std::isfinite(n.x) || !std::isfinite(n.y) || !std::isfinite(n.z) || glm::length(n) < 1e-6f)
-      throw InputError("wick vertex " + std::to_string(i) + " has a zero or non-finite normal; a follicle needs a direction");
+      throw InputError("wick vertex " + std::to_string(i) +
+                       " has a zero or non-finite normal; a follicle needs a direction");
   }
   if (style.model == StylingModel::kCantilever) return growCantilever(wick, style, collision, options);
   const std::vector<double> envelopes = follicleEnvelopes(wick);

@@ -5,17 +5,17 @@
 #include <string>
 #include <vector>
 
-#include "libcore/model/mesh.h"
 #include "libcore/config/params.h"
-#include "libcore/util/progress.h"
+#include "libcore/model/mesh.h"
+#include "libcore/model/strands.h"
 #include "libcore/physics/rosenbrock.h"
 #include "libcore/physics/strand_energy.h"
-#include "libcore/model/strands.h"
+#include "libcore/util/progress.h"
 
 namespace hairgen {
 
 struct GrowOptions {
-  std::string configDigest;  // recorded in the guides' provenance
+  std::string configDigest;      // recorded in the guides' provenance
   Progress* progress = nullptr;  // advanced once per guide
 };
 
@@ -38,13 +38,15 @@ struct GrowResult {
 // Grows every guide (in parallel; the result does not depend on the thread count). Throws InputError
 // for a wick vertex with a zero or non-finite normal and NumericError naming the guide whose energy is
 // not finite.
-GrowResult grow(const Mesh& wick, const Hairstyle& style, const Collision& collision, const GrowOptions& options);
+GrowResult grow(const Mesh& wick, const Hairstyle& style, const Collision& collision,
+                const GrowOptions& options);
 
 // Each follicle's height fraction in [0, 1] between the lowest and the highest wick vertex: how far
 // its layered envelope reaches (thesis §4.1.2.2). All 0 for a flat wick.
 std::vector<double> follicleEnvelopes(const Mesh& wick);
 
 // One guide, for tests and benchmarks.
-GuideReport growGuide(const RodFrame& root, double envelope, const Hairstyle& style, const Collision& collision);
+GuideReport growGuide(const RodFrame& root, double envelope, const Hairstyle& style,
+                      const Collision& collision);
 
 }  // namespace hairgen

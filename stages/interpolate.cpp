@@ -67,8 +67,8 @@ void checkGuides(const Mesh& wick, const Strands& guides, const std::string& nam
     if (!(gap <= 1e-4)) {
       char mm[32];
       std::snprintf(mm, sizeof mm, "%.3g mm", gap * 1e3);
-      throw InputError(where, "guide " + std::to_string(i) + " starts " + mm + " from wick vertex " + std::to_string(i) +
-                                  "; these guides were not grown from this Setup's wick");
+      throw InputError(where, "guide " + std::to_string(i) + " starts " + mm + " from wick vertex " +
+                                  std::to_string(i) + "; these guides were not grown from this Setup's wick");
     }
   }
 }
@@ -139,8 +139,8 @@ glm::dvec3 strayCentre(const Collision& collision) {
   return glm::dvec3(0.0);
 }
 
-Strands interpolate(const Mesh& wick, const Strands& guides, const Hairstyle& style, const Collision& collision,
-                    const InterpolateOptions& options) {
+Strands interpolate(const Mesh& wick, const Strands& guides, const Hairstyle& style,
+                    const Collision& collision, const InterpolateOptions& options) {
   checkGuides(wick, guides, options.guidesName);
   const size_t triangleCount = wick.triangles.size();
   const uint64_t seed = style.seed;
@@ -161,8 +161,8 @@ Strands interpolate(const Mesh& wick, const Strands& guides, const Hairstyle& st
   }
   if (firstPoint.back() >= std::numeric_limits<uint32_t>::max() ||
       (maxCount > 0 && (maxCount - 1) * triangleCount + triangleCount > std::numeric_limits<uint32_t>::max()))
-    throw InputError("HairDensity " + std::to_string(style.hairDensity) + " gives " + std::to_string(firstStrand.back()) +
-                     " strands of " + std::to_string(firstPoint.back()) +
+    throw InputError("HairDensity " + std::to_string(style.hairDensity) + " gives " +
+                     std::to_string(firstStrand.back()) + " strands of " + std::to_string(firstPoint.back()) +
                      " points, more than 32-bit offsets and ids can hold; lower HairDensity");
 
   const size_t strands = firstStrand.back(), points = firstPoint.back();
@@ -201,7 +201,8 @@ Strands interpolate(const Mesh& wick, const Strands& guides, const Hairstyle& st
 
     for (uint32_t k = 0; k < count[t]; ++k) {
       const size_t s = firstStrand[t] + k;
-      const glm::dvec3 root = rootWeights(counterUniform(seed, t, k, kRootU1), counterUniform(seed, t, k, kRootU2));
+      const glm::dvec3 root =
+          rootWeights(counterUniform(seed, t, k, kRootU1), counterUniform(seed, t, k, kRootU2));
       const glm::dvec3 tip = tipWeights(root, style.clump * counterUniform(seed, t, k, kTipV1),
                                         style.clump * counterUniform(seed, t, k, kTipV2), style.strayHairs);
       const size_t p0 = firstPoint[t] + uint64_t(k) * n;
@@ -213,8 +214,9 @@ Strands interpolate(const Mesh& wick, const Strands& guides, const Hairstyle& st
       coupe.guideIds[s] = tri;
       coupe.guideWeights[s] = glm::vec3(root);
       if (!wick.uvs.empty())
-        coupe.rootUv[s] = glm::vec2(root.x * glm::dvec2(wick.uvs[tri.x]) + root.y * glm::dvec2(wick.uvs[tri.y]) +
-                                    root.z * glm::dvec2(wick.uvs[tri.z]));
+        coupe.rootUv[s] =
+            glm::vec2(root.x * glm::dvec2(wick.uvs[tri.x]) + root.y * glm::dvec2(wick.uvs[tri.y]) +
+                      root.z * glm::dvec2(wick.uvs[tri.z]));
     }
     if (options.progress) options.progress->advance();
   });

@@ -8,10 +8,10 @@
 
 #include <glm/glm.hpp>
 
-#include "libcore/model/mesh.h"
 #include "libcore/config/params.h"
-#include "libcore/util/progress.h"
+#include "libcore/model/mesh.h"
 #include "libcore/model/strands.h"
+#include "libcore/util/progress.h"
 
 namespace hairgen {
 
@@ -25,8 +25,8 @@ struct InterpolateOptions {
 // triangle, then by strand index k within it; strand k of triangle t has id k·T + t (T triangles), so
 // ids are stable when the density changes and the strands with id < m·T are the first m of every
 // triangle. Deterministic for any thread count. Throws InputError when the guides do not fit the wick.
-Strands interpolate(const Mesh& wick, const Strands& guides, const Hairstyle& style, const Collision& collision,
-                    const InterpolateOptions& options);
+Strands interpolate(const Mesh& wick, const Strands& guides, const Hairstyle& style,
+                    const Collision& collision, const InterpolateOptions& options);
 
 // The pieces, for tests.
 

@@ -13,16 +13,18 @@
 #include <cstdint>
 #include <string>
 
-#include "libcore/volume/hair_volume.h"
 #include "libcore/config/params.h"
 #include "libcore/model/strands.h"
+#include "libcore/volume/hair_volume.h"
 
 namespace hairgen {
 
 double strandAmbient(uint64_t seed, uint32_t strandId, double mean, double deviation);
 
 // Whether a Setup asks for the stage: volumetric shading, or an ambient distribution other than 1.
-inline bool wantsAmbient(const Visuality& v) { return v.ambientDeviation > 0.0 || v.ambientMean != 1.0; }
+inline bool wantsAmbient(const Visuality& v) {
+  return v.ambientDeviation > 0.0 || v.ambientMean != 1.0;
+}
 inline bool wantsShade(const Visuality& v, const RenderSettings& r) {
   return wantsAmbient(v) || r.shadingModel == ShadingModel::kVolumetric;
 }

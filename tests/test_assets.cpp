@@ -3,22 +3,25 @@
 
 #include <sstream>
 
-#include "libcore/util/file_util.h"
 #include "libcore/assets/head_generator.h"
 #include "libcore/io/obj_io.h"
+#include "libcore/util/file_util.h"
 #include "tests/test_util.h"
 
 namespace hairgen {
 namespace {
 
-std::filesystem::path assets() { return test::sourceDir() / "configs" / "assets"; }
+std::filesystem::path assets() {
+  return test::sourceDir() / "configs" / "assets";
+}
 
 TEST(Assets, GeneratorReproducesTheCommittedFilesByteForByte) {
   test::TempDir dir("assets");
   HeadAssetParams params;
   writeHeadAssets(dir.path(), params, generateHeadAssets(params));
   for (const char* file : {"head.obj", "wick.obj", "assets.txt"})
-    EXPECT_TRUE(readFileText(dir / file) == readFileText(assets() / file)) << file << " differs: run `hairgen assets`";
+    EXPECT_TRUE(readFileText(dir / file) == readFileText(assets() / file))
+        << file << " differs: run `hairgen assets`";
 }
 
 TEST(Assets, WickLiesJustInsideTheHeadEllipsoid) {

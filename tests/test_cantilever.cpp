@@ -3,8 +3,8 @@
 
 #include <cmath>
 
-#include "libcore/io/obj_io.h"
 #include "libcore/config/setup.h"
+#include "libcore/io/obj_io.h"
 #include "stages/cantilever.h"
 #include "stages/shade.h"
 #include "tests/test_util.h"
@@ -39,7 +39,8 @@ TEST(Cantilever, WithoutForceAHairStaysStraightAlongItsFollicle) {
   const glm::dvec3 pore(0.01, 0.1, -0.02), normal = glm::normalize(glm::dvec3(0.3, 1.0, -0.2));
   std::vector<glm::dvec3> p = bendHair(pore, normal, h, nullptr);
   ASSERT_EQ(p.size(), 21u);
-  for (size_t i = 0; i < p.size(); ++i) EXPECT_LT(glm::length(p[i] - (pore + 0.01 * double(i) * normal)), 1e-12);
+  for (size_t i = 0; i < p.size(); ++i)
+    EXPECT_LT(glm::length(p[i] - (pore + 0.01 * double(i) * normal)), 1e-12);
 }
 
 TEST(Cantilever, AHorizontalHairDeflectsDownMoreWhenLongerLessWhenStiffer) {
@@ -60,7 +61,7 @@ TEST(Cantilever, ASingleSegmentDeflectsByEquationThree) {
   h.flexuralRigidity = 1e-10;
   std::vector<glm::dvec3> p = bendHair(glm::dvec3(0.0), glm::dvec3(1, 0, 0), h, nullptr);
   const double d = 0.02, load = h.density * M_PI * h.hairRadius1 * h.hairRadius2 * h.gravity * d;
-  const double moment = -load * d * 1.0 / 2.0;             // (2) with k = i = 1
+  const double moment = -load * d * 1.0 / 2.0;                    // (2) with k = i = 1
   const double y = -0.5 * (moment / h.flexuralRigidity) * d * d;  // (3)
   EXPECT_DOUBLE_EQ(cantileverDeflection(load, d, h.flexuralRigidity, 1, 1), y);
   // p1 = p0 + d e/|e| with e = d a0 + y (down).
@@ -77,7 +78,8 @@ TEST(Cantilever, SegmentsKeepTheirLengthAndNoNodeOfTheBobEntersTheHead) {
   const double d = h.totalLength() / h.segments;
   double worstLength = 0.0, innermost = HUGE_VAL;
   for (size_t i = 0; i < b.wick.vertexCount(); ++i) {
-    std::vector<glm::dvec3> p = bendHair(glm::dvec3(b.wick.positions[i]), glm::dvec3(b.wick.normals[i]), h, b.head());
+    std::vector<glm::dvec3> p =
+        bendHair(glm::dvec3(b.wick.positions[i]), glm::dvec3(b.wick.normals[i]), h, b.head());
     for (size_t n = 1; n < p.size(); ++n) {
       worstLength = std::max(worstLength, std::abs(glm::length(p[n] - p[n - 1]) - d) / d);
       glm::dvec3 local = (p[n] - b.head()->centre) / b.head()->halfExtents;
@@ -96,7 +98,8 @@ TEST(Cantilever, ACutRemovesExactlyTheSegmentsBelowItsHeightForItsPores) {
   cut.cuts.push_back({-40.0, 40.0, 180.0, 0.09, {}});  // the front, above the brows
   int selected = 0, shortened = 0;
   for (size_t i = 0; i < b.wick.vertexCount(); ++i) {
-    std::vector<glm::dvec3> full = bendHair(glm::dvec3(b.wick.positions[i]), glm::dvec3(b.wick.normals[i]), uncut, b.head());
+    std::vector<glm::dvec3> full =
+        bendHair(glm::dvec3(b.wick.positions[i]), glm::dvec3(b.wick.normals[i]), uncut, b.head());
     std::vector<glm::dvec3> kept = full;
     cutHair(kept, cut, b.head());
     glm::dvec2 polar = porePolar(full.front(), b.head());

@@ -13,7 +13,9 @@ namespace {
 using test::sourceDir;
 using test::text;
 
-std::filesystem::path thesis(const std::string& file) { return sourceDir() / "configs" / "thesis" / file; }
+std::filesystem::path thesis(const std::string& file) {
+  return sourceDir() / "configs" / "thesis" / file;
+}
 
 // Runs `fn`, expects an InputError, and returns its message (what()).
 template <typename Fn>
@@ -118,10 +120,11 @@ TEST_P(ThesisCoupe, ParsesToAppendixCTables) {
 
 INSTANTIATE_TEST_SUITE_P(
     Tables, ThesisCoupe,
-    ::testing::Values(CoupeTable{1, {0.01}, 750, 0.002, 0.005, {0, 0, 0}, {0.5, 0.5, 0.5}, 1, 0.0},
-                      CoupeTable{2, {0.02, 0.02, 0.02, 0.02}, 100, 0.05, 0.05, {0.45, 0.25, 0}, {0.2, 0.2, 0.2}, 1, 0.0},
-                      CoupeTable{3, {0.04, 0.04, 0.04, 0.04}, 80, 0.025, 0.025, {0.45, 0.25, 0}, {0.2, 0.2, 0.2}, 2, 0.04},
-                      CoupeTable{4, {0.04, 0.04, 0.04, 0.04}, 80, 4.0, 0.025, {0.90, 0.65, 0.10}, {0.2, 0.2, 0.2}, 2, 0.0}),
+    ::testing::Values(
+        CoupeTable{1, {0.01}, 750, 0.002, 0.005, {0, 0, 0}, {0.5, 0.5, 0.5}, 1, 0.0},
+        CoupeTable{2, {0.02, 0.02, 0.02, 0.02}, 100, 0.05, 0.05, {0.45, 0.25, 0}, {0.2, 0.2, 0.2}, 1, 0.0},
+        CoupeTable{3, {0.04, 0.04, 0.04, 0.04}, 80, 0.025, 0.025, {0.45, 0.25, 0}, {0.2, 0.2, 0.2}, 2, 0.04},
+        CoupeTable{4, {0.04, 0.04, 0.04, 0.04}, 80, 4.0, 0.025, {0.90, 0.65, 0.10}, {0.2, 0.2, 0.2}, 2, 0.0}),
     [](const auto& p) { return "Coupe" + std::to_string(p.param.coupe); });
 
 TEST(ThesisConfigs, Coupe3FrontSphereAsTable11) {
@@ -147,7 +150,8 @@ TEST(ConfigErrors, KeyOfAnotherSectionSaysWhereItBelongs) {
 }
 
 TEST(ConfigErrors, DuplicateKeyNamesBothLines) {
-  std::string m = inputError([] { readHairstyle(text("HairLengths 0.1\nMaxIter 3\nmaxiter 4\n", "h.txt"), {}); });
+  std::string m =
+      inputError([] { readHairstyle(text("HairLengths 0.1\nMaxIter 3\nmaxiter 4\n", "h.txt"), {}); });
   EXPECT_NE(m.find("h.txt:3:"), std::string::npos) << m;
   EXPECT_NE(m.find("h.txt:2"), std::string::npos) << m;
 }
@@ -165,7 +169,8 @@ TEST(ConfigErrors, MalformedNumberNamesLine) {
 
 TEST(ConfigErrors, NonFiniteNumberIsRejected) {
   for (const char* bad : {"nan", "inf", "-inf", "1e999"}) {
-    std::string m = inputError([&] { readHairstyle(text(std::string("HairLengths 0.1\nGravity ") + bad + "\n", "h.txt"), {}); });
+    std::string m = inputError(
+        [&] { readHairstyle(text(std::string("HairLengths 0.1\nGravity ") + bad + "\n", "h.txt"), {}); });
     EXPECT_NE(m.find("h.txt:2:"), std::string::npos) << bad << ": " << m;
   }
 }
@@ -174,9 +179,14 @@ TEST(ConfigErrors, OutOfRangeSaysTheRange) {
   std::string m = inputError([] { readHairstyle(text("HairLengths 0.1 -0.2\n", "h.txt"), {}); });
   EXPECT_NE(m.find("h.txt:1:"), std::string::npos) << m;
   EXPECT_NE(m.find("out of range"), std::string::npos) << m;
-  EXPECT_NE(inputError([] { readHairstyle(text("HairLengths 0.1\nMaxIter 0\n"), {}); }).find("out of range"), std::string::npos);
-  EXPECT_NE(inputError([] { readHairstyle(text("HairLengths 0.1\nPoisson 0.7\n"), {}); }).find("out of range"), std::string::npos);
-  EXPECT_NE(inputError([] { readHairstyle(text("HairLengths 0.1\nHairDensity -1\n"), {}); }).find("out of range"), std::string::npos);
+  EXPECT_NE(inputError([] { readHairstyle(text("HairLengths 0.1\nMaxIter 0\n"), {}); }).find("out of range"),
+            std::string::npos);
+  EXPECT_NE(
+      inputError([] { readHairstyle(text("HairLengths 0.1\nPoisson 0.7\n"), {}); }).find("out of range"),
+      std::string::npos);
+  EXPECT_NE(
+      inputError([] { readHairstyle(text("HairLengths 0.1\nHairDensity -1\n"), {}); }).find("out of range"),
+      std::string::npos);
 }
 
 TEST(ConfigErrors, WrongValueCountNamesLine) {
@@ -193,7 +203,8 @@ TEST(ConfigErrors, IntegerKeyRejectsFraction) {
 }
 
 TEST(ConfigErrors, DegenerateCollisionAxesAreRejected) {
-  std::string m = inputError([] { readCollision(text("Ellipsoid 0 1 0 0 0 1 1 1 1 0 0 1 0 0 0 0 1\n", "c.txt"), {}); });
+  std::string m =
+      inputError([] { readCollision(text("Ellipsoid 0 1 0 0 0 1 1 1 1 0 0 1 0 0 0 0 1\n", "c.txt"), {}); });
   EXPECT_NE(m.find("parallel"), std::string::npos) << m;
 }
 
@@ -218,7 +229,8 @@ TEST(ConfigErrors, SetupNamingMissingFileNamesSetupLine) {
 }
 
 TEST(Config, KeysAreCaseInsensitiveCommentsAndQuotesWork) {
-  hairgen::Setup s = readSetup(text("LOAD   false  # trailing comment\nwickmodel \"my wick.obj\"\nLoadPath a.hair\n"), {});
+  hairgen::Setup s =
+      readSetup(text("LOAD   false  # trailing comment\nwickmodel \"my wick.obj\"\nLoadPath a.hair\n"), {});
   EXPECT_FALSE(s.load);
   EXPECT_EQ(s.wickModel.path.filename(), "my wick.obj");
   EXPECT_EQ(s.loadFile.path.filename(), "a.hair");  // LoadPath, the thesis' other spelling
@@ -233,7 +245,8 @@ TEST(Config, MissingKeysTakePhysicalDefaults) {
 }
 
 TEST(Overrides, ReplaceAValueAndAddAMissingOne) {
-  std::vector<Override> o = {parseOverride("Hairstyle.HairDensity=160"), parseOverride("hairstyle.clump=0.5")};
+  std::vector<Override> o = {parseOverride("Hairstyle.HairDensity=160"),
+                             parseOverride("hairstyle.clump=0.5")};
   Hairstyle h = readHairstyle(text("HairLengths 0.1\nHairDensity 80\n"), o);
   EXPECT_DOUBLE_EQ(h.hairDensity, 160);
   EXPECT_DOUBLE_EQ(h.clump, 0.5);
@@ -241,8 +254,10 @@ TEST(Overrides, ReplaceAValueAndAddAMissingOne) {
 }
 
 TEST(Overrides, MultiValueAndRepeatableKeys) {
-  std::vector<Override> o = {parseOverride("Collision.Sphere=0 1 0 0 0.2 0.05"), parseOverride("Hairstyle.HairLengths=0.02 0.03")};
-  Collision c = readCollision(text("Sphere 0 1 0 0 0 1\nSphere 0 1 1 1 1 1\nEllipsoid 0 1 0 0 0 1 1 1 1 0 0 0 1 0 0 0 1\n"), o);
+  std::vector<Override> o = {parseOverride("Collision.Sphere=0 1 0 0 0.2 0.05"),
+                             parseOverride("Hairstyle.HairLengths=0.02 0.03")};
+  Collision c = readCollision(
+      text("Sphere 0 1 0 0 0 1\nSphere 0 1 1 1 1 1\nEllipsoid 0 1 0 0 0 1 1 1 1 0 0 0 1 0 0 0 1\n"), o);
   ASSERT_EQ(c.shapes.size(), 2u);
   EXPECT_EQ(c.shapes[0].kind, ShapeKind::kEllipsoid);
   EXPECT_EQ(c.shapes[1].centre, glm::dvec3(0, 0, 0.2));
@@ -251,9 +266,11 @@ TEST(Overrides, MultiValueAndRepeatableKeys) {
 
 TEST(Overrides, BadOverridesAreInputErrors) {
   EXPECT_NE(inputError([] { parseOverride("HairDensity=3"); }).find("Section.Key=VALUE"), std::string::npos);
-  EXPECT_NE(inputError([] { parseOverride("Hairstyl.HairDensity=3"); }).find("did you mean 'Hairstyle'"), std::string::npos);
+  EXPECT_NE(inputError([] { parseOverride("Hairstyl.HairDensity=3"); }).find("did you mean 'Hairstyle'"),
+            std::string::npos);
   EXPECT_NE(inputError([] { parseOverride("Hairstyle.Density="); }).find("no value"), std::string::npos);
-  std::string m = inputError([] { readHairstyle(text("HairLengths 0.1\n"), {parseOverride("Hairstyle.Gravity=abc")}); });
+  std::string m =
+      inputError([] { readHairstyle(text("HairLengths 0.1\n"), {parseOverride("Hairstyle.Gravity=abc")}); });
   EXPECT_NE(m.find("--set Hairstyle.Gravity=abc"), std::string::npos) << m;
 }
 

@@ -1,10 +1,10 @@
 // glTF caches: round trips through .glb and .gltf, and files hairgen must refuse.
 #include <gtest/gtest.h>
 
-#include "libcore/util/error.h"
-#include "libcore/util/file_util.h"
 #include "libcore/io/gltf_io.h"
 #include "libcore/io/hair_io.h"
+#include "libcore/util/error.h"
+#include "libcore/util/file_util.h"
 #include "tests/test_util.h"
 
 namespace hairgen {
@@ -51,7 +51,8 @@ TEST(Gltf, AccessorPastItsBufferIsRejected) {
   size_t digits = text.find_first_of("0123456789", at);
   size_t end = text.find_first_not_of("0123456789", digits);
   text.replace(digits, end - digits, "99999");
-  EXPECT_THROW(decodeGltf(reinterpret_cast<const uint8_t*>(text.data()), text.size(), "bad.gltf"), InputError);
+  EXPECT_THROW(decodeGltf(reinterpret_cast<const uint8_t*>(text.data()), text.size(), "bad.gltf"),
+               InputError);
 }
 
 TEST(Gltf, GarbageIsAnInputError) {

@@ -3,9 +3,9 @@
 
 #include <tbb/global_control.h>
 
-#include "libcore/util/error.h"
-#include "libcore/io/obj_io.h"
 #include "libcore/config/setup.h"
+#include "libcore/io/obj_io.h"
+#include "libcore/util/error.h"
 #include "stages/grow.h"
 #include "tests/test_util.h"
 
@@ -49,7 +49,8 @@ TEST(Grow, WithNegligibleElasticityAGuideHangsStraightDown) {
   GuideReport r = growGuide(root, 0.0, h, Collision{});
   std::vector<glm::dvec3> p = shape(root, h, r.coordinates);
   glm::dvec3 below = root.position - glm::dvec3(0, 0.16, 0);
-  EXPECT_LT(glm::length(p.back() - below), 0.002) << "tip at " << p.back().x << " " << p.back().y << " " << p.back().z;
+  EXPECT_LT(glm::length(p.back() - below), 0.002)
+      << "tip at " << p.back().x << " " << p.back().y << " " << p.back().z;
 }
 
 TEST(Grow, Coupe3LongGuidesHangBelowTheirRootsAndStayOutOfTheHead) {
@@ -101,8 +102,8 @@ TEST(Grow, Coupe1ShortGuidesAreHeldByTheirElasticity) {
   // Coupe 1's guides are 1 cm: elasticity outweighs gravity, so a guide keeps its rest shape. With
   // the coupe's own helix (radius 2 mm, step 5 mm) the rest shape is most of a coil whose chord
   // leaves the follicle at ~87°, and no point of it moves by a quarter of the length (1 cm hangs
-  // visibly under gravity only when it is held sideways); with a straight rest shape — the "straight spiky hair" the thesis
-  // describes for it — the guide stays within 15° of its follicle normal.
+  // visibly under gravity only when it is held sideways); with a straight rest shape — the "straight spiky
+  // hair" the thesis describes for it — the guide stays within 15° of its follicle normal.
   auto [c, wick] = test::loadJob("thesis/coupe1/setup.txt");
   auto chord = [](const Strands& g, size_t i) {
     return glm::normalize(glm::dvec3(g.points[g.firstPoint[i + 1] - 1] - g.points[g.firstPoint[i]]));
@@ -119,7 +120,8 @@ TEST(Grow, Coupe1ShortGuidesAreHeldByTheirElasticity) {
     RodFrame root = follicleFrame(glm::dvec3(wick.positions[i]), glm::dvec3(wick.normals[i]));
     sampleRod(root, c.hairstyle.hairLengths, rest, s, p, nullptr);
     for (size_t k = 0; k < p.size(); ++k)
-      worstShape = std::max(worstShape, glm::length(glm::dvec3(helix.guides.points[helix.guides.firstPoint[i] + k]) - p[k]));
+      worstShape = std::max(
+          worstShape, glm::length(glm::dvec3(helix.guides.points[helix.guides.firstPoint[i] + k]) - p[k]));
   }
   worstShape /= c.hairstyle.totalLength();
   EXPECT_LT(worstShape, 0.25);
@@ -128,10 +130,13 @@ TEST(Grow, Coupe1ShortGuidesAreHeldByTheirElasticity) {
   GrowResult straight = grow(wick, c.hairstyle, c.collision, {});
   double worstNormal = 0.0;
   for (size_t i = 0; i < wick.vertexCount(); ++i)
-    worstNormal = std::max(worstNormal, degrees(chord(straight.guides, i), glm::normalize(glm::dvec3(wick.normals[i]))));
+    worstNormal = std::max(worstNormal,
+                           degrees(chord(straight.guides, i), glm::normalize(glm::dvec3(wick.normals[i]))));
   EXPECT_LT(worstNormal, 15.0);
-  std::printf("coupe 1: points move at most %.1f%% of the length from rest; straight rest: worst angle to "
-              "normal %.1f deg\n", 100.0 * worstShape, worstNormal);
+  std::printf(
+      "coupe 1: points move at most %.1f%% of the length from rest; straight rest: worst angle to "
+      "normal %.1f deg\n",
+      100.0 * worstShape, worstNormal);
 }
 
 TEST(Grow, Coupe3MaxIterReachesTheMinimum) {

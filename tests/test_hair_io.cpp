@@ -3,9 +3,9 @@
 
 #include <cstring>
 
+#include "libcore/io/hair_io.h"
 #include "libcore/util/error.h"
 #include "libcore/util/file_util.h"
-#include "libcore/io/hair_io.h"
 #include "tests/test_util.h"
 
 namespace hairgen {

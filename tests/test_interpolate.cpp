@@ -8,10 +8,10 @@
 
 #include <tbb/global_control.h>
 
-#include "libcore/util/error.h"
-#include "libcore/io/obj_io.h"
-#include "libcore/util/random.h"
 #include "libcore/config/setup.h"
+#include "libcore/io/obj_io.h"
+#include "libcore/util/error.h"
+#include "libcore/util/random.h"
 #include "stages/grow.h"
 #include "stages/interpolate.h"
 #include "tests/test_util.h"
@@ -60,7 +60,8 @@ TEST(Interpolate, OneCornerWeightsReproduceThatGuideExactly) {
   const Strands& guides = grown().guides;
   const glm::uvec3 tri = grown().wick.triangles[100];
   GuideSpan g[3];
-  for (int c = 0; c < 3; ++c) g[c] = {&guides.points[guides.firstPoint[tri[c]]], &guides.tangents[guides.firstPoint[tri[c]]]};
+  for (int c = 0; c < 3; ++c)
+    g[c] = {&guides.points[guides.firstPoint[tri[c]]], &guides.tangents[guides.firstPoint[tri[c]]]};
   const uint32_t n = guides.pointsOf(tri.x);
   std::vector<glm::vec3> p(n), t(n);
   for (int c = 0; c < 3; ++c) {
@@ -146,8 +147,10 @@ TEST(Interpolate, DoublingTheDensityKeepsEveryStrandByteForByte) {
     ASSERT_NE(it, byId.end()) << "strand id " << low.strandId[s] << " is gone";
     size_t h = it->second;
     ASSERT_EQ(low.pointsOf(s), high.pointsOf(h));
-    ASSERT_EQ(0, std::memcmp(&low.points[low.firstPoint[s]], &high.points[high.firstPoint[h]], low.pointsOf(s) * sizeof(glm::vec3)));
-    ASSERT_EQ(0, std::memcmp(&low.tangents[low.firstPoint[s]], &high.tangents[high.firstPoint[h]], low.pointsOf(s) * sizeof(glm::vec3)));
+    ASSERT_EQ(0, std::memcmp(&low.points[low.firstPoint[s]], &high.points[high.firstPoint[h]],
+                             low.pointsOf(s) * sizeof(glm::vec3)));
+    ASSERT_EQ(0, std::memcmp(&low.tangents[low.firstPoint[s]], &high.tangents[high.firstPoint[h]],
+                             low.pointsOf(s) * sizeof(glm::vec3)));
     ASSERT_EQ(low.rootBary[s], high.rootBary[h]);
   }
 }

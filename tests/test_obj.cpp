@@ -3,8 +3,8 @@
 
 #include <sstream>
 
-#include "libcore/util/error.h"
 #include "libcore/io/obj_io.h"
+#include "libcore/util/error.h"
 #include "tests/test_util.h"
 
 namespace hairgen {
@@ -34,8 +34,10 @@ TEST(Obj, MissingNormalsAreComputedAreaWeighted) {
 TEST(Obj, NormalsIndexedApartAreAveragedPerPosition) {
   // A hard edge: vertex 2 and 3 are shared by faces with different normals, given per corner.
   MeshReadStats stats;
-  Mesh m = parseObj("v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 1\nvn 0 0 1\nvn 0 -1 1\n"
-                    "f 1//1 2//1 3//1\nf 1//2 3//2 4//2\n", "n.obj", &stats);
+  Mesh m = parseObj(
+      "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 1\nvn 0 0 1\nvn 0 -1 1\n"
+      "f 1//1 2//1 3//1\nf 1//2 3//2 4//2\n",
+      "n.obj", &stats);
   EXPECT_TRUE(stats.normalsFromFile);
   EXPECT_TRUE(stats.normalsReindexed);
   EXPECT_EQ(m.vertexCount(), 4u);  // one follicle per position, not per corner
@@ -55,7 +57,7 @@ TEST(Obj, DegenerateFacesAreDroppedAndCounted) {
 
 TEST(Obj, EmptyMeshesAreErrors) {
   EXPECT_THROW(parseObj("# nothing\n", "e.obj"), InputError);
-  EXPECT_THROW(parseObj("v 0 0 0\nv 1 0 0\nv 0 1 0\n", "p.obj"), InputError);  // points, no faces
+  EXPECT_THROW(parseObj("v 0 0 0\nv 1 0 0\nv 0 1 0\n", "p.obj"), InputError);           // points, no faces
   EXPECT_THROW(parseObj("v 0 0 0\nv 1 0 0\nv 2 0 0\nf 1 2 3\n", "l.obj"), InputError);  // all degenerate
 }
 
@@ -82,7 +84,8 @@ TEST(Obj, NegativeIndicesCountBack) {
 }
 
 TEST(Obj, WrittenMeshReadsBackIdentically) {
-  Mesh m = parseObj("v 0 0 0\nv 1 0 0\nv 1 1 0.5\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\nf 1/1 2/2 3/3 4/4\n", "uv.obj");
+  Mesh m = parseObj(
+      "v 0 0 0\nv 1 0 0\nv 1 1 0.5\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\nf 1/1 2/2 3/3 4/4\n", "uv.obj");
   std::ostringstream out;
   writeObj(m, out, "test");
   Mesh back = parseObj(out.str(), "back.obj");

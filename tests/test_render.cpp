@@ -77,8 +77,8 @@ int compareStrandWithCpu(RenderSettings r, const glm::dvec3& normal) {
       for (int c = 0; c < 3; ++c) {
         const float got = out.beauty.at(std::string(1, "RGB"[c]), x, y);
         if (std::abs(got - expect[c]) > 0.02 * std::max(expect[c], 0.05)) {
-          ADD_FAILURE() << name(r.shadingModel) << ": pixel " << x << "," << y << " channel " << c << " is " << got
-                        << ", the CPU says " << expect[c];
+          ADD_FAILURE() << name(r.shadingModel) << ": pixel " << x << "," << y << " channel " << c << " is "
+                        << got << ", the CPU says " << expect[c];
           return -1;
         }
       }
@@ -116,7 +116,8 @@ TEST(Render, VolumetricWithBlendZeroIsKajiyaKay) {
     addStraight(s, {-0.04f, y, z}, {0.04f, y + 0.01f, z - 0.01f}, 16);
   }
   for (size_t p = 0; p < s.pointCount(); ++p)
-    s.normals.push_back(glm::normalize(glm::vec3(std::sin(0.7f * float(p)), std::cos(1.3f * float(p)), 0.5f)));
+    s.normals.push_back(
+        glm::normalize(glm::vec3(std::sin(0.7f * float(p)), std::cos(1.3f * float(p)), 0.5f)));
   for (int samples : {1, 4}) {  // lines, then ribbons: the normals reach the shader both ways
     RenderSettings r = frontCamera(96, samples);
     r.strandWidth = 0.0002;
@@ -131,11 +132,14 @@ TEST(Render, VolumetricWithBlendZeroIsKajiyaKay) {
     for (int y = 0; y < 96; ++y)
       for (int x = 0; x < 96; ++x)
         for (const char* c : {"R", "G", "B", "A"}) {
-          worst = std::max(worst, double(std::abs(volumetric.beauty.at(c, x, y) - kajiyaKay.beauty.at(c, x, y))));
-          fullDiffers = std::max(fullDiffers, double(std::abs(full.beauty.at(c, x, y) - kajiyaKay.beauty.at(c, x, y))));
+          worst =
+              std::max(worst, double(std::abs(volumetric.beauty.at(c, x, y) - kajiyaKay.beauty.at(c, x, y))));
+          fullDiffers =
+              std::max(fullDiffers, double(std::abs(full.beauty.at(c, x, y) - kajiyaKay.beauty.at(c, x, y))));
         }
     EXPECT_LE(worst, 0.004) << samples << " samples";
-    EXPECT_GT(fullDiffers, 0.05) << "blend 1 should not look like Kajiya-Kay, or the check above proves nothing";
+    EXPECT_GT(fullDiffers, 0.05)
+        << "blend 1 should not look like Kajiya-Kay, or the check above proves nothing";
   }
 }
 

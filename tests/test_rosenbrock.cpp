@@ -9,7 +9,9 @@ namespace hairgen {
 namespace {
 
 TEST(Rosenbrock, FindsTheBananaMinimum) {
-  auto banana = [](std::span<const double> x) { return (1 - x[0]) * (1 - x[0]) + 100 * std::pow(x[1] - x[0] * x[0], 2); };
+  auto banana = [](std::span<const double> x) {
+    return (1 - x[0]) * (1 - x[0]) + 100 * std::pow(x[1] - x[0] * x[0], 2);
+  };
   std::vector<double> x0 = {-1.2, 1.0}, steps = {0.1, 0.1};
   RosenbrockOptions options;
   options.maxStages = 1000;

@@ -11,7 +11,9 @@
 namespace hairgen {
 namespace {
 
-RodFrame verticalRoot() { return follicleFrame(glm::dvec3(0.01, 0.2, -0.03), glm::dvec3(0.3, 1.0, 0.2)); }
+RodFrame verticalRoot() {
+  return follicleFrame(glm::dvec3(0.01, 0.2, -0.03), glm::dvec3(0.3, 1.0, 0.2));
+}
 
 TEST(SuperHelix, FollicleFrameIsOrthonormalAndUsesUpAsUp) {
   RodFrame f = follicleFrame(glm::dvec3(0.0), glm::dvec3(0.0, 0.0, 2.0));
@@ -37,7 +39,8 @@ TEST(SuperHelix, RestShapeIsTheExactHelix) {
   glm::dvec3 w = darbouxVector(root, rest.tau, rest.kappa1, rest.kappa2);
   glm::dvec3 axis = glm::normalize(w);
   double omega = glm::length(w);
-  glm::dvec3 centre = root.position + glm::cross(w, root.n0) / (omega * omega);  // axis point, r = 1/Ω² · |W×n0|
+  glm::dvec3 centre =
+      root.position + glm::cross(w, root.n0) / (omega * omega);  // axis point, r = 1/Ω² · |W×n0|
   for (size_t i = 0; i < p.size(); ++i) {
     glm::dvec3 v = p[i] - centre;
     glm::dvec3 radial = v - glm::dot(v, axis) * axis;
@@ -119,10 +122,12 @@ TEST(SuperHelix, ClosedFormGravityMatchesQuadrature) {
 TEST(StrandEnergy, PenetrationFollowsEachShapesDefinition) {
   CollisionShape sphere{ShapeKind::kSphere, 0, 1, glm::dvec3(0), glm::dvec3(0.1), glm::dmat3(1.0), {}};
   EXPECT_NEAR(penetration(sphere, {0.07, 0, 0}), 0.03, 1e-15);
-  CollisionShape ellipsoid{ShapeKind::kEllipsoid, 0, 1, glm::dvec3(0), glm::dvec3(0.2, 0.1, 0.1), glm::dmat3(1.0), {}};
+  CollisionShape ellipsoid{ShapeKind::kEllipsoid, 0, 1, glm::dvec3(0), glm::dvec3(0.2, 0.1, 0.1),
+                           glm::dmat3(1.0),       {}};
   EXPECT_NEAR(penetration(ellipsoid, {0.1, 0, 0}), 0.1, 1e-15);
   EXPECT_NEAR(penetration(ellipsoid, {0, 0.2, 0}), -0.1, 1e-15);
-  CollisionShape cuboid{ShapeKind::kCuboid, 0, 1, glm::dvec3(0), glm::dvec3(0.2, 0.1, 0.3), glm::dmat3(1.0), {}};
+  CollisionShape cuboid{ShapeKind::kCuboid, 0, 1, glm::dvec3(0), glm::dvec3(0.2, 0.1, 0.3),
+                        glm::dmat3(1.0),    {}};
   EXPECT_NEAR(penetration(cuboid, {0.15, 0.02, 0}), 0.05, 1e-15);
 }
 
@@ -137,7 +142,13 @@ TEST(StrandEnergy, CollisionTermEqualsDirectSamplingOfEveryShape) {
   collision.shapes = {
       {ShapeKind::kEllipsoid, 0.03, 10.0, glm::dvec3(0, 0.12, 0), glm::dvec3(0.08, 0.1, 0.11), tilted, {}},
       {ShapeKind::kSphere, 0.01, 3.0, glm::dvec3(0.05, 0.2, 0.08), glm::dvec3(0.06), glm::dmat3(1.0), {}},
-      {ShapeKind::kCuboid, 0.0, 20.0, glm::dvec3(-0.04, 0.15, 0.0), glm::dvec3(0.05, 0.02, 0.04), tilted, {}}};
+      {ShapeKind::kCuboid,
+       0.0,
+       20.0,
+       glm::dvec3(-0.04, 0.15, 0.0),
+       glm::dvec3(0.05, 0.02, 0.04),
+       tilted,
+       {}}};
   const double envelope = 0.7;
   std::mt19937 rng(5);
   std::uniform_real_distribution<double> k(-60.0, 60.0);

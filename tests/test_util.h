@@ -8,13 +8,15 @@
 #include <string>
 
 #include "libcore/config/config.h"
-#include "libcore/io/obj_io.h"
 #include "libcore/config/setup.h"
+#include "libcore/io/obj_io.h"
 #include "libcore/model/strands.h"
 
 namespace hairgen::test {
 
-inline std::filesystem::path sourceDir() { return HAIRGEN_SOURCE_DIR; }
+inline std::filesystem::path sourceDir() {
+  return HAIRGEN_SOURCE_DIR;
+}
 // A bundled Setup (a path under configs/) read as a stage would, with its wick.
 struct Job {
   Config config;
@@ -26,7 +28,9 @@ inline Job loadJob(const std::string& setup, SetupUse use = SetupUse::kGrow) {
   return job;
 }
 
-inline std::filesystem::path realData() { return sourceDir() / ".." / "shared" / "testdata" / "real"; }
+inline std::filesystem::path realData() {
+  return sourceDir() / ".." / "shared" / "testdata" / "real";
+}
 
 // A fresh directory under the system temp dir, removed on destruction.
 class TempDir {

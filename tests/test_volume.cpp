@@ -7,10 +7,10 @@
 
 #include <glm/gtc/matrix_transform.hpp>
 
-#include "libcore/volume/hair_volume.h"
-#include "libcore/model/strand_frames.h"
-#include "libcore/io/obj_io.h"
 #include "libcore/config/setup.h"
+#include "libcore/io/obj_io.h"
+#include "libcore/model/strand_frames.h"
+#include "libcore/volume/hair_volume.h"
 #include "stages/grow.h"
 #include "stages/interpolate.h"
 #include "tests/test_util.h"
@@ -56,7 +56,8 @@ TEST(Volume, TheDistanceToABallOfStrandsIsTheDistanceToItsSurface) {
         const double r = glm::length(x - centre);
         worst = std::max(worst, std::abs(double(sdf.at(i, j, k)) - (r - radius)));
         if (r < 0.3 * radius) continue;  // the centre is where the distance has its kink
-        const glm::dvec3 g(sdf.at(i + 1, j, k) - sdf.at(i - 1, j, k), sdf.at(i, j + 1, k) - sdf.at(i, j - 1, k),
+        const glm::dvec3 g(sdf.at(i + 1, j, k) - sdf.at(i - 1, j, k),
+                           sdf.at(i, j + 1, k) - sdf.at(i, j - 1, k),
                            sdf.at(i, j, k + 1) - sdf.at(i, j, k - 1));
         worstGradient = std::max(worstGradient, std::abs(glm::length(g) / (2 * voxel) - 1.0));
         ++checked;
@@ -87,7 +88,8 @@ TEST(Volume, Coupe3NormalsPointAwayFromTheHeadOnTheOutside) {
   const glm::dvec3 head = coupe3().config.collision.shapes[0].centre;
   std::map<std::pair<int, int>, double> farthest;
   auto bin = [&](const glm::dvec3& d) {
-    return std::make_pair(int(std::floor(std::atan2(d.x, d.z) / 0.2)), int(std::floor(std::asin(d.y / glm::length(d)) / 0.2)));
+    return std::make_pair(int(std::floor(std::atan2(d.x, d.z) / 0.2)),
+                          int(std::floor(std::asin(d.y / glm::length(d)) / 0.2)));
   };
   for (const glm::vec3& p : coupe.points) {
     glm::dvec3 d = glm::dvec3(p) - head;
@@ -112,14 +114,16 @@ TEST(Volume, ReposingOntoTheRestPoseGivesTheRestNormals) {
   same.normals.clear();
   std::vector<glm::vec3> reposed = reposeNormals(rest, same);
   double worst = 0.0;
-  for (size_t i = 0; i < reposed.size(); ++i) worst = std::max(worst, double(glm::length(reposed[i] - rest.normals[i])));
+  for (size_t i = 0; i < reposed.size(); ++i)
+    worst = std::max(worst, double(glm::length(reposed[i] - rest.normals[i])));
   EXPECT_LT(worst, 1e-6);
 }
 
 TEST(Volume, ReposingRestNormalsOnARotatedCoupeRotatesThem) {
   Strands rest = coupe3().coupe;
   rest.normals = volumeNormals(buildVolume(rest, 0.004, 3, 0.25).distance, rest);
-  const glm::dmat3 r = glm::dmat3(glm::rotate(glm::dmat4(1.0), 0.7, glm::normalize(glm::dvec3(0.3, 1.0, -0.4))));
+  const glm::dmat3 r =
+      glm::dmat3(glm::rotate(glm::dmat4(1.0), 0.7, glm::normalize(glm::dvec3(0.3, 1.0, -0.4))));
   Strands moved = rest;
   for (glm::vec3& p : moved.points) p = glm::vec3(r * glm::dvec3(p) + glm::dvec3(0.1, -0.2, 0.05));
   for (glm::vec3& t : moved.tangents) t = glm::vec3(r * glm::dvec3(t));

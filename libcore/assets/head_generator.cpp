@@ -9,9 +9,9 @@
 #include <sstream>
 #include <tuple>
 
-#include "libcore/util/file_util.h"
-#include "libcore/io/obj_io.h"
 #include "libcore/assets/surface_nets.h"
+#include "libcore/io/obj_io.h"
+#include "libcore/util/file_util.h"
 #include "libcore/util/text.h"
 
 namespace hairgen {
@@ -35,9 +35,13 @@ double smoothUnion(double a, double b, double k) {
   double h = glm::clamp(0.5 + 0.5 * (b - a) / k, 0.0, 1.0);
   return glm::mix(b, a, h) - k * h * (1.0 - h);
 }
-double smoothSubtract(double a, double b, double k) { return -smoothUnion(-a, b, k); }
+double smoothSubtract(double a, double b, double k) {
+  return -smoothUnion(-a, b, k);
+}
 
-double mirrorX(double x) { return std::abs(x); }
+double mirrorX(double x) {
+  return std::abs(x);
+}
 
 double hairlineHeight(const HeadAssetParams& params, double azimuthDegrees) {
   const auto& table = params.hairline;
@@ -55,11 +59,12 @@ double hairlineHeight(const HeadAssetParams& params, double azimuthDegrees) {
 // Geodesic sphere: the icosahedron with every face split into frequency² triangles, on the unit sphere.
 Mesh geodesicSphere(int frequency) {
   const double t = (1.0 + std::sqrt(5.0)) / 2.0;
-  std::vector<glm::dvec3> ico = {{-1, t, 0}, {1, t, 0}, {-1, -t, 0}, {1, -t, 0}, {0, -1, t}, {0, 1, t},
-                                 {0, -1, -t}, {0, 1, -t}, {t, 0, -1}, {t, 0, 1}, {-t, 0, -1}, {-t, 0, 1}};
-  const int faces[20][3] = {{0, 11, 5}, {0, 5, 1},  {0, 1, 7},   {0, 7, 10}, {0, 10, 11}, {1, 5, 9}, {5, 11, 4},
-                            {11, 10, 2}, {10, 7, 6}, {7, 1, 8},  {3, 9, 4},  {3, 4, 2},   {3, 2, 6}, {3, 6, 8},
-                            {3, 8, 9},  {4, 9, 5},  {2, 4, 11}, {6, 2, 10}, {8, 6, 7},   {9, 8, 1}};
+  std::vector<glm::dvec3> ico = {{-1, t, 0},  {1, t, 0},  {-1, -t, 0}, {1, -t, 0}, {0, -1, t},  {0, 1, t},
+                                 {0, -1, -t}, {0, 1, -t}, {t, 0, -1},  {t, 0, 1},  {-t, 0, -1}, {-t, 0, 1}};
+  const int faces[20][3] = {{0, 11, 5}, {0, 5, 1},  {0, 1, 7},   {0, 7, 10}, {0, 10, 11},
+                            {1, 5, 9},  {5, 11, 4}, {11, 10, 2}, {10, 7, 6}, {7, 1, 8},
+                            {3, 9, 4},  {3, 4, 2},  {3, 2, 6},   {3, 6, 8},  {3, 8, 9},
+                            {4, 9, 5},  {2, 4, 11}, {6, 2, 10},  {8, 6, 7},  {9, 8, 1}};
   Mesh mesh;
   std::map<std::tuple<int64_t, int64_t, int64_t>, uint32_t> index;
   auto vertex = [&](glm::dvec3 p) {
@@ -72,34 +77,42 @@ Mesh geodesicSphere(int frequency) {
   const int n = frequency;
   for (const auto& f : faces) {
     glm::dvec3 a = ico[f[0]], b = ico[f[1]], c = ico[f[2]];
-    auto point = [&](int i, int j) { return vertex(a + (b - a) * (double(i) / n) + (c - a) * (double(j) / n)); };
+    auto point = [&](int i, int j) {
+      return vertex(a + (b - a) * (double(i) / n) + (c - a) * (double(j) / n));
+    };
     for (int i = 0; i < n; ++i)
       for (int j = 0; i + j < n; ++j) {
         mesh.triangles.push_back(glm::uvec3(point(i, j), point(i + 1, j), point(i, j + 1)));
-        if (i + j + 1 < n) mesh.triangles.push_back(glm::uvec3(point(i + 1, j), point(i + 1, j + 1), point(i, j + 1)));
+        if (i + j + 1 < n)
+          mesh.triangles.push_back(glm::uvec3(point(i + 1, j), point(i + 1, j + 1), point(i, j + 1)));
       }
   }
   return mesh;
 }
 
-float round(double v, double step) { return static_cast<float>(std::round(v / step) * step); }
+float round(double v, double step) {
+  return static_cast<float>(std::round(v / step) * step);
+}
 
 }  // namespace
 
 double headDistance(const HeadAssetParams& params, const glm::dvec3& world) {
   const glm::dvec3 c = params.ellipsoidCentre;
-  const glm::dvec3 p = world - glm::dvec3(0.0, c.y, c.z) - glm::dvec3(c.x, 0, 0);  // head frame: cranium centre at origin
-  const glm::dvec3 m(mirrorX(p.x), p.y, p.z);                                     // left-right symmetric features
+  const glm::dvec3 p =
+      world - glm::dvec3(0.0, c.y, c.z) - glm::dvec3(c.x, 0, 0);  // head frame: cranium centre at origin
+  const glm::dvec3 m(mirrorX(p.x), p.y, p.z);                     // left-right symmetric features
 
   double d = ellipsoid(p, params.ellipsoidAxes * params.craniumScale);
 
   // Jaw: an ellipsoid below the front of the cranium, narrowing towards the chin.
   glm::dvec3 q = p - glm::dvec3(0.0, -0.073, 0.035);
-  double taper = 1.0 - 0.30 * glm::clamp((q.z + 0.02) / 0.1, 0.0, 1.0) * glm::clamp(-q.y / 0.06 + 0.3, 0.0, 1.0);
+  double taper =
+      1.0 - 0.30 * glm::clamp((q.z + 0.02) / 0.1, 0.0, 1.0) * glm::clamp(-q.y / 0.06 + 0.3, 0.0, 1.0);
   q.x /= taper;
   d = smoothUnion(d, ellipsoid(q, {0.064, 0.074, 0.078}) * taper, 0.025);
   d = smoothUnion(d, ellipsoid(p - glm::dvec3(0.0, -0.136, 0.080), {0.019, 0.012, 0.013}), 0.020);  // chin
-  d = smoothUnion(d, ellipsoid(m - glm::dvec3(0.044, -0.048, 0.074), {0.016, 0.012, 0.018}), 0.018);  // cheekbones
+  d = smoothUnion(d, ellipsoid(m - glm::dvec3(0.044, -0.048, 0.074), {0.016, 0.012, 0.018}),
+                  0.018);  // cheekbones
 
   // Neck, cut flat below.
   double neck = capsule(p, {0.0, -0.115, -0.028}, {0.0, -0.300, -0.035}, 0.054, 0.058);
@@ -123,7 +136,8 @@ double headDistance(const HeadAssetParams& params, const glm::dvec3& world) {
   // Ears: a flattened shell with a hollow, tilted back a little.
   glm::dvec3 e = m - glm::dvec3(0.074, -0.040, -0.008);
   double tilt = 0.25;
-  e = glm::dvec3(e.x, std::cos(tilt) * e.y - std::sin(tilt) * e.z, std::sin(tilt) * e.y + std::cos(tilt) * e.z);
+  e = glm::dvec3(e.x, std::cos(tilt) * e.y - std::sin(tilt) * e.z,
+                 std::sin(tilt) * e.y + std::cos(tilt) * e.z);
   double ear = ellipsoid(e, {0.011, 0.031, 0.018});
   ear = smoothSubtract(ear, ellipsoid(e - glm::dvec3(0.007, 0.002, 0.002), {0.006, 0.020, 0.011}), 0.003);
   d = smoothUnion(d, ear, 0.006);
@@ -153,7 +167,9 @@ HeadAssets generateHeadAssets(const HeadAssetParams& params) {
       for (uint32_t other : {t[(k + 1) % 3], t[(k + 2) % 3]})
         if (std::find(list.begin(), list.end(), other) == list.end()) list.push_back(other);
     }
-  auto project = [&](glm::dvec3 p) { return p / glm::length(p / axes); };  // radial projection onto the ellipsoid
+  auto project = [&](glm::dvec3 p) {
+    return p / glm::length(p / axes);
+  };  // radial projection onto the ellipsoid
   for (int sweep = 0; sweep < params.wickRelaxation; ++sweep) {
     std::vector<glm::dvec3> next(pos.size());
     for (size_t i = 0; i < pos.size(); ++i) {
@@ -180,11 +196,13 @@ HeadAssets generateHeadAssets(const HeadAssetParams& params) {
         remap[t[k]] = static_cast<uint32_t>(wick.positions.size());
         const glm::dvec3& p = pos[t[k]];
         glm::dvec3 u = p / axes;
-        wick.positions.push_back(glm::vec3(round(c.x + p.x, 1e-5), round(c.y + p.y, 1e-5), round(c.z + p.z, 1e-5)));
+        wick.positions.push_back(
+            glm::vec3(round(c.x + p.x, 1e-5), round(c.y + p.y, 1e-5), round(c.z + p.z, 1e-5)));
         glm::dvec3 n = glm::normalize(p / (axes * axes));  // the ellipsoid's outward normal
         wick.normals.push_back(glm::vec3(round(n.x, 1e-4), round(n.y, 1e-4), round(n.z, 1e-4)));
         double azimuth = std::atan2(u.x, u.z);
-        wick.uvs.push_back(glm::vec2(round(0.5 + azimuth / (2.0 * M_PI), 1e-5), round(0.5 + 0.5 * u.y, 1e-5)));
+        wick.uvs.push_back(
+            glm::vec2(round(0.5 + azimuth / (2.0 * M_PI), 1e-5), round(0.5 + 0.5 * u.y, 1e-5)));
       }
       out[k] = remap[t[k]];
     }
@@ -195,7 +213,9 @@ HeadAssets generateHeadAssets(const HeadAssetParams& params) {
 
 std::string describeHeadAssetParams(const HeadAssetParams& params) {
   std::ostringstream out;
-  auto v3 = [](const glm::dvec3& v) { return formatReal(v.x) + " " + formatReal(v.y) + " " + formatReal(v.z); };
+  auto v3 = [](const glm::dvec3& v) {
+    return formatReal(v.x) + " " + formatReal(v.y) + " " + formatReal(v.z);
+  };
   out << "# Parameters of the bundled head.obj and wick.obj, written by `hairgen assets -o DIR`.\n"
       << "# Regenerate with that command; tests check that it reproduces the committed files byte for byte.\n"
       << "ellipsoidCentre " << v3(params.ellipsoidCentre) << "    # metres, thesis Appendix C\n"
@@ -211,11 +231,14 @@ std::string describeHeadAssetParams(const HeadAssetParams& params) {
   return out.str();
 }
 
-void writeHeadAssets(const std::filesystem::path& dir, const HeadAssetParams& params, const HeadAssets& assets) {
-  for (auto [mesh, file, what] : {std::tuple{&assets.head, "head.obj", "head"}, {&assets.wick, "wick.obj", "wick"}}) {
+void writeHeadAssets(const std::filesystem::path& dir, const HeadAssetParams& params,
+                     const HeadAssets& assets) {
+  for (auto [mesh, file, what] :
+       {std::tuple{&assets.head, "head.obj", "head"}, {&assets.wick, "wick.obj", "wick"}}) {
     std::ostringstream text;
     writeObj(*mesh, text,
-             std::string("hairgen ") + what + " mesh, generated by `hairgen assets`; parameters in assets.txt\n" +
+             std::string("hairgen ") + what +
+                 " mesh, generated by `hairgen assets`; parameters in assets.txt\n" +
                  "metres, +y up, face along +z");
     writeFileAtomic(dir / file, text.str());
   }

@@ -26,8 +26,8 @@ Mesh surfaceNets(const DistanceFn& sdf, const glm::dvec3& lo, const glm::dvec3& 
   // One vertex per cell with a sign change; cells are indexed like their lowest node.
   std::vector<int> cellVertex(value.size(), -1);
   Mesh mesh;
-  static const std::array<std::array<int, 2>, 12> edges = {{{0, 1}, {2, 3}, {4, 5}, {6, 7}, {0, 2}, {1, 3},
-                                                            {4, 6}, {5, 7}, {0, 4}, {1, 5}, {2, 6}, {3, 7}}};
+  static const std::array<std::array<int, 2>, 12> edges = {
+      {{0, 1}, {2, 3}, {4, 5}, {6, 7}, {0, 2}, {1, 3}, {4, 6}, {5, 7}, {0, 4}, {1, 5}, {2, 6}, {3, 7}}};
   for (int k = 0; k + 1 < n.z; ++k)
     for (int j = 0; j + 1 < n.y; ++j)
       for (int i = 0; i + 1 < n.x; ++i) {

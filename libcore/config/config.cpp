@@ -8,13 +8,15 @@
 namespace hairgen {
 namespace {
 
-KeySpec key(std::string name, std::string hint, std::vector<std::string> aliases = {}, bool repeatable = false) {
+KeySpec key(std::string name, std::string hint, std::vector<std::string> aliases = {},
+            bool repeatable = false) {
   return KeySpec{std::move(name), std::move(aliases), std::move(hint), repeatable};
 }
 
 std::vector<SectionSpec> makeSections() {
   return {
-      {"Setup", "Setup",
+      {"Setup",
+       "Setup",
        {key("Load", "true or false: read the coupe from LoadFile instead of growing it"),
         key("Save", "true or false: write the coupe to SaveFile"),
         key("LoadFile", "path of a .hair/.gltf/.glb coupe", {"LoadPath"}),
@@ -29,7 +31,8 @@ std::vector<SectionSpec> makeSections() {
         key("HairFrag", "path of a GLSL fragment shader for the hair"),
         key("HeadVert", "path of a GLSL vertex shader for the head"),
         key("HeadFrag", "path of a GLSL fragment shader for the head")}},
-      {"Hairstyle", "Hairstyle Info",
+      {"Hairstyle",
+       "Hairstyle Info",
        {key("VisualityStep", "metres between output vertices, e.g. 0.0025"),
         key("CollisionStep", "metres between collision samples, e.g. 0.005"),
         key("MaxIter", "Rosenbrock stages at most, an integer >= 1, e.g. 20"),
@@ -53,34 +56,32 @@ std::vector<SectionSpec> makeSections() {
         key("JointAngleLimit", "cantilever: degrees [first node], e.g. 15 5"),
         key("Force", "ax ay az all | above Y | below Y | side +x|-x|+z|-z | box x0 y0 z0 x1 y1 z1", {}, true),
         key("Cut", "azimuthFrom azimuthTo zenithMax height (degrees, degrees, degrees, metres)", {}, true)}},
-      {"Collision", "Collision Info",
+      {"Collision",
+       "Collision Info",
        {key("Sphere", "volume penalty cx cy cz r", {}, true),
         key("Ellipsoid", "volume penalty cx cy cz a b c ux uy uz vx vy vz wx wy wz", {"Elipsoid"}, true),
         key("Cuboid", "volume penalty cx cy cz a b c ux uy uz vx vy vz wx wy wz", {}, true)}},
-      {"Visuality", "Visuality Info",
+      {"Visuality",
+       "Visuality Info",
        {key("AmbientColor", "r g b, e.g. 0.10 0.10 0.10"), key("DiffuseColor", "r g b, e.g. 0.45 0.25 0.00"),
         key("SpecularColor", "r g b, e.g. 0.20 0.20 0.20"), key("Glossiness", "specular exponent, e.g. 60"),
         key("AmbientMean", "hairgen shade: mean of the per-strand coefficient, e.g. 1"),
         key("AmbientDeviation", "hairgen shade: its standard deviation, e.g. 0.15")}},
-      {"Render", "Render Info",
-       {key("Resolution", "width height in pixels, e.g. 640 640"),
-        key("CameraPosition", "x y z in metres"),
-        key("CameraTarget", "x y z in metres"),
-        key("CameraUp", "x y z"),
-        key("FieldOfView", "vertical, degrees in (0, 180), e.g. 38"),
-        key("LightPosition", "x y z in metres"),
-        key("LightColor", "r g b"),
-        key("AmbientIntensity", ">= 0, e.g. 0.2"),
+      {"Render",
+       "Render Info",
+       {key("Resolution", "width height in pixels, e.g. 640 640"), key("CameraPosition", "x y z in metres"),
+        key("CameraTarget", "x y z in metres"), key("CameraUp", "x y z"),
+        key("FieldOfView", "vertical, degrees in (0, 180), e.g. 38"), key("LightPosition", "x y z in metres"),
+        key("LightColor", "r g b"), key("AmbientIntensity", ">= 0, e.g. 0.2"),
         key("Samples", "antialiasing samples per pixel, 1 to 64"),
         key("LayerSizes", "four depths in metres, e.g. 0.002 0.006 0.015 0.04"),
-        key("StrandOpacity", "0 to 1, e.g. 0.7"),
-        key("StrandWidth", "metres, e.g. 0.00008"),
-        key("ShadingModel", "kajiya-kay, thesis, anjyo or volumetric"),
-        key("Background", "r g b"),
+        key("StrandOpacity", "0 to 1, e.g. 0.7"), key("StrandWidth", "metres, e.g. 0.00008"),
+        key("ShadingModel", "kajiya-kay, thesis, anjyo or volumetric"), key("Background", "r g b"),
         key("HeadColor", "r g b, the head's albedo"),
         key("VoxelSize", "hairgen shade: metres between density grid nodes, e.g. 0.004"),
         key("VolumePadding", "hairgen shade: empty voxels around the hair, e.g. 3"),
-        key("ShellDensity", "hairgen shade: the shell's density as a fraction of a typical hair point's, e.g. 0.25"),
+        key("ShellDensity",
+            "hairgen shade: the shell's density as a fraction of a typical hair point's, e.g. 0.25"),
         key("VolumetricBlend", "0 (Kajiya-Kay) to 1 (volumetric), e.g. 1")}},
   };
 }
@@ -129,7 +130,8 @@ const SectionSpec& sectionSpec(std::string_view name) {
   throw InputError("unknown config section '" + std::string(name) + "'");
 }
 
-ConfigText parseConfigText(std::string_view text, const std::string& name, const std::filesystem::path& baseDir) {
+ConfigText parseConfigText(std::string_view text, const std::string& name,
+                           const std::filesystem::path& baseDir) {
   ConfigText config{name, baseDir, {}};
   int lineNumber = 0;
   size_t pos = 0;
@@ -194,18 +196,21 @@ Override parseOverride(std::string_view argument) {
   std::string sectionName(argument.substr(0, dot));
   const SectionSpec* section = nullptr;
   for (const SectionSpec& s : allSections())
-    if (toLower(s.name) == toLower(sectionName) || toLower(s.name) + "info" == toLower(sectionName)) section = &s;
+    if (toLower(s.name) == toLower(sectionName) || toLower(s.name) + "info" == toLower(sectionName))
+      section = &s;
   if (!section) {
     std::vector<std::string> names;
     for (const SectionSpec& s : allSections()) names.push_back(s.name);
     std::string close = closestMatch(sectionName, names);
-    throw InputError(where, "unknown section '" + sectionName + "'" +
-                                (close.empty() ? "; sections are Setup, Hairstyle, Collision, Visuality, Render"
-                                               : "; did you mean '" + close + "'?"));
+    throw InputError(where,
+                     "unknown section '" + sectionName + "'" +
+                         (close.empty() ? "; sections are Setup, Hairstyle, Collision, Visuality, Render"
+                                        : "; did you mean '" + close + "'?"));
   }
   std::string keyName(argument.substr(dot + 1, eq - dot - 1));
   if (canonicalKey(*section, keyName).empty())
-    throw InputError(where, "unknown key '" + keyName + "' in " + section->title + unknownKeyHint(*section, keyName));
+    throw InputError(
+        where, "unknown key '" + keyName + "' in " + section->title + unknownKeyHint(*section, keyName));
   ConfigText parsed = parseConfigText(argument.substr(eq + 1), where.file, std::filesystem::current_path());
   std::vector<std::string> values;
   for (const ConfigLine& line : parsed.lines) {
@@ -297,11 +302,13 @@ const ConfigLine* SectionReader::single(std::string_view key) {
 void SectionReader::expectCount(const ConfigLine& line, size_t count) const {
   if (line.values.size() != count)
     throw InputError(line.where, "'" + line.key + "' takes " + std::to_string(count) + " value" +
-                                     (count == 1 ? "" : "s") + ", found " + std::to_string(line.values.size()) +
-                                     "; expected " + spec(canonicalKey(section_, line.key)).hint);
+                                     (count == 1 ? "" : "s") + ", found " +
+                                     std::to_string(line.values.size()) + "; expected " +
+                                     spec(canonicalKey(section_, line.key)).hint);
 }
 
-double SectionReader::checkReal(const ConfigLine& line, size_t index, Range range, std::string_view what) const {
+double SectionReader::checkReal(const ConfigLine& line, size_t index, Range range,
+                                std::string_view what) const {
   const std::string& token = line.values.at(index);
   std::optional<double> value = parseReal(token);
   std::string label = what.empty() ? "'" + line.key + "'" : "'" + line.key + "' " + std::string(what);
@@ -316,26 +323,31 @@ double SectionReader::real(std::string_view key, std::optional<double> fallback,
   const ConfigLine* line = single(key);
   if (!line) {
     if (!fallback)
-      throw InputError({text_.name, 0}, "missing required key '" + std::string(key) + "' (" + spec(key).hint + ")");
+      throw InputError({text_.name, 0},
+                       "missing required key '" + std::string(key) + "' (" + spec(key).hint + ")");
     return *fallback;
   }
   expectCount(*line, 1);
   return checkReal(*line, 0, range, "");
 }
 
-int64_t SectionReader::integer(std::string_view key, std::optional<int64_t> fallback, int64_t min, int64_t max) {
+int64_t SectionReader::integer(std::string_view key, std::optional<int64_t> fallback, int64_t min,
+                               int64_t max) {
   const ConfigLine* line = single(key);
   if (!line) {
     if (!fallback)
-      throw InputError({text_.name, 0}, "missing required key '" + std::string(key) + "' (" + spec(key).hint + ")");
+      throw InputError({text_.name, 0},
+                       "missing required key '" + std::string(key) + "' (" + spec(key).hint + ")");
     return *fallback;
   }
   expectCount(*line, 1);
   std::optional<int64_t> value = parseInt(line->values[0]);
-  if (!value) throw InputError(line->where, "'" + line->key + "': '" + line->values[0] + "' is not an integer");
+  if (!value)
+    throw InputError(line->where, "'" + line->key + "': '" + line->values[0] + "' is not an integer");
   if (*value < min || *value > max)
-    throw InputError(line->where, "'" + line->key + "' = " + line->values[0] + " is out of range; it must be in [" +
-                                      std::to_string(min) + ", " + std::to_string(max) + "]");
+    throw InputError(line->where, "'" + line->key + "' = " + line->values[0] +
+                                      " is out of range; it must be in [" + std::to_string(min) + ", " +
+                                      std::to_string(max) + "]");
   return *value;
 }
 
@@ -345,7 +357,8 @@ uint64_t SectionReader::unsignedInteger(std::string_view key, uint64_t fallback)
   expectCount(*line, 1);
   std::optional<uint64_t> value = parseUInt(line->values[0]);
   if (!value)
-    throw InputError(line->where, "'" + line->key + "': '" + line->values[0] + "' is not a non-negative integer");
+    throw InputError(line->where,
+                     "'" + line->key + "': '" + line->values[0] + "' is not a non-negative integer");
   return *value;
 }
 
@@ -354,7 +367,8 @@ std::vector<double> SectionReader::reals(std::string_view key, size_t count,
   const ConfigLine* line = single(key);
   if (!line) {
     if (!fallback)
-      throw InputError({text_.name, 0}, "missing required key '" + std::string(key) + "' (" + spec(key).hint + ")");
+      throw InputError({text_.name, 0},
+                       "missing required key '" + std::string(key) + "' (" + spec(key).hint + ")");
     return *fallback;
   }
   expectCount(*line, count);
@@ -367,7 +381,8 @@ std::vector<double> SectionReader::reals(std::string_view key, size_t count,
 std::vector<double> SectionReader::realList(std::string_view key, Range range) {
   const ConfigLine* line = single(key);
   if (!line)
-    throw InputError({text_.name, 0}, "missing required key '" + std::string(key) + "' (" + spec(key).hint + ")");
+    throw InputError({text_.name, 0},
+                     "missing required key '" + std::string(key) + "' (" + spec(key).hint + ")");
   std::vector<double> values;
   for (size_t i = 0; i < line->values.size(); ++i)
     values.push_back(checkReal(*line, i, range, "value " + std::to_string(i + 1)));
@@ -386,7 +401,8 @@ bool SectionReader::boolean(std::string_view key, bool fallback) {
   std::string v = toLower(line->values[0]);
   if (v == "true" || v == "1" || v == "yes" || v == "on") return true;
   if (v == "false" || v == "0" || v == "no" || v == "off") return false;
-  throw InputError(line->where, "'" + line->key + "': '" + line->values[0] + "' is not a boolean; use true or false");
+  throw InputError(line->where,
+                   "'" + line->key + "': '" + line->values[0] + "' is not a boolean; use true or false");
 }
 
 std::string SectionReader::word(std::string_view key, const std::string& fallback,
@@ -428,7 +444,7 @@ void SectionReader::finish() const {
     const ConfigLine& line = text_.lines[i];
     if (canonicalKey(section_, line.key).empty())
       throw InputError(line.where, "unknown key '" + line.key + "' in " + section_.title +
-                                      unknownKeyHint(section_, line.key));
+                                       unknownKeyHint(section_, line.key));
     // A known key nobody read: the reader forgot it. Name it rather than ignore it.
     throw InputError(line.where, "key '" + line.key + "' is not used by this version of hairgen");
   }

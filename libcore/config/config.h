@@ -14,8 +14,8 @@
 
 #include <glm/glm.hpp>
 
-#include "libcore/util/error.h"
 #include "libcore/config/params.h"
+#include "libcore/util/error.h"
 
 namespace hairgen {
 
@@ -26,13 +26,14 @@ struct ConfigLine {
 };
 
 struct ConfigText {
-  std::string name;                 // display name (the path as given)
-  std::filesystem::path baseDir;    // relative paths in values resolve against it
+  std::string name;               // display name (the path as given)
+  std::filesystem::path baseDir;  // relative paths in values resolve against it
   std::vector<ConfigLine> lines;
 };
 
 // Splits text into lines of tokens. Throws InputError on an unterminated quote or a control byte.
-ConfigText parseConfigText(std::string_view text, const std::string& name, const std::filesystem::path& baseDir);
+ConfigText parseConfigText(std::string_view text, const std::string& name,
+                           const std::filesystem::path& baseDir);
 ConfigText readConfigText(const std::filesystem::path& file);
 
 // One key a section knows: its canonical spelling, other accepted spellings, and a one-line hint of
@@ -87,7 +88,8 @@ class SectionReader {
   std::vector<double> realList(std::string_view key, Range range = {});  // one or more, required
   bool boolean(std::string_view key, bool fallback);
   // One of `choices` (compared case-insensitively; returns the canonical spelling from `choices`).
-  std::string word(std::string_view key, const std::string& fallback, const std::vector<std::string>& choices);
+  std::string word(std::string_view key, const std::string& fallback,
+                   const std::vector<std::string>& choices);
   PathRef path(std::string_view key);  // empty PathRef when absent
 
   glm::dvec3 vec3(std::string_view key, glm::dvec3 fallback, Range range = {});

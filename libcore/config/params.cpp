@@ -14,43 +14,61 @@ std::string join(std::initializer_list<double> values) {
   for (double v : values) out += (out.empty() ? "" : " ") + formatReal(v);
   return out;
 }
-std::string join(const glm::dvec3& v) { return join({v.x, v.y, v.z}); }
+std::string join(const glm::dvec3& v) {
+  return join({v.x, v.y, v.z});
+}
 
 }  // namespace
 
-const char* name(StylingModel model) { return model == StylingModel::kCantilever ? "cantilever" : "superhelix"; }
+const char* name(StylingModel model) {
+  return model == StylingModel::kCantilever ? "cantilever" : "superhelix";
+}
 
 const char* name(ShadingModel model) {
   switch (model) {
-    case ShadingModel::kThesis: return "thesis";
-    case ShadingModel::kAnjyo: return "anjyo";
-    case ShadingModel::kVolumetric: return "volumetric";
-    case ShadingModel::kKajiyaKay: break;
+    case ShadingModel::kThesis:
+      return "thesis";
+    case ShadingModel::kAnjyo:
+      return "anjyo";
+    case ShadingModel::kVolumetric:
+      return "volumetric";
+    case ShadingModel::kKajiyaKay:
+      break;
   }
   return "kajiya-kay";
 }
 
 const char* name(ShapeKind kind) {
   switch (kind) {
-    case ShapeKind::kEllipsoid: return "Ellipsoid";
-    case ShapeKind::kCuboid: return "Cuboid";
-    case ShapeKind::kSphere: break;
+    case ShapeKind::kEllipsoid:
+      return "Ellipsoid";
+    case ShapeKind::kCuboid:
+      return "Cuboid";
+    case ShapeKind::kSphere:
+      break;
   }
   return "Sphere";
 }
 
 bool ForceField::contains(const glm::dvec3& p) const {
   switch (region) {
-    case Region::kAll: return true;
-    case Region::kAbove: return p.y > level;
-    case Region::kBelow: return p.y < level;
-    case Region::kSide: return glm::dot(p, side) > 0.0;
-    case Region::kBox: return glm::all(glm::greaterThanEqual(p, lo)) && glm::all(glm::lessThanEqual(p, hi));
+    case Region::kAll:
+      return true;
+    case Region::kAbove:
+      return p.y > level;
+    case Region::kBelow:
+      return p.y < level;
+    case Region::kSide:
+      return glm::dot(p, side) > 0.0;
+    case Region::kBox:
+      return glm::all(glm::greaterThanEqual(p, lo)) && glm::all(glm::lessThanEqual(p, hi));
   }
   return false;
 }
 
-double Hairstyle::totalLength() const { return std::accumulate(hairLengths.begin(), hairLengths.end(), 0.0); }
+double Hairstyle::totalLength() const {
+  return std::accumulate(hairLengths.begin(), hairLengths.end(), 0.0);
+}
 
 std::string Config::canonicalText() const {
   std::ostringstream out;
@@ -79,8 +97,8 @@ std::string Config::canonicalText() const {
       << "Hairstyle.FlexuralRigidity " << formatReal(h.flexuralRigidity) << "\n"
       << "Hairstyle.JointAngleLimit " << formatReal(h.jointLimit) << " " << h.jointLimitFrom << "\n";
   for (const ForceField& f : h.forces)
-    out << "Hairstyle.Force " << join(f.acceleration) << " " << int(f.region) << " " << formatReal(f.level) << " "
-        << join(f.side) << " " << join(f.lo) << " " << join(f.hi) << "\n";
+    out << "Hairstyle.Force " << join(f.acceleration) << " " << int(f.region) << " " << formatReal(f.level)
+        << " " << join(f.side) << " " << join(f.lo) << " " << join(f.hi) << "\n";
   for (const HairCut& c : h.cuts)
     out << "Hairstyle.Cut " << join({c.azimuthFrom, c.azimuthTo, c.zenithMax, c.height}) << "\n";
   for (const CollisionShape& c : collision.shapes) {
@@ -107,7 +125,8 @@ std::string Config::canonicalText() const {
       << "Render.LightColor " << join(r.lightColor) << "\n"
       << "Render.AmbientIntensity " << formatReal(r.ambientIntensity) << "\n"
       << "Render.Samples " << r.samples << "\n"
-      << "Render.LayerSizes " << join({r.layerSizes.x, r.layerSizes.y, r.layerSizes.z, r.layerSizes.w}) << "\n"
+      << "Render.LayerSizes " << join({r.layerSizes.x, r.layerSizes.y, r.layerSizes.z, r.layerSizes.w})
+      << "\n"
       << "Render.StrandOpacity " << formatReal(r.strandOpacity) << "\n"
       << "Render.StrandWidth " << formatReal(r.strandWidth) << "\n"
       << "Render.ShadingModel " << name(r.shadingModel) << "\n"

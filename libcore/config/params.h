@@ -26,9 +26,9 @@ struct ForceField {
   enum class Region { kAll, kAbove, kBelow, kSide, kBox };
   glm::dvec3 acceleration{0.0};
   Region region = Region::kAll;
-  double level = 0.0;          // kAbove / kBelow: a height, metres
-  glm::dvec3 side{0.0};        // kSide: a unit axis (±x or ±z); the region is where p·side > 0
-  glm::dvec3 lo{0.0}, hi{0.0}; // kBox
+  double level = 0.0;           // kAbove / kBelow: a height, metres
+  glm::dvec3 side{0.0};         // kSide: a unit axis (±x or ±z); the region is where p·side > 0
+  glm::dvec3 lo{0.0}, hi{0.0};  // kBox
   FileLoc where;
   bool contains(const glm::dvec3& p) const;
 };
@@ -58,18 +58,18 @@ struct Hairstyle {
   double density = 1300.0;          // ρ, kilograms per cubic metre (Table 3)
   double gravity = 9.81;            // g, newtons per kilogram (Table 3)
   StylingModel model = StylingModel::kSuperHelix;
-  double clump = 0.25;              // tip weights v1, v2 drawn in [0, Clump): 0 gathers tips at the nearest guide
-  bool strayHairs = true;           // true = the thesis' barycentric assignment (§4.1.4.4)
-  uint64_t seed = 0;                // keys every random number; --seed overrides it
+  double clump = 0.25;     // tip weights v1, v2 drawn in [0, Clump): 0 gathers tips at the nearest guide
+  bool strayHairs = true;  // true = the thesis' barycentric assignment (§4.1.4.4)
+  uint64_t seed = 0;       // keys every random number; --seed overrides it
   // Model cantilever (Anjyo et al. 1992):
-  int segments = 20;                // equal segments per hair, over the whole of HairLengths
-  double flexuralRigidity = 0.0;    // E·I in N·m²; 0 = Young × π a b³/4
-  double jointLimit = 180.0;        // degrees: the largest turn between consecutive segments
-  int jointLimitFrom = 1;           // the first node (1 = the first after the pore) the limit applies to
+  int segments = 20;              // equal segments per hair, over the whole of HairLengths
+  double flexuralRigidity = 0.0;  // E·I in N·m²; 0 = Young × π a b³/4
+  double jointLimit = 180.0;      // degrees: the largest turn between consecutive segments
+  int jointLimitFrom = 1;         // the first node (1 = the first after the pore) the limit applies to
   std::vector<ForceField> forces;
   std::vector<HairCut> cuts;
 
-  double totalLength() const;       // metres
+  double totalLength() const;  // metres
 };
 
 enum class ShapeKind { kSphere, kEllipsoid, kCuboid };
@@ -78,12 +78,12 @@ const char* name(ShapeKind kind);
 // One collision body of Collision Info.
 struct CollisionShape {
   ShapeKind kind = ShapeKind::kSphere;
-  double volume = 0.0;              // metres: envelope growth from the lowest to the highest follicle
-  double penalty = 0.0;             // k of the penalty ½k·max(dent + extra, 0)²
-  glm::dvec3 centre{0.0};           // metres
-  glm::dvec3 halfExtents{0.0};      // metres: radius, semi-axes or half-extents along `axes`
-  glm::dmat3 axes{1.0};             // columns: the body's unit axes (orthonormalised on read)
-  FileLoc where;                    // the config line it came from
+  double volume = 0.0;          // metres: envelope growth from the lowest to the highest follicle
+  double penalty = 0.0;         // k of the penalty ½k·max(dent + extra, 0)²
+  glm::dvec3 centre{0.0};       // metres
+  glm::dvec3 halfExtents{0.0};  // metres: radius, semi-axes or half-extents along `axes`
+  glm::dmat3 axes{1.0};         // columns: the body's unit axes (orthonormalised on read)
+  FileLoc where;                // the config line it came from
 };
 
 struct Collision {
@@ -103,27 +103,27 @@ struct Visuality {
 
 // Render Info (new in hairgen): camera, light and film.
 struct RenderSettings {
-  glm::ivec2 resolution{640, 640};            // pixels
-  glm::dvec3 cameraPosition{0.32, 0.16, 0.52}; // metres; frames the bundled head from front-right
+  glm::ivec2 resolution{640, 640};              // pixels
+  glm::dvec3 cameraPosition{0.32, 0.16, 0.52};  // metres; frames the bundled head from front-right
   glm::dvec3 cameraTarget{0.0, 0.03, 0.0};
   glm::dvec3 cameraUp{0.0, 1.0, 0.0};
-  double fieldOfView = 38.0;                  // degrees, vertical
-  glm::dvec3 lightPosition{0.6, 1.0, 0.8};    // metres
+  double fieldOfView = 38.0;                // degrees, vertical
+  glm::dvec3 lightPosition{0.6, 1.0, 0.8};  // metres
   glm::dvec3 lightColor{1.0, 1.0, 1.0};
   double ambientIntensity = 0.2;
-  int samples = 4;                            // antialiasing sub-pixels per pixel (k² for k×k)
+  int samples = 4;                                   // antialiasing sub-pixels per pixel (k² for k×k)
   glm::dvec4 layerSizes{0.002, 0.006, 0.015, 0.04};  // metres: the 4 deep-opacity layer depths
-  double strandOpacity = 0.7;                 // opacity of one strand, 0-1
-  double strandWidth = 8.0e-5;                // metres, on-screen diameter of a strand
+  double strandOpacity = 0.7;                        // opacity of one strand, 0-1
+  double strandWidth = 8.0e-5;                       // metres, on-screen diameter of a strand
   ShadingModel shadingModel = ShadingModel::kKajiyaKay;
   glm::dvec3 background{0.18, 0.18, 0.20};
-  glm::dvec3 headColor{0.72, 0.55, 0.45};     // Lambert albedo of the head
+  glm::dvec3 headColor{0.72, 0.55, 0.45};  // Lambert albedo of the head
   // The volumetric model (Petrovic et al. 2005): `hairgen shade` builds the hair's density grid and
   // shell from these, and `ShadingModel volumetric` mixes its shading with Kajiya-Kay by the blend.
-  double voxelSize = 0.004;     // metres, the density grid's spacing
-  int volumePadding = 3;        // empty voxels around the hair on every side
-  double shellDensity = 0.25;   // the shell's density, as a fraction of the density at a typical hair point
-  double volumetricBlend = 1.0; // 0 = Kajiya-Kay, 1 = volumetric
+  double voxelSize = 0.004;      // metres, the density grid's spacing
+  int volumePadding = 3;         // empty voxels around the hair on every side
+  double shellDensity = 0.25;    // the shell's density, as a fraction of the density at a typical hair point
+  double volumetricBlend = 1.0;  // 0 = Kajiya-Kay, 1 = volumetric
 };
 
 // A path named by a config file, with where it was named (for "missing file" errors).
@@ -149,7 +149,7 @@ struct Override {
   std::string section;  // canonical: Setup, Hairstyle, Collision, Visuality, Render
   std::string key;      // as written
   std::vector<std::string> values;
-  std::string text;     // the argument as given
+  std::string text;  // the argument as given
 };
 
 // Everything a job reads, after overrides.

@@ -16,7 +16,9 @@ glm::dmat3 orthonormalAxes(const SectionReader& reader, const ConfigLine& line, 
                            glm::dvec3 w) {
   double scale = std::max(glm::length(u), std::max(glm::length(v), glm::length(w)));
   if (glm::length(u) < 1e-9 || glm::length(v) < 1e-9 || glm::length(w) < 1e-9)
-    throw reader.error(line, "'" + line.key + "': an axis vector is zero; give three independent axes, e.g. 1 0 0 0 1 0 0 0 1");
+    throw reader.error(
+        line,
+        "'" + line.key + "': an axis vector is zero; give three independent axes, e.g. 1 0 0 0 1 0 0 0 1");
   u = glm::normalize(u);
   v -= glm::dot(v, u) * u;
   if (glm::length(v) < 1e-6 * scale)
@@ -31,10 +33,11 @@ glm::dmat3 orthonormalAxes(const SectionReader& reader, const ConfigLine& line, 
 CollisionShape readShape(const SectionReader& reader, const ConfigLine& line, ShapeKind kind) {
   size_t count = kind == ShapeKind::kSphere ? 6 : 17;
   if (line.values.size() != count)
-    throw reader.error(line, "'" + line.key + "' takes " + std::to_string(count) + " values, found " +
-                                 std::to_string(line.values.size()) + "; expected " +
-                                 (kind == ShapeKind::kSphere ? "volume penalty cx cy cz r"
-                                                             : "volume penalty cx cy cz a b c ux uy uz vx vy vz wx wy wz"));
+    throw reader.error(
+        line, "'" + line.key + "' takes " + std::to_string(count) + " values, found " +
+                  std::to_string(line.values.size()) + "; expected " +
+                  (kind == ShapeKind::kSphere ? "volume penalty cx cy cz r"
+                                              : "volume penalty cx cy cz a b c ux uy uz vx vy vz wx wy wz"));
   CollisionShape shape;
   shape.kind = kind;
   shape.where = line.where;
@@ -45,7 +48,8 @@ CollisionShape readShape(const SectionReader& reader, const ConfigLine& line, Sh
     shape.halfExtents = glm::dvec3(reader.checkReal(line, 5, Range::positive(), "radius"));
     return shape;
   }
-  for (int i = 0; i < 3; ++i) shape.halfExtents[i] = reader.checkReal(line, 5 + i, Range::positive(), "dimension");
+  for (int i = 0; i < 3; ++i)
+    shape.halfExtents[i] = reader.checkReal(line, 5 + i, Range::positive(), "dimension");
   glm::dvec3 axis[3];
   for (int a = 0; a < 3; ++a)
     for (int i = 0; i < 3; ++i) axis[a][i] = reader.checkReal(line, 8 + 3 * a + i, {}, "axis");
@@ -55,12 +59,15 @@ CollisionShape readShape(const SectionReader& reader, const ConfigLine& line, Sh
 
 ForceField readForce(const SectionReader& r, const ConfigLine& line) {
   auto bad = [&](const std::string& why) {
-    return r.error(line, "Force " + why + "; expected ax ay az all | above Y | below Y | side +x|-x|+z|-z | box x0 y0 z0 x1 y1 z1");
+    return r.error(
+        line, "Force " + why +
+                  "; expected ax ay az all | above Y | below Y | side +x|-x|+z|-z | box x0 y0 z0 x1 y1 z1");
   };
   if (line.values.size() < 4) throw bad("needs an acceleration and a region");
   ForceField f;
   f.where = line.where;
-  for (int i = 0; i < 3; ++i) f.acceleration[i] = r.checkReal(line, i, Range::closed(-1e4, 1e4), "acceleration");
+  for (int i = 0; i < 3; ++i)
+    f.acceleration[i] = r.checkReal(line, i, Range::closed(-1e4, 1e4), "acceleration");
   const std::string region = toLower(line.values[3]);
   const size_t extra = line.values.size() - 4;
   if (region == "all" && extra == 0) {
@@ -71,11 +78,16 @@ ForceField readForce(const SectionReader& r, const ConfigLine& line) {
   } else if (region == "side" && extra == 1) {
     const std::string& s = line.values[4];
     f.region = ForceField::Region::kSide;
-    if (s == "+x") f.side = {1, 0, 0};
-    else if (s == "-x") f.side = {-1, 0, 0};
-    else if (s == "+z") f.side = {0, 0, 1};
-    else if (s == "-z") f.side = {0, 0, -1};
-    else throw bad("side '" + s + "' is not +x, -x, +z or -z");
+    if (s == "+x")
+      f.side = {1, 0, 0};
+    else if (s == "-x")
+      f.side = {-1, 0, 0};
+    else if (s == "+z")
+      f.side = {0, 0, 1};
+    else if (s == "-z")
+      f.side = {0, 0, -1};
+    else
+      throw bad("side '" + s + "' is not +x, -x, +z or -z");
   } else if (region == "box" && extra == 6) {
     f.region = ForceField::Region::kBox;
     for (int i = 0; i < 3; ++i) f.lo[i] = r.checkReal(line, 4 + i, {}, "box corner");
@@ -93,10 +105,12 @@ ConfigText emptyText(const std::filesystem::path& setupFile, const char* what) {
 void requireExisting(const PathRef& ref, const char* key) {
   std::error_code ec;
   if (!std::filesystem::exists(ref.path, ec))
-    throw InputError(ref.where, std::string(key) + " names '" + ref.path.string() +
-                                    "', which does not exist (paths are relative to the file that names them)");
+    throw InputError(ref.where,
+                     std::string(key) + " names '" + ref.path.string() +
+                         "', which does not exist (paths are relative to the file that names them)");
   if (std::filesystem::is_directory(ref.path, ec))
-    throw InputError(ref.where, std::string(key) + " names '" + ref.path.string() + "', which is a directory");
+    throw InputError(ref.where,
+                     std::string(key) + " names '" + ref.path.string() + "', which is a directory");
 }
 
 }  // namespace
@@ -120,9 +134,11 @@ Setup readSetup(const ConfigText& text, const std::vector<Override>& overrides) 
   s.headVert = r.path("HeadVert");
   s.headFrag = r.path("HeadFrag");
   if (s.load && !s.loadFile.given())
-    throw InputError(r.where("Load"), "Load is true but no LoadFile names the coupe to load; add `LoadFile PATH`");
+    throw InputError(r.where("Load"),
+                     "Load is true but no LoadFile names the coupe to load; add `LoadFile PATH`");
   if (s.save && !s.saveFile.given())
-    throw InputError(r.where("Save"), "Save is true but no SaveFile names where to save; add `SaveFile PATH`");
+    throw InputError(r.where("Save"),
+                     "Save is true but no SaveFile names where to save; add `SaveFile PATH`");
   r.finish();
   return s;
 }
@@ -137,7 +153,7 @@ Hairstyle readHairstyle(const ConfigText& text, const std::vector<Override>& ove
   h.hairLengths = r.realList("HairLengths", {0.0, 10.0, true, false});
   if (h.hairLengths.size() > 256)
     throw InputError(r.where("HairLengths"), "at most 256 Super-Helix elements are supported, found " +
-                                                  std::to_string(h.hairLengths.size()));
+                                                 std::to_string(h.hairLengths.size()));
   h.hairDensity = r.real("HairDensity", h.hairDensity, Range::nonNegative());
   h.hairRadius1 = r.real("HairRadius1", h.hairRadius1, {0.0, 0.01, true, false});
   h.hairRadius2 = r.real("HairRadius2", h.hairRadius2, {0.0, 0.01, true, false});
@@ -147,8 +163,9 @@ Hairstyle readHairstyle(const ConfigText& text, const std::vector<Override>& ove
   h.young = r.real("Young", h.young, Range::positive());
   h.density = r.real("Density", h.density, Range::nonNegative());
   h.gravity = r.real("Gravity", h.gravity, Range::closed(0.0, 1000.0));
-  h.model = r.word("Model", "superhelix", {"superhelix", "cantilever"}) == "cantilever" ? StylingModel::kCantilever
-                                                                                        : StylingModel::kSuperHelix;
+  h.model = r.word("Model", "superhelix", {"superhelix", "cantilever"}) == "cantilever"
+                ? StylingModel::kCantilever
+                : StylingModel::kSuperHelix;
   h.clump = r.real("Clump", h.clump, Range::closed(0.0, 1.0));
   h.strayHairs = r.boolean("StrayHairs", h.strayHairs);
   h.seed = r.unsignedInteger("Seed", h.seed);
@@ -169,8 +186,8 @@ Hairstyle readHairstyle(const ConfigText& text, const std::vector<Override>& ove
   for (const ConfigLine* line : r.lines("Force")) h.forces.push_back(readForce(r, *line));
   for (const ConfigLine* line : r.lines("Cut")) {
     if (line->values.size() != 4)
-      throw r.error(*line, "Cut takes azimuthFrom azimuthTo zenithMax height, found " + std::to_string(line->values.size()) +
-                               " values");
+      throw r.error(*line, "Cut takes azimuthFrom azimuthTo zenithMax height, found " +
+                               std::to_string(line->values.size()) + " values");
     HairCut c;
     c.azimuthFrom = r.checkReal(*line, 0, Range::closed(-360.0, 360.0), "azimuth");
     c.azimuthTo = r.checkReal(*line, 1, Range::closed(-360.0, 360.0), "azimuth");
@@ -191,7 +208,8 @@ Collision readCollision(const ConfigText& text, const std::vector<Override>& ove
   for (const ConfigLine* line : r.lines("Ellipsoid")) all.emplace_back(line, ShapeKind::kEllipsoid);
   for (const ConfigLine* line : r.lines("Cuboid")) all.emplace_back(line, ShapeKind::kCuboid);
   std::stable_sort(all.begin(), all.end(), [](const auto& a, const auto& b) {
-    if (a.first->where.file != b.first->where.file) return a.first->where.line > 0 && b.first->where.line == 0;
+    if (a.first->where.file != b.first->where.file)
+      return a.first->where.line > 0 && b.first->where.line == 0;
     return a.first->where.line < b.first->where.line;
   });
   Collision c;
@@ -216,8 +234,9 @@ Visuality readVisuality(const ConfigText& text, const std::vector<Override>& ove
 RenderSettings readRender(const ConfigText& text, const std::vector<Override>& overrides) {
   SectionReader r(text, sectionSpec("Render"), overrides);
   RenderSettings s;
-  std::vector<double> res = r.reals("Resolution", 2, std::vector<double>{double(s.resolution.x), double(s.resolution.y)},
-                                    Range::closed(1, 16384));
+  std::vector<double> res =
+      r.reals("Resolution", 2, std::vector<double>{double(s.resolution.x), double(s.resolution.y)},
+              Range::closed(1, 16384));
   if (res[0] != std::floor(res[0]) || res[1] != std::floor(res[1]))
     throw InputError(r.where("Resolution"), "Resolution must be two whole numbers of pixels");
   s.resolution = glm::ivec2(static_cast<int>(res[0]), static_cast<int>(res[1]));
@@ -225,7 +244,8 @@ RenderSettings readRender(const ConfigText& text, const std::vector<Override>& o
   s.cameraTarget = r.vec3("CameraTarget", s.cameraTarget);
   s.cameraUp = r.vec3("CameraUp", s.cameraUp);
   if (glm::length(s.cameraTarget - s.cameraPosition) < 1e-9)
-    throw InputError(r.where("CameraTarget"), "CameraTarget equals CameraPosition; the camera needs a direction");
+    throw InputError(r.where("CameraTarget"),
+                     "CameraTarget equals CameraPosition; the camera needs a direction");
   if (glm::length(glm::cross(s.cameraUp, s.cameraTarget - s.cameraPosition)) < 1e-9)
     throw InputError(r.where("CameraUp"), "CameraUp is zero or parallel to the view direction");
   s.fieldOfView = r.real("FieldOfView", s.fieldOfView, {0.0, 180.0, true, true});
@@ -233,9 +253,9 @@ RenderSettings readRender(const ConfigText& text, const std::vector<Override>& o
   s.lightColor = r.vec3("LightColor", s.lightColor, Range::closed(0.0, 1e6));
   s.ambientIntensity = r.real("AmbientIntensity", s.ambientIntensity, Range::closed(0.0, 1e6));
   s.samples = static_cast<int>(r.integer("Samples", s.samples, 1, 64));
-  std::vector<double> layers = r.reals("LayerSizes", 4,
-                                       std::vector<double>{s.layerSizes.x, s.layerSizes.y, s.layerSizes.z, s.layerSizes.w},
-                                       Range::positive());
+  std::vector<double> layers = r.reals(
+      "LayerSizes", 4, std::vector<double>{s.layerSizes.x, s.layerSizes.y, s.layerSizes.z, s.layerSizes.w},
+      Range::positive());
   s.layerSizes = glm::dvec4(layers[0], layers[1], layers[2], layers[3]);
   s.strandOpacity = r.real("StrandOpacity", s.strandOpacity, Range::closed(0.0, 1.0));
   s.strandWidth = r.real("StrandWidth", s.strandWidth, {0.0, 1.0, true, false});
@@ -254,7 +274,8 @@ RenderSettings readRender(const ConfigText& text, const std::vector<Override>& o
   return s;
 }
 
-Config loadConfig(const std::filesystem::path& setupFile, const std::vector<Override>& overrides, SetupUse use) {
+Config loadConfig(const std::filesystem::path& setupFile, const std::vector<Override>& overrides,
+                  SetupUse use) {
   Config config;
   config.overrides = overrides;
   config.setup = readSetup(readConfigText(setupFile), overrides);
@@ -262,23 +283,32 @@ Config loadConfig(const std::filesystem::path& setupFile, const std::vector<Over
   bool grows = use == SetupUse::kGrow || use == SetupUse::kInterpolate || (use == SetupUse::kRun && !s.load);
 
   auto need = [&](const PathRef& ref, const char* key, const char* why) {
-    if (!ref.given()) throw InputError({setupFile.string(), 0}, std::string("missing required key '") + key + "' (" + why + ")");
+    if (!ref.given())
+      throw InputError({setupFile.string(), 0},
+                       std::string("missing required key '") + key + "' (" + why + ")");
   };
   if (grows) {
     need(s.hairstyleInfo, "HairstyleInfo", "path of the Hairstyle Info file");
     need(s.wickModel, "WickModel", "path of the wick OBJ");
   }
-  for (auto [ref, key] : {std::pair{&s.hairstyleInfo, "HairstyleInfo"}, {&s.collisionInfo, "CollisionInfo"},
-                          {&s.visualityInfo, "VisualityInfo"}, {&s.renderInfo, "RenderInfo"}, {&s.wickModel, "WickModel"},
-                          {&s.headModel, "HeadModel"}, {&s.hairVert, "HairVert"}, {&s.hairFrag, "HairFrag"},
-                          {&s.headVert, "HeadVert"}, {&s.headFrag, "HeadFrag"}})
+  for (auto [ref, key] : {std::pair{&s.hairstyleInfo, "HairstyleInfo"},
+                          {&s.collisionInfo, "CollisionInfo"},
+                          {&s.visualityInfo, "VisualityInfo"},
+                          {&s.renderInfo, "RenderInfo"},
+                          {&s.wickModel, "WickModel"},
+                          {&s.headModel, "HeadModel"},
+                          {&s.hairVert, "HairVert"},
+                          {&s.hairFrag, "HairFrag"},
+                          {&s.headVert, "HeadVert"},
+                          {&s.headFrag, "HeadFrag"}})
     if (ref->given()) requireExisting(*ref, key);
   if (s.load && (use == SetupUse::kRun || use == SetupUse::kCheck)) requireExisting(s.loadFile, "LoadFile");
 
   auto text = [&](const PathRef& ref, const char* what) {
     return ref.given() ? readConfigText(ref.path) : emptyText(setupFile, what);
   };
-  if (s.hairstyleInfo.given() || grows) config.hairstyle = readHairstyle(text(s.hairstyleInfo, "Hairstyle Info"), overrides);
+  if (s.hairstyleInfo.given() || grows)
+    config.hairstyle = readHairstyle(text(s.hairstyleInfo, "Hairstyle Info"), overrides);
   config.collision = readCollision(text(s.collisionInfo, "Collision Info"), overrides);
   config.visuality = readVisuality(text(s.visualityInfo, "Visuality Info"), overrides);
   config.render = readRender(text(s.renderInfo, "Render Info"), overrides);

@@ -29,6 +29,7 @@ enum class SetupUse {
 // Reads `setupFile` and every info file it names. A file that is named but missing, or a file the use
 // needs that is not named, is an InputError at the Setup's line. Info files that are not named get
 // their defaults (overrides still apply).
-Config loadConfig(const std::filesystem::path& setupFile, const std::vector<Override>& overrides, SetupUse use);
+Config loadConfig(const std::filesystem::path& setupFile, const std::vector<Override>& overrides,
+                  SetupUse use);
 
 }  // namespace hairgen

@@ -29,7 +29,9 @@ Imath::M44f toImath(const glm::dmat4& m) {
   return r;
 }
 
-bool isHalf(const std::string& c) { return c == "R" || c == "G" || c == "B" || c == "A"; }
+bool isHalf(const std::string& c) {
+  return c == "R" || c == "G" || c == "B" || c == "A";
+}
 
 }  // namespace
 
@@ -52,8 +54,9 @@ void writeExr(const fs::path& file, const Image& image, const ExrMetadata& metad
                                     sizeof(half) * image.width));
     } else {
       header.channels().insert(name, Imf::Channel(Imf::FLOAT));
-      frame.insert(name, Imf::Slice(Imf::FLOAT, reinterpret_cast<char*>(const_cast<float*>(image.planes[c].data())),
-                                    sizeof(float), sizeof(float) * image.width));
+      frame.insert(name,
+                   Imf::Slice(Imf::FLOAT, reinterpret_cast<char*>(const_cast<float*>(image.planes[c].data())),
+                              sizeof(float), sizeof(float) * image.width));
     }
   }
   writeThroughTemporary(file, [&](const fs::path& temporary) {
@@ -104,7 +107,8 @@ void writePreview(const fs::path& file, const Image& image) {
   OIIO::ImageSpec spec(image.width, image.height, 3, OIIO::TypeDesc::UINT8);
   spec.attribute("Software", "hairgen " HAIRGEN_VERSION);
   writeThroughTemporary(file, [&](const fs::path& temporary) {
-    if (!out->open(temporary.string(), spec) || !out->write_image(OIIO::TypeDesc::UINT8, rgb.data()) || !out->close())
+    if (!out->open(temporary.string(), spec) || !out->write_image(OIIO::TypeDesc::UINT8, rgb.data()) ||
+        !out->close())
       throw IoError("cannot write " + file.string() + ": " + out->geterror());
   });
 }

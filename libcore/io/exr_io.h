@@ -15,7 +15,7 @@ namespace hairgen {
 struct ExrMetadata {
   std::map<std::string, std::string> strings;  // e.g. "producer", "hairgen:configDigest"
   glm::dmat4 worldToCamera{1.0}, worldToNdc{1.0};
-  bool camera = false;                         // write worldToCamera / worldToNDC
+  bool camera = false;  // write worldToCamera / worldToNDC
 };
 
 void writeExr(const std::filesystem::path& file, const Image& image, const ExrMetadata& metadata);

@@ -91,7 +91,8 @@ std::vector<glm::vec3> asFloat(const std::vector<glm::uvec3>& ids, const char* w
 // The id stored as a float at `value`, checked to be a whole number in range.
 uint32_t idFrom(float value, const std::string& what, const std::string& name) {
   if (!(value >= 0.0f) || value >= float(kMaxExactId) || value != std::floor(value))
-    throw InputError({name, 0}, what + " holds " + std::to_string(value) + ", not a whole number in [0, 2^24)");
+    throw InputError({name, 0},
+                     what + " holds " + std::to_string(value) + ", not a whole number in [0, 2^24)");
   return static_cast<uint32_t>(value);
 }
 
@@ -104,13 +105,15 @@ class AccessorView {
  public:
   AccessorView(const tinygltf::Model& model, int index, const std::string& what, const std::string& name) {
     auto fail = [&](const std::string& message) { return InputError({name, 0}, what + ": " + message); };
-    if (index < 0 || static_cast<size_t>(index) >= model.accessors.size()) throw fail("accessor index out of range");
+    if (index < 0 || static_cast<size_t>(index) >= model.accessors.size())
+      throw fail("accessor index out of range");
     const tinygltf::Accessor& a = model.accessors[index];
     if (a.sparse.isSparse) throw fail("sparse accessors are not supported");
     if (a.bufferView < 0 || static_cast<size_t>(a.bufferView) >= model.bufferViews.size())
       throw fail("the accessor has no valid bufferView");
     const tinygltf::BufferView& v = model.bufferViews[a.bufferView];
-    if (v.buffer < 0 || static_cast<size_t>(v.buffer) >= model.buffers.size()) throw fail("bufferView names no buffer");
+    if (v.buffer < 0 || static_cast<size_t>(v.buffer) >= model.buffers.size())
+      throw fail("bufferView names no buffer");
     const std::vector<unsigned char>& data = model.buffers[v.buffer].data;
     int componentSize = tinygltf::GetComponentSizeInBytes(static_cast<uint32_t>(a.componentType));
     int components = tinygltf::GetNumComponentsInType(static_cast<uint32_t>(a.type));
@@ -122,7 +125,8 @@ class AccessorView {
       throw fail("bufferView reaches past the end of its buffer");
     if (a.count > 0) {
       uint64_t needed = uint64_t(a.byteOffset) + uint64_t(stride) * (a.count - 1) + elementSize;
-      if (a.byteOffset > v.byteLength || needed > v.byteLength) throw fail("accessor reaches past the end of its bufferView");
+      if (a.byteOffset > v.byteLength || needed > v.byteLength)
+        throw fail("accessor reaches past the end of its bufferView");
     }
     base_ = data.data() + v.byteOffset + a.byteOffset;
     count_ = a.count;
@@ -136,9 +140,10 @@ class AccessorView {
   size_t count() const { return count_; }
   void expect(int componentType, int components) const {
     if (componentType_ != componentType || components_ != components)
-      throw InputError({name_, 0}, what_ + ": expected " + std::to_string(components) + " component(s) of type " +
-                                       std::to_string(componentType) + ", found " + std::to_string(components_) +
-                                       " of type " + std::to_string(componentType_));
+      throw InputError({name_, 0}, what_ + ": expected " + std::to_string(components) +
+                                       " component(s) of type " + std::to_string(componentType) + ", found " +
+                                       std::to_string(components_) + " of type " +
+                                       std::to_string(componentType_));
   }
   float f(size_t i, int c) const {
     float v;
@@ -148,9 +153,18 @@ class AccessorView {
   uint32_t u(size_t i, int c) const {
     const unsigned char* p = base_ + i * stride_;
     switch (componentType_) {
-      case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE: return p[c];
-      case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT: { uint16_t v; std::memcpy(&v, p + 2 * c, 2); return v; }
-      default: { uint32_t v; std::memcpy(&v, p + 4 * c, 4); return v; }
+      case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE:
+        return p[c];
+      case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT: {
+        uint16_t v;
+        std::memcpy(&v, p + 2 * c, 2);
+        return v;
+      }
+      default: {
+        uint32_t v;
+        std::memcpy(&v, p + 4 * c, 4);
+        return v;
+      }
     }
   }
   int componentType() const { return componentType_; }
@@ -186,11 +200,13 @@ std::vector<uint8_t> encodeGltf(const Strands& s, bool binary) {
       indices.push_back(p);
       indices.push_back(p + 1);
     }
-  if (indices.empty()) throw InputError("no strand has two points; a LINES primitive needs at least one segment");
+  if (indices.empty())
+    throw InputError("no strand has two points; a LINES primitive needs at least one segment");
 
   tinygltf::Primitive prim;
   prim.mode = TINYGLTF_MODE_LINE;
-  prim.indices = b.add(indices, TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT, TINYGLTF_TYPE_SCALAR, TINYGLTF_TARGET_ELEMENT_ARRAY_BUFFER);
+  prim.indices = b.add(indices, TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT, TINYGLTF_TYPE_SCALAR,
+                       TINYGLTF_TARGET_ELEMENT_ARRAY_BUFFER);
   constexpr int kFloat = TINYGLTF_COMPONENT_TYPE_FLOAT;
   constexpr int kArray = TINYGLTF_TARGET_ARRAY_BUFFER;
   prim.attributes["POSITION"] = b.add(s.points, kFloat, TINYGLTF_TYPE_VEC3, kArray, true);
@@ -199,24 +215,36 @@ std::vector<uint8_t> encodeGltf(const Strands& s, bool binary) {
     // glTF requires unit normals; ones already unit to float precision are kept bit for bit.
     for (glm::vec3& n : unit) {
       float length = glm::length(n);
-      if (!(length > 0.0f)) n = glm::vec3(0.0f, 1.0f, 0.0f);
-      else if (std::abs(length - 1.0f) > 1e-5f) n /= length;
+      if (!(length > 0.0f))
+        n = glm::vec3(0.0f, 1.0f, 0.0f);
+      else if (std::abs(length - 1.0f) > 1e-5f)
+        n /= length;
     }
     prim.attributes["NORMAL"] = b.add(unit, kFloat, TINYGLTF_TYPE_VEC3, kArray);
   }
   if (!s.colors.empty()) prim.attributes["COLOR_0"] = b.add(s.colors, kFloat, TINYGLTF_TYPE_VEC3, kArray);
   if (!s.transparency.empty())
     prim.attributes["_TRANSPARENCY"] = b.add(s.transparency, kFloat, TINYGLTF_TYPE_SCALAR, kArray);
-  if (!s.tangents.empty()) prim.attributes["_TANGENT"] = b.add(s.tangents, kFloat, TINYGLTF_TYPE_VEC3, kArray);
-  if (!s.thickness.empty()) prim.attributes["_THICKNESS"] = b.add(s.thickness, kFloat, TINYGLTF_TYPE_SCALAR, kArray);
-  if (!s.strandId.empty()) prim.attributes["_STRAND_ID"] = b.add(asFloat(perVertex(s, s.strandId), "strand id"), kFloat, TINYGLTF_TYPE_SCALAR, kArray);
-  if (!s.rootUv.empty()) prim.attributes["_ROOT_UV"] = b.add(perVertex(s, s.rootUv), kFloat, TINYGLTF_TYPE_VEC2, kArray);
-  if (!s.guideIds.empty()) prim.attributes["_GUIDE_IDS"] = b.add(asFloat(perVertex(s, s.guideIds), "guide id"), kFloat, TINYGLTF_TYPE_VEC3, kArray);
+  if (!s.tangents.empty())
+    prim.attributes["_TANGENT"] = b.add(s.tangents, kFloat, TINYGLTF_TYPE_VEC3, kArray);
+  if (!s.thickness.empty())
+    prim.attributes["_THICKNESS"] = b.add(s.thickness, kFloat, TINYGLTF_TYPE_SCALAR, kArray);
+  if (!s.strandId.empty())
+    prim.attributes["_STRAND_ID"] =
+        b.add(asFloat(perVertex(s, s.strandId), "strand id"), kFloat, TINYGLTF_TYPE_SCALAR, kArray);
+  if (!s.rootUv.empty())
+    prim.attributes["_ROOT_UV"] = b.add(perVertex(s, s.rootUv), kFloat, TINYGLTF_TYPE_VEC2, kArray);
+  if (!s.guideIds.empty())
+    prim.attributes["_GUIDE_IDS"] =
+        b.add(asFloat(perVertex(s, s.guideIds), "guide id"), kFloat, TINYGLTF_TYPE_VEC3, kArray);
   if (!s.guideWeights.empty())
-    prim.attributes["_GUIDE_WEIGHTS"] = b.add(perVertex(s, s.guideWeights), kFloat, TINYGLTF_TYPE_VEC3, kArray);
+    prim.attributes["_GUIDE_WEIGHTS"] =
+        b.add(perVertex(s, s.guideWeights), kFloat, TINYGLTF_TYPE_VEC3, kArray);
   if (!s.rootTriangle.empty())
-    prim.attributes["_ROOT_TRIANGLE"] = b.add(asFloat(perVertex(s, s.rootTriangle), "root triangle"), kFloat, TINYGLTF_TYPE_SCALAR, kArray);
-  if (!s.rootBary.empty()) prim.attributes["_ROOT_BARY"] = b.add(perVertex(s, s.rootBary), kFloat, TINYGLTF_TYPE_VEC3, kArray);
+    prim.attributes["_ROOT_TRIANGLE"] =
+        b.add(asFloat(perVertex(s, s.rootTriangle), "root triangle"), kFloat, TINYGLTF_TYPE_SCALAR, kArray);
+  if (!s.rootBary.empty())
+    prim.attributes["_ROOT_BARY"] = b.add(perVertex(s, s.rootBary), kFloat, TINYGLTF_TYPE_VEC3, kArray);
 
   tinygltf::Model& m = b.model;
   tinygltf::Buffer buffer;
@@ -237,7 +265,8 @@ std::vector<uint8_t> encodeGltf(const Strands& s, bool binary) {
   m.asset.version = "2.0";
   m.asset.generator = "hairgen " HAIRGEN_VERSION;
   Value::Object extras;
-  extras["producer"] = Value(s.provenance.producer.empty() ? std::string("hairgen " HAIRGEN_VERSION) : s.provenance.producer);
+  extras["producer"] =
+      Value(s.provenance.producer.empty() ? std::string("hairgen " HAIRGEN_VERSION) : s.provenance.producer);
   extras["strands"] = Value(static_cast<double>(s.strandCount()));
   extras["points"] = Value(static_cast<double>(s.pointCount()));
   extras["stage"] = Value(s.provenance.stage);
@@ -257,13 +286,15 @@ std::vector<uint8_t> encodeGltf(const Strands& s, bool binary) {
   return std::vector<uint8_t>(bytes.begin(), bytes.end());
 }
 
-Strands decodeGltf(const uint8_t* data, size_t size, const std::string& name, const std::filesystem::path& baseDir) {
+Strands decodeGltf(const uint8_t* data, size_t size, const std::string& name,
+                   const std::filesystem::path& baseDir) {
   if (size > UINT32_MAX) throw InputError({name, 0}, "file larger than 4 GiB; glTF cannot address it");
   tinygltf::TinyGLTF loader;
   tinygltf::Model m;
   std::string err, warn;
   bool binary = size >= 4 && std::memcmp(data, "glTF", 4) == 0;
-  bool ok = binary ? loader.LoadBinaryFromMemory(&m, &err, &warn, data, static_cast<unsigned>(size), baseDir.string())
+  bool ok = binary ? loader.LoadBinaryFromMemory(&m, &err, &warn, data, static_cast<unsigned>(size),
+                                                 baseDir.string())
                    : loader.LoadASCIIFromString(&m, &err, &warn, reinterpret_cast<const char*>(data),
                                                 static_cast<unsigned>(size), baseDir.string());
   if (!ok) throw InputError({name, 0}, "not a readable glTF file: " + (err.empty() ? warn : err));
@@ -275,25 +306,31 @@ Strands decodeGltf(const uint8_t* data, size_t size, const std::string& name, co
   std::string seed = stringOr(m.asset.extras, "seed");
   if (!seed.empty()) s.provenance.seed = std::strtoull(seed.c_str(), nullptr, 10);
   s.defaultThickness = static_cast<float>(numberOr(m.asset.extras, "defaultThickness", s.defaultThickness));
-  s.defaultTransparency = static_cast<float>(numberOr(m.asset.extras, "defaultTransparency", s.defaultTransparency));
+  s.defaultTransparency =
+      static_cast<float>(numberOr(m.asset.extras, "defaultTransparency", s.defaultTransparency));
   if (m.asset.extras.IsObject() && m.asset.extras.Has("defaultColor")) {
     const Value& c = m.asset.extras.Get("defaultColor");
     if (c.IsArray() && c.ArrayLen() == 3)
-      for (int i = 0; i < 3; ++i) s.defaultColor[i] = static_cast<float>(c.Get(i).IsNumber() ? c.Get(i).GetNumberAsDouble() : 0.0);
+      for (int i = 0; i < 3; ++i)
+        s.defaultColor[i] = static_cast<float>(c.Get(i).IsNumber() ? c.Get(i).GetNumberAsDouble() : 0.0);
   }
 
   bool found = false;
   for (const tinygltf::Mesh& mesh : m.meshes) {
     for (const tinygltf::Primitive& prim : mesh.primitives) {
       if (prim.mode != TINYGLTF_MODE_LINE) continue;
-      if (found) throw InputError({name, 0}, "more than one LINES primitive; hairgen reads one hair primitive per file");
+      if (found)
+        throw InputError({name, 0},
+                         "more than one LINES primitive; hairgen reads one hair primitive per file");
       found = true;
       auto position = prim.attributes.find("POSITION");
-      if (position == prim.attributes.end()) throw InputError({name, 0}, "the LINES primitive has no POSITION");
+      if (position == prim.attributes.end())
+        throw InputError({name, 0}, "the LINES primitive has no POSITION");
       AccessorView pos(m, position->second, "POSITION", name);
       pos.expect(TINYGLTF_COMPONENT_TYPE_FLOAT, 3);
       const size_t n = pos.count();
-      if (prim.indices < 0) throw InputError({name, 0}, "the LINES primitive has no indices; hairgen needs indexed strands");
+      if (prim.indices < 0)
+        throw InputError({name, 0}, "the LINES primitive has no indices; hairgen needs indexed strands");
       AccessorView idx(m, prim.indices, "indices", name);
       if (idx.componentType() != TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT &&
           idx.componentType() != TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT &&
@@ -303,10 +340,14 @@ Strands decodeGltf(const uint8_t* data, size_t size, const std::string& name, co
       std::vector<bool> joinsNext(n, false);
       for (size_t i = 0; i < idx.count(); i += 2) {
         uint32_t a = idx.u(i, 0), b = idx.u(i + 1, 0);
-        if (a >= n || b >= n) throw InputError({name, 0}, "index " + std::to_string(std::max(a, b)) + " is past the " + std::to_string(n) + " vertices");
+        if (a >= n || b >= n)
+          throw InputError({name, 0}, "index " + std::to_string(std::max(a, b)) + " is past the " +
+                                          std::to_string(n) + " vertices");
         if (b != a + 1)
-          throw InputError({name, 0}, "segment (" + std::to_string(a) + ", " + std::to_string(b) +
-                                          ") does not join consecutive vertices; hairgen reads strands stored as runs of vertices");
+          throw InputError(
+              {name, 0},
+              "segment (" + std::to_string(a) + ", " + std::to_string(b) +
+                  ") does not join consecutive vertices; hairgen reads strands stored as runs of vertices");
         joinsNext[a] = true;
       }
       s.points.resize(n);
@@ -321,7 +362,8 @@ Strands decodeGltf(const uint8_t* data, size_t size, const std::string& name, co
         if (it == prim.attributes.end()) return std::nullopt;
         AccessorView view(m, it->second, key, name);
         if (view.count() != n)
-          throw InputError({name, 0}, std::string(key) + " has " + std::to_string(view.count()) + " entries for " + std::to_string(n) + " vertices");
+          throw InputError({name, 0}, std::string(key) + " has " + std::to_string(view.count()) +
+                                          " entries for " + std::to_string(n) + " vertices");
         return view;
       };
       auto vec3s = [&](const char* key, std::vector<glm::vec3>& out) {
@@ -359,7 +401,8 @@ Strands decodeGltf(const uint8_t* data, size_t size, const std::string& name, co
       if (auto v = attribute("_ROOT_TRIANGLE")) {
         v->expect(TINYGLTF_COMPONENT_TYPE_FLOAT, 1);
         s.rootTriangle.resize(strands);
-        for (size_t i = 0; i < strands; ++i) s.rootTriangle[i] = idFrom(v->f(root(i), 0), "_ROOT_TRIANGLE", name);
+        for (size_t i = 0; i < strands; ++i)
+          s.rootTriangle[i] = idFrom(v->f(root(i), 0), "_ROOT_TRIANGLE", name);
       }
       if (auto v = attribute("_GUIDE_IDS")) {
         v->expect(TINYGLTF_COMPONENT_TYPE_FLOAT, 3);
@@ -376,7 +419,8 @@ Strands decodeGltf(const uint8_t* data, size_t size, const std::string& name, co
         if (auto v = attribute(key)) {
           v->expect(TINYGLTF_COMPONENT_TYPE_FLOAT, 3);
           out.resize(strands);
-          for (size_t i = 0; i < strands; ++i) out[i] = {v->f(root(i), 0), v->f(root(i), 1), v->f(root(i), 2)};
+          for (size_t i = 0; i < strands; ++i)
+            out[i] = {v->f(root(i), 0), v->f(root(i), 1), v->f(root(i), 2)};
         }
       };
       strandVec3("_GUIDE_WEIGHTS", s.guideWeights);

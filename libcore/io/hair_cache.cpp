@@ -1,8 +1,8 @@
 #include "libcore/io/hair_cache.h"
 
-#include "libcore/util/error.h"
 #include "libcore/io/gltf_io.h"
 #include "libcore/io/hair_io.h"
+#include "libcore/util/error.h"
 #include "libcore/util/text.h"
 
 namespace hairgen {

@@ -21,7 +21,10 @@ class Writer {
     const uint8_t* b = static_cast<const uint8_t*>(p);
     out.insert(out.end(), b, b + n);
   }
-  void u16(uint16_t v) { uint8_t b[2] = {uint8_t(v), uint8_t(v >> 8)}; bytes(b, 2); }
+  void u16(uint16_t v) {
+    uint8_t b[2] = {uint8_t(v), uint8_t(v >> 8)};
+    bytes(b, 2);
+  }
   void u32(uint32_t v) {
     uint8_t b[4];
     for (int i = 0; i < 4; ++i) b[i] = uint8_t(v >> (8 * i));
@@ -36,7 +39,11 @@ class Writer {
     std::memcpy(&bits, &v, 4);
     u32(bits);
   }
-  void vec(const glm::vec3& v) { f32(v.x); f32(v.y); f32(v.z); }
+  void vec(const glm::vec3& v) {
+    f32(v.x);
+    f32(v.y);
+    f32(v.z);
+  }
   std::vector<uint8_t> out;
 };
 
@@ -47,15 +54,19 @@ class Reader {
   size_t position() const { return pos_; }
   void need(uint64_t n, const std::string& what) const {
     if (n > remaining())
-      throw InputError({name_, 0}, "truncated: " + what + " needs " + std::to_string(n) + " bytes at offset " +
-                                       std::to_string(pos_) + " but only " + std::to_string(remaining()) + " remain");
+      throw InputError({name_, 0}, "truncated: " + what + " needs " + std::to_string(n) +
+                                       " bytes at offset " + std::to_string(pos_) + " but only " +
+                                       std::to_string(remaining()) + " remain");
   }
   const uint8_t* take(size_t n) {
     const uint8_t* p = data_ + pos_;
     pos_ += n;
     return p;
   }
-  uint16_t u16() { const uint8_t* b = take(2); return uint16_t(b[0] | b[1] << 8); }
+  uint16_t u16() {
+    const uint8_t* b = take(2);
+    return uint16_t(b[0] | b[1] << 8);
+  }
   uint32_t u32() {
     const uint8_t* b = take(4);
     return uint32_t(b[0]) | uint32_t(b[1]) << 8 | uint32_t(b[2]) << 16 | uint32_t(b[3]) << 24;
@@ -116,13 +127,17 @@ Provenance parseProvenance(const std::string& text, const std::string& name) {
     size_t eq = line.find('=');
     if (eq == std::string::npos) throw InputError({name, 0}, "PROV chunk: line without '='");
     std::string key = line.substr(0, eq), value = line.substr(eq + 1);
-    if (key == "producer") p.producer = value;
-    else if (key == "stage") p.stage = value;
-    else if (key == "config") p.configDigest = value;
+    if (key == "producer")
+      p.producer = value;
+    else if (key == "stage")
+      p.stage = value;
+    else if (key == "config")
+      p.configDigest = value;
     else if (key == "seed") {
       char* end2 = nullptr;
       p.seed = std::strtoull(value.c_str(), &end2, 10);
-      if (value.empty() || *end2 != '\0') throw InputError({name, 0}, "PROV chunk: seed '" + value + "' is not a number");
+      if (value.empty() || *end2 != '\0')
+        throw InputError({name, 0}, "PROV chunk: seed '" + value + "' is not a number");
     }
   }
   return p;
@@ -139,9 +154,11 @@ std::vector<uint8_t> encodeHair(const Strands& s) {
   bool uniform = strandCount > 0;
   for (size_t i = 0; i < strandCount; ++i) {
     uint32_t n = s.pointsOf(i);
-    if (n == 0) throw InputError("strand " + std::to_string(i) + " has no points; a .hair file cannot store it");
+    if (n == 0)
+      throw InputError("strand " + std::to_string(i) + " has no points; a .hair file cannot store it");
     if (n - 1 > 0xffff)
-      throw InputError("strand " + std::to_string(i) + " has " + std::to_string(n) + " points; .hair allows 65536");
+      throw InputError("strand " + std::to_string(i) + " has " + std::to_string(n) +
+                       " points; .hair allows 65536");
     if (n != s.pointsOf(0)) uniform = false;
   }
   uint32_t flags = kPoints | (uniform ? 0 : kSegments) | (s.thickness.empty() ? 0 : kThickness) |
@@ -169,17 +186,36 @@ std::vector<uint8_t> encodeHair(const Strands& s) {
   for (const glm::vec3& c : s.colors) w.vec(c);
 
   std::vector<std::pair<const char*, std::vector<uint8_t>>> chunks;
-  auto vec3s = [](const std::vector<glm::vec3>& v) { return payload([&](Writer& p) { for (auto& x : v) p.vec(x); }); };
-  auto u32s = [](const std::vector<uint32_t>& v) { return payload([&](Writer& p) { for (auto x : v) p.u32(x); }); };
+  auto vec3s = [](const std::vector<glm::vec3>& v) {
+    return payload([&](Writer& p) {
+      for (auto& x : v) p.vec(x);
+    });
+  };
+  auto u32s = [](const std::vector<uint32_t>& v) {
+    return payload([&](Writer& p) {
+      for (auto x : v) p.u32(x);
+    });
+  };
   if (!s.tangents.empty()) chunks.emplace_back("TANG", vec3s(s.tangents));
   if (!s.normals.empty()) chunks.emplace_back("NORM", vec3s(s.normals));
   if (!s.strandId.empty()) chunks.emplace_back("SIDS", u32s(s.strandId));
   if (!s.rootTriangle.empty()) chunks.emplace_back("RTRI", u32s(s.rootTriangle));
   if (!s.rootBary.empty()) chunks.emplace_back("RBAR", vec3s(s.rootBary));
   if (!s.rootUv.empty())
-    chunks.emplace_back("RUVS", payload([&](Writer& p) { for (auto& x : s.rootUv) { p.f32(x.x); p.f32(x.y); } }));
+    chunks.emplace_back("RUVS", payload([&](Writer& p) {
+                          for (auto& x : s.rootUv) {
+                            p.f32(x.x);
+                            p.f32(x.y);
+                          }
+                        }));
   if (!s.guideIds.empty())
-    chunks.emplace_back("GIDS", payload([&](Writer& p) { for (auto& x : s.guideIds) { p.u32(x.x); p.u32(x.y); p.u32(x.z); } }));
+    chunks.emplace_back("GIDS", payload([&](Writer& p) {
+                          for (auto& x : s.guideIds) {
+                            p.u32(x.x);
+                            p.u32(x.y);
+                            p.u32(x.z);
+                          }
+                        }));
   if (!s.guideWeights.empty()) chunks.emplace_back("GWTS", vec3s(s.guideWeights));
   if (!s.provenance.empty()) {
     std::string prov = provenanceText(s.provenance);
@@ -207,13 +243,16 @@ Strands decodeHair(const uint8_t* data, size_t size, const std::string& name, Ha
   s.defaultColor = r.vec();
   const char* info = reinterpret_cast<const char*>(r.take(kInfoSize));
   header.info.assign(info, strnlen(info, kInfoSize));
-  if (!(header.flags & kPoints)) throw InputError({name, 0}, "the file has no points array (flag 2 is not set)");
+  if (!(header.flags & kPoints))
+    throw InputError({name, 0}, "the file has no points array (flag 2 is not set)");
 
   // Everything the flags promise must fit in the file before any array is allocated.
   uint64_t arrays = (header.flags & kSegments ? 2 * strandCount : 0) + 12 * pointCount +
                     (header.flags & kThickness ? 4 * pointCount : 0) +
-                    (header.flags & kTransparency ? 4 * pointCount : 0) + (header.flags & kColor ? 12 * pointCount : 0);
-  r.need(arrays, "the arrays for " + std::to_string(strandCount) + " strands and " + std::to_string(pointCount) + " points");
+                    (header.flags & kTransparency ? 4 * pointCount : 0) +
+                    (header.flags & kColor ? 12 * pointCount : 0);
+  r.need(arrays, "the arrays for " + std::to_string(strandCount) + " strands and " +
+                     std::to_string(pointCount) + " points");
 
   if (strandCount > pointCount)
     throw InputError({name, 0}, "the header declares " + std::to_string(strandCount) + " strands but only " +
@@ -225,8 +264,9 @@ Strands decodeHair(const uint8_t* data, size_t size, const std::string& name, Ha
     uint64_t segments = header.flags & kSegments ? r.u16() : header.defaultSegments;
     total += segments + 1;
     if (total > pointCount)
-      throw InputError({name, 0}, "the strands' segment counts need more than the " + std::to_string(pointCount) +
-                                      " points the header declares (strand " + std::to_string(i) + ")");
+      throw InputError({name, 0}, "the strands' segment counts need more than the " +
+                                      std::to_string(pointCount) + " points the header declares (strand " +
+                                      std::to_string(i) + ")");
     s.firstPoint[i + 1] = static_cast<uint32_t>(total);
   }
   if (total != pointCount)
@@ -234,18 +274,29 @@ Strands decodeHair(const uint8_t* data, size_t size, const std::string& name, Ha
                                     " points but the header declares " + std::to_string(pointCount));
   s.points.resize(pointCount);
   for (glm::vec3& p : s.points) p = r.vec();
-  if (header.flags & kThickness) { s.thickness.resize(pointCount); for (float& t : s.thickness) t = r.f32(); }
-  if (header.flags & kTransparency) { s.transparency.resize(pointCount); for (float& t : s.transparency) t = r.f32(); }
-  if (header.flags & kColor) { s.colors.resize(pointCount); for (glm::vec3& c : s.colors) c = r.vec(); }
+  if (header.flags & kThickness) {
+    s.thickness.resize(pointCount);
+    for (float& t : s.thickness) t = r.f32();
+  }
+  if (header.flags & kTransparency) {
+    s.transparency.resize(pointCount);
+    for (float& t : s.transparency) t = r.f32();
+  }
+  if (header.flags & kColor) {
+    s.colors.resize(pointCount);
+    for (glm::vec3& c : s.colors) c = r.vec();
+  }
 
   if (r.remaining() > 0) {
     r.need(12, "the hairgen chunk block header");
     if (std::memcmp(r.take(4), "HGEN", 4) != 0)
-      throw InputError({name, 0}, std::to_string(r.remaining() + 4) +
-                                      " unexpected bytes after the cyHair arrays (not a hairgen chunk block)");
+      throw InputError({name, 0},
+                       std::to_string(r.remaining() + 4) +
+                           " unexpected bytes after the cyHair arrays (not a hairgen chunk block)");
     uint32_t version = r.u32();
     if (version != kBlockVersion)
-      throw InputError({name, 0}, "chunk block version " + std::to_string(version) + " is not supported (this hairgen reads 1)");
+      throw InputError({name, 0}, "chunk block version " + std::to_string(version) +
+                                      " is not supported (this hairgen reads 1)");
     uint32_t chunkCount = r.u32();
     for (uint32_t c = 0; c < chunkCount; ++c) {
       r.need(12, "chunk " + std::to_string(c) + "'s header");
@@ -258,7 +309,8 @@ Strands decodeHair(const uint8_t* data, size_t size, const std::string& name, Ha
       const uint8_t* bytes = r.take(length);
       uint32_t stored = r.u32();
       uLong crc = crc32_z(crc32(0L, head, 12), bytes, length);
-      if (static_cast<uint32_t>(crc) != stored) throw InputError({name, 0}, "chunk '" + tag + "' fails its CRC-32 check: the file is corrupt");
+      if (static_cast<uint32_t>(crc) != stored)
+        throw InputError({name, 0}, "chunk '" + tag + "' fails its CRC-32 check: the file is corrupt");
       for (const std::string& seen : header.chunks)
         if (seen == tag) throw InputError({name, 0}, "chunk '" + tag + "' appears twice");
       header.chunks.push_back(tag);
@@ -266,25 +318,46 @@ Strands decodeHair(const uint8_t* data, size_t size, const std::string& name, Ha
       Reader p(bytes, length, name);
       auto expect = [&](uint64_t count, uint64_t bytesEach) {
         if (length != count * bytesEach)
-          throw InputError({name, 0}, "chunk '" + tag + "' holds " + std::to_string(length) + " bytes, expected " +
-                                          std::to_string(count * bytesEach));
+          throw InputError({name, 0}, "chunk '" + tag + "' holds " + std::to_string(length) +
+                                          " bytes, expected " + std::to_string(count * bytesEach));
       };
-      auto readVec3 = [&](std::vector<glm::vec3>& v, uint64_t count) { expect(count, 12); v.resize(count); for (auto& x : v) x = p.vec(); };
-      auto readU32 = [&](std::vector<uint32_t>& v, uint64_t count) { expect(count, 4); v.resize(count); for (auto& x : v) x = p.u32(); };
-      if (tag == "TANG") readVec3(s.tangents, pointCount);
-      else if (tag == "NORM") readVec3(s.normals, pointCount);
-      else if (tag == "SIDS") readU32(s.strandId, strandCount);
-      else if (tag == "RTRI") readU32(s.rootTriangle, strandCount);
-      else if (tag == "RBAR") readVec3(s.rootBary, strandCount);
-      else if (tag == "GWTS") readVec3(s.guideWeights, strandCount);
+      auto readVec3 = [&](std::vector<glm::vec3>& v, uint64_t count) {
+        expect(count, 12);
+        v.resize(count);
+        for (auto& x : v) x = p.vec();
+      };
+      auto readU32 = [&](std::vector<uint32_t>& v, uint64_t count) {
+        expect(count, 4);
+        v.resize(count);
+        for (auto& x : v) x = p.u32();
+      };
+      if (tag == "TANG")
+        readVec3(s.tangents, pointCount);
+      else if (tag == "NORM")
+        readVec3(s.normals, pointCount);
+      else if (tag == "SIDS")
+        readU32(s.strandId, strandCount);
+      else if (tag == "RTRI")
+        readU32(s.rootTriangle, strandCount);
+      else if (tag == "RBAR")
+        readVec3(s.rootBary, strandCount);
+      else if (tag == "GWTS")
+        readVec3(s.guideWeights, strandCount);
       else if (tag == "RUVS") {
         expect(strandCount, 8);
         s.rootUv.resize(strandCount);
-        for (auto& x : s.rootUv) { x.x = p.f32(); x.y = p.f32(); }
+        for (auto& x : s.rootUv) {
+          x.x = p.f32();
+          x.y = p.f32();
+        }
       } else if (tag == "GIDS") {
         expect(strandCount, 12);
         s.guideIds.resize(strandCount);
-        for (auto& x : s.guideIds) { x.x = p.u32(); x.y = p.u32(); x.z = p.u32(); }
+        for (auto& x : s.guideIds) {
+          x.x = p.u32();
+          x.y = p.u32();
+          x.z = p.u32();
+        }
       } else if (tag == "PROV") {
         s.provenance = parseProvenance(std::string(reinterpret_cast<const char*>(bytes), length), name);
       }

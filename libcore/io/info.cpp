@@ -3,11 +3,11 @@
 #include <cmath>
 #include <sstream>
 
-#include "libcore/util/error.h"
 #include "libcore/io/gltf_io.h"
 #include "libcore/io/hair_cache.h"
 #include "libcore/io/hair_io.h"
 #include "libcore/io/obj_io.h"
+#include "libcore/util/error.h"
 #include "libcore/util/text.h"
 
 namespace hairgen {
@@ -34,7 +34,9 @@ nlohmann::ordered_json describeStrands(const Strands& s) {
   j["meanStrandLength"] = s.strandCount() ? totalLength / double(s.strandCount()) : 0.0;
   j["bounds"] = boundsJson(s.points);
   std::vector<std::string> arrays;
-  auto note = [&](bool present, const char* label) { if (present) arrays.push_back(label); };
+  auto note = [&](bool present, const char* label) {
+    if (present) arrays.push_back(label);
+  };
   note(!s.tangents.empty(), "tangents");
   note(!s.normals.empty(), "normals");
   note(!s.colors.empty(), "colors");
@@ -78,8 +80,9 @@ nlohmann::ordered_json describeFile(const std::filesystem::path& file) {
     j["meanEdgeLength"] = edge / (3.0 * double(mesh.triangleCount()));
     j["bounds"] = boundsJson(mesh.positions);
     j["uvs"] = !mesh.uvs.empty();
-    j["normals"] = stats.normalsFromFile ? (stats.normalsReindexed ? "from file, averaged per position" : "from file")
-                                         : "computed (area-weighted)";
+    j["normals"] = stats.normalsFromFile
+                       ? (stats.normalsReindexed ? "from file, averaged per position" : "from file")
+                       : "computed (area-weighted)";
     j["polygonsTriangulated"] = stats.polygonsTriangulated;
     j["degenerateFacesDropped"] = stats.degenerateDropped;
     j["unreferencedVerticesDropped"] = stats.unreferencedDropped;
@@ -91,7 +94,8 @@ nlohmann::ordered_json describeFile(const std::filesystem::path& file) {
     Strands s = readHair(file, &header);
     j["format"] = "hair";
     j.update(describeStrands(s));
-    j["cyHair"] = {{"flags", header.flags}, {"defaultSegments", header.defaultSegments}, {"info", header.info}};
+    j["cyHair"] = {
+        {"flags", header.flags}, {"defaultSegments", header.defaultSegments}, {"info", header.info}};
     j["chunks"] = header.chunks;
     return j;
   }
@@ -112,31 +116,36 @@ std::string formatDescription(const nlohmann::ordered_json& j) {
     return v.dump();
   };
   auto box = [&](const nlohmann::ordered_json& b) {
-    return "(" + num(b["min"][0]) + ", " + num(b["min"][1]) + ", " + num(b["min"][2]) + ") to (" + num(b["max"][0]) +
-           ", " + num(b["max"][1]) + ", " + num(b["max"][2]) + ")";
+    return "(" + num(b["min"][0]) + ", " + num(b["min"][1]) + ", " + num(b["min"][2]) + ") to (" +
+           num(b["max"][0]) + ", " + num(b["max"][1]) + ", " + num(b["max"][2]) + ")";
   };
   out << j["file"].get<std::string>() << ": " << j["format"].get<std::string>() << "\n";
   if (j["format"] == "obj") {
-    out << "  " << j["vertices"] << " vertices, " << j["triangles"] << " triangles, area " << num(j["area_cm2"])
-        << " cm² (" << num(j["area_m2"]) << " m²), mean edge " << num(j["meanEdgeLength"]) << " m\n"
+    out << "  " << j["vertices"] << " vertices, " << j["triangles"] << " triangles, area "
+        << num(j["area_cm2"]) << " cm² (" << num(j["area_m2"]) << " m²), mean edge "
+        << num(j["meanEdgeLength"]) << " m\n"
         << "  bounds " << box(j["bounds"]) << "\n"
-        << "  normals " << j["normals"].get<std::string>() << (j["uvs"].get<bool>() ? ", UVs" : ", no UVs") << "\n"
+        << "  normals " << j["normals"].get<std::string>() << (j["uvs"].get<bool>() ? ", UVs" : ", no UVs")
+        << "\n"
         << "  " << j["polygonsTriangulated"] << " polygons triangulated, " << j["degenerateFacesDropped"]
-        << " degenerate faces dropped, " << j["unreferencedVerticesDropped"] << " unreferenced vertices dropped\n";
+        << " degenerate faces dropped, " << j["unreferencedVerticesDropped"]
+        << " unreferenced vertices dropped\n";
     return out.str();
   }
-  out << "  " << j["strands"] << " strands, " << j["points"] << " points (" << j["pointsPerStrand"]["min"] << " to "
-      << j["pointsPerStrand"]["max"] << " per strand), mean strand length " << num(j["meanStrandLength"]) << "\n"
+  out << "  " << j["strands"] << " strands, " << j["points"] << " points (" << j["pointsPerStrand"]["min"]
+      << " to " << j["pointsPerStrand"]["max"] << " per strand), mean strand length "
+      << num(j["meanStrandLength"]) << "\n"
       << "  bounds " << box(j["bounds"]) << "\n";
   std::string attributes;
   for (const auto& a : j["attributes"]) attributes += (attributes.empty() ? "" : ", ") + a.get<std::string>();
   out << "  attributes: " << (attributes.empty() ? "positions only" : attributes) << "\n";
   if (j.contains("cyHair"))
-    out << "  cyHair flags " << j["cyHair"]["flags"] << ", default segments " << j["cyHair"]["defaultSegments"]
-        << ", info \"" << j["cyHair"]["info"].get<std::string>() << "\"\n";
+    out << "  cyHair flags " << j["cyHair"]["flags"] << ", default segments "
+        << j["cyHair"]["defaultSegments"] << ", info \"" << j["cyHair"]["info"].get<std::string>() << "\"\n";
   if (j.contains("provenance"))
-    out << "  made by " << j["provenance"]["producer"].get<std::string>() << " (" << j["provenance"]["stage"].get<std::string>()
-        << "), seed " << j["provenance"]["seed"] << ", config " << j["provenance"]["configDigest"].get<std::string>() << "\n";
+    out << "  made by " << j["provenance"]["producer"].get<std::string>() << " ("
+        << j["provenance"]["stage"].get<std::string>() << "), seed " << j["provenance"]["seed"] << ", config "
+        << j["provenance"]["configDigest"].get<std::string>() << "\n";
   return out.str();
 }
 

@@ -34,7 +34,8 @@ void checkCorner(std::string_view corner, const FileLoc& where, const size_t cou
   size_t part = 0, start = 0;
   for (size_t i = 0; i <= corner.size(); ++i) {
     if (i < corner.size() && corner[i] != '/') continue;
-    if (part > 2) throw InputError(where, "face corner '" + std::string(corner) + "' has more than three parts");
+    if (part > 2)
+      throw InputError(where, "face corner '" + std::string(corner) + "' has more than three parts");
     std::string_view text = corner.substr(start, i - start);
     if (!text.empty() || part == 0) {
       std::optional<int64_t> index = parseInt(text);
@@ -44,7 +45,8 @@ void checkCorner(std::string_view corner, const FileLoc& where, const size_t cou
       int64_t n = static_cast<int64_t>(counts[part]);
       if (*index > n || *index < -n)
         throw InputError(where, "face corner '" + std::string(corner) + "' refers to " + kinds[part] + " " +
-                                    std::to_string(*index) + " but only " + std::to_string(n) + " are defined above it");
+                                    std::to_string(*index) + " but only " + std::to_string(n) +
+                                    " are defined above it");
     }
     ++part;
     start = i + 1;
@@ -62,7 +64,8 @@ void validate(std::string_view text, const std::string& name) {
     pos = end + 1;
     ++lineNumber;
     FileLoc where{name, lineNumber};
-    if (line.find('\0') != std::string_view::npos) throw InputError(where, "NUL byte in an OBJ file; is this a text file?");
+    if (line.find('\0') != std::string_view::npos)
+      throw InputError(where, "NUL byte in an OBJ file; is this a text file?");
     std::vector<std::string_view> words = splitWords(line);
     if (words.empty() || words[0][0] == '#') continue;
     std::string_view tag = words[0];
@@ -89,8 +92,9 @@ void validate(std::string_view text, const std::string& name) {
       double x = *parseReal(words[1]), y = *parseReal(words[2]), z = *parseReal(words[3]);
       // A follicle grows along its normal: a zero one is a broken export, not something to guess.
       if (x * x + y * y + z * z < 1e-24)
-        throw InputError(where, "normal of zero length; fix the export, or delete the 'vn' lines (and the //n "
-                                "in the faces) to have hairgen compute area-weighted normals");
+        throw InputError(where,
+                         "normal of zero length; fix the export, or delete the 'vn' lines (and the //n "
+                         "in the faces) to have hairgen compute area-weighted normals");
       ++counts[2];
     } else if (tag == "f") {
       if (words.size() < 4) throw InputError(where, "a face needs at least three corners");
@@ -175,8 +179,9 @@ Mesh parseObj(std::string_view text, const std::string& name, MeshReadStats* sta
   }
   // A polygon with k corners arrives as k-2 triangles; count it once as triangulated.
   if (triangles.empty())
-    throw InputError({name, 0}, stats.facesRead == 0 ? "the mesh has no faces; hairgen needs a surface (f lines)"
-                                                     : "every face of the mesh is degenerate");
+    throw InputError({name, 0}, stats.facesRead == 0
+                                    ? "the mesh has no faces; hairgen needs a surface (f lines)"
+                                    : "every face of the mesh is degenerate");
   stats.polygonsTriangulated = 0;
   {
     // tinyobjloader does not report the polygons it split; recount from the text.

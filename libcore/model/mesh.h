@@ -11,9 +11,9 @@ namespace hairgen {
 // A triangle mesh as flat arrays. Positions in metres, +y up, face along +z (DESIGN §2).
 struct Mesh {
   std::vector<glm::vec3> positions;
-  std::vector<glm::vec3> normals;    // one unit normal per vertex (same size as positions)
-  std::vector<glm::uvec3> triangles; // counter-clockwise seen from outside
-  std::vector<glm::vec2> uvs;        // one per vertex, or empty when the mesh has none
+  std::vector<glm::vec3> normals;     // one unit normal per vertex (same size as positions)
+  std::vector<glm::uvec3> triangles;  // counter-clockwise seen from outside
+  std::vector<glm::vec2> uvs;         // one per vertex, or empty when the mesh has none
 
   size_t vertexCount() const { return positions.size(); }
   size_t triangleCount() const { return triangles.size(); }
@@ -25,7 +25,7 @@ std::vector<glm::vec3> areaWeightedNormals(const std::vector<glm::vec3>& positio
                                            const std::vector<glm::uvec3>& triangles);
 
 double triangleArea(const Mesh& mesh, size_t triangle);  // square metres
-double surfaceArea(const Mesh& mesh);                     // square metres
+double surfaceArea(const Mesh& mesh);                    // square metres
 
 struct Bounds {
   glm::vec3 min{0.0f};

@@ -34,7 +34,8 @@ std::vector<glm::vec3> transportFrames(const Strands& s) {
     glm::dvec3 t = glm::normalize(glm::dvec3(tangents[first]));
     glm::dvec3 ref = centroid - glm::dvec3(s.points[first]);
     glm::dvec3 frame = ref - glm::dot(ref, t) * t;
-    if (glm::length(frame) < 1e-9) frame = glm::cross(t, std::abs(t.x) < 0.9 ? glm::dvec3(1, 0, 0) : glm::dvec3(0, 1, 0));
+    if (glm::length(frame) < 1e-9)
+      frame = glm::cross(t, std::abs(t.x) < 0.9 ? glm::dvec3(1, 0, 0) : glm::dvec3(0, 1, 0));
     frame = glm::normalize(frame);
     u[first] = glm::vec3(frame);
     for (uint32_t p = first + 1; p < last; ++p) {

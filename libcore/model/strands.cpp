@@ -7,11 +7,21 @@
 namespace hairgen {
 namespace {
 
-bool finite(const glm::vec3& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
-bool finite(const glm::vec2& v) { return std::isfinite(v.x) && std::isfinite(v.y); }
-bool finite(float v) { return std::isfinite(v); }
-bool finite(uint32_t) { return true; }
-bool finite(const glm::uvec3&) { return true; }
+bool finite(const glm::vec3& v) {
+  return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
+}
+bool finite(const glm::vec2& v) {
+  return std::isfinite(v.x) && std::isfinite(v.y);
+}
+bool finite(float v) {
+  return std::isfinite(v);
+}
+bool finite(uint32_t) {
+  return true;
+}
+bool finite(const glm::uvec3&) {
+  return true;
+}
 
 template <typename T>
 void checkArray(const std::string& source, const char* name, const std::vector<T>& values, size_t expected) {
@@ -63,7 +73,8 @@ std::vector<glm::vec3> polylineTangents(const Strands& s) {
     const uint32_t first = s.firstPoint[i], last = s.firstPoint[i + 1];
     glm::vec3 previous(0.0f, 1.0f, 0.0f);
     for (uint32_t p = first; p < last; ++p) {
-      glm::vec3 d = p + 1 < last ? s.points[p + 1] - s.points[p] : (p > first ? s.points[p] - s.points[p - 1] : previous);
+      glm::vec3 d = p + 1 < last ? s.points[p + 1] - s.points[p]
+                                 : (p > first ? s.points[p] - s.points[p - 1] : previous);
       float len = glm::length(d);
       t[p] = previous = len > 0.0f ? d / len : previous;
     }

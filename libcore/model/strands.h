@@ -12,8 +12,8 @@ namespace hairgen {
 
 // Where a cache came from, stored in it so a farm script can tell two caches apart.
 struct Provenance {
-  std::string producer;      // "hairgen 0.1.0"; empty for files made elsewhere
-  std::string stage;         // "grow", "interpolate", "shade", "convert", ...
+  std::string producer;  // "hairgen 0.1.0"; empty for files made elsewhere
+  std::string stage;     // "grow", "interpolate", "shade", "convert", ...
   uint64_t seed = 0;
   std::string configDigest;  // hex digest of the effective configuration, or ""
 
@@ -30,22 +30,22 @@ struct Strands {
   std::vector<uint32_t> firstPoint{0};  // strandCount() + 1 offsets, firstPoint[0] == 0
 
   // Per point (size points.size() or empty).
-  std::vector<glm::vec3> tangents;      // unit
-  std::vector<glm::vec3> normals;       // unit shading normals
-  std::vector<glm::vec3> colors;        // linear RGB
-  std::vector<float> thickness;         // diameter, metres
-  std::vector<float> transparency;      // 0 = opaque
+  std::vector<glm::vec3> tangents;  // unit
+  std::vector<glm::vec3> normals;   // unit shading normals
+  std::vector<glm::vec3> colors;    // linear RGB
+  std::vector<float> thickness;     // diameter, metres
+  std::vector<float> transparency;  // 0 = opaque
 
   // Per strand (size strandCount() or empty).
   std::vector<uint32_t> strandId;
-  std::vector<uint32_t> rootTriangle;   // wick triangle the root lies on
-  std::vector<glm::vec3> rootBary;      // barycentrics of the root on that triangle
+  std::vector<uint32_t> rootTriangle;  // wick triangle the root lies on
+  std::vector<glm::vec3> rootBary;     // barycentrics of the root on that triangle
   std::vector<glm::vec2> rootUv;
   std::vector<glm::uvec3> guideIds;     // the three guides a strand follows
   std::vector<glm::vec3> guideWeights;  // their weights at the root
 
   // cyHair header defaults, used where the per-point arrays are absent.
-  float defaultThickness = 7.0e-5f;     // metres
+  float defaultThickness = 7.0e-5f;  // metres
   float defaultTransparency = 0.0f;
   glm::vec3 defaultColor{0.45f, 0.25f, 0.0f};
 

@@ -23,15 +23,20 @@ double dot(const std::vector<double>& a, const std::vector<double>& b) {
 
 const char* name(RosenbrockStop stop) {
   switch (stop) {
-    case RosenbrockStop::kEpsilon: return "epsilon";
-    case RosenbrockStop::kStalled: return "stalled";
-    case RosenbrockStop::kMaxEvaluations: return "maxEvaluations";
-    case RosenbrockStop::kMaxStages: break;
+    case RosenbrockStop::kEpsilon:
+      return "epsilon";
+    case RosenbrockStop::kStalled:
+      return "stalled";
+    case RosenbrockStop::kMaxEvaluations:
+      return "maxEvaluations";
+    case RosenbrockStop::kMaxStages:
+      break;
   }
   return "maxIter";
 }
 
-std::vector<std::vector<double>> palmerDirections(const std::vector<std::vector<double>>& xi, std::span<const double> d) {
+std::vector<std::vector<double>> palmerDirections(const std::vector<std::vector<double>>& xi,
+                                                  std::span<const double> d) {
   const size_t n = xi.size();
   // A_k for every k, from the back: A_n = d_n ξ_n, A_k = A_{k+1} + d_k ξ_k.
   std::vector<std::vector<double>> a(n + 1, std::vector<double>(n, 0.0));
@@ -93,7 +98,8 @@ RosenbrockResult minimizeRosenbrock(const std::function<double(std::span<const d
       step.assign(steps.begin(), steps.end());
     } else {
       for (size_t i = 0; i < n; ++i)
-        step[i] = std::max(std::abs(step[i]) * options.expand, options.minRestartFraction * std::abs(steps[i]));
+        step[i] =
+            std::max(std::abs(step[i]) * options.expand, options.minRestartFraction * std::abs(steps[i]));
     }
     std::fill(advance.begin(), advance.end(), 0.0);
     std::fill(succeeded.begin(), succeeded.end(), 0);

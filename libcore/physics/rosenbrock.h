@@ -9,14 +9,15 @@
 namespace hairgen {
 
 struct RosenbrockOptions {
-  int maxStages = 20;            // stages at most (the thesis' MaxIter)
-  double epsilon = 1e-4;         // a stage that lowers f by less than epsilon · energyScale ends the search
-  double energyScale = 1.0;      // what "relative" is relative to (same units as f)
-  double expand = 3.0;           // step factor after a success
-  double contract = -0.5;        // step factor after a failure (reverses the direction)
-  double minStepFraction = 1e-9; // a direction whose step shrank below this fraction of its initial step is spent
+  int maxStages = 20;        // stages at most (the thesis' MaxIter)
+  double epsilon = 1e-4;     // a stage that lowers f by less than epsilon · energyScale ends the search
+  double energyScale = 1.0;  // what "relative" is relative to (same units as f)
+  double expand = 3.0;       // step factor after a success
+  double contract = -0.5;    // step factor after a failure (reverses the direction)
+  double minStepFraction =
+      1e-9;  // a direction whose step shrank below this fraction of its initial step is spent
   double minRestartFraction = 1e-3;  // a new stage's steps: the last ones × expand, at least this × initial
-  int maxEvaluations = 1000000;  // hard bound, so a pathological f cannot loop forever
+  int maxEvaluations = 1000000;      // hard bound, so a pathological f cannot loop forever
 };
 
 enum class RosenbrockStop { kEpsilon, kMaxStages, kStalled, kMaxEvaluations };

@@ -16,7 +16,8 @@ double penetration(const CollisionShape& shape, const glm::dvec3& p) {
       // Along the ray from the centre through p: the surface lies at dist / ratio (§4.1.2.1.1).
       double dist = glm::length(local);
       double ratio = glm::length(local / shape.halfExtents);
-      if (!(ratio > 0.0)) return std::min(shape.halfExtents.x, std::min(shape.halfExtents.y, shape.halfExtents.z));
+      if (!(ratio > 0.0))
+        return std::min(shape.halfExtents.x, std::min(shape.halfExtents.y, shape.halfExtents.z));
       return dist / ratio - dist;
     }
     case ShapeKind::kCuboid: {
@@ -31,17 +32,23 @@ namespace {
 
 double boundingRadius(const CollisionShape& shape) {
   switch (shape.kind) {
-    case ShapeKind::kSphere: return shape.halfExtents.x;
-    case ShapeKind::kEllipsoid: return std::max(shape.halfExtents.x, std::max(shape.halfExtents.y, shape.halfExtents.z));
-    case ShapeKind::kCuboid: return glm::length(shape.halfExtents);
+    case ShapeKind::kSphere:
+      return shape.halfExtents.x;
+    case ShapeKind::kEllipsoid:
+      return std::max(shape.halfExtents.x, std::max(shape.halfExtents.y, shape.halfExtents.z));
+    case ShapeKind::kCuboid:
+      return glm::length(shape.halfExtents);
   }
   return 0.0;
 }
 
 }  // namespace
 
-StrandEnergy::StrandEnergy(const Hairstyle& style, const Collision& collision, const RodFrame& root, double envelope)
-    : lengths_(style.hairLengths), root_(root), rest_(restShape(style.helixRadius, style.helixStep)),
+StrandEnergy::StrandEnergy(const Hairstyle& style, const Collision& collision, const RodFrame& root,
+                           double envelope)
+    : lengths_(style.hairLengths),
+      root_(root),
+      rest_(restShape(style.helixRadius, style.helixStep)),
       collisionStep_(style.collisionStep) {
   const double a = style.hairRadius1, b = style.hairRadius2;
   const double i1 = M_PI * a * b * b * b / 4.0, i2 = M_PI * b * a * a * a / 4.0;
@@ -118,7 +125,8 @@ double StrandEnergy::penalty(const glm::dvec3& p) const {
     if (dist2 >= shape.reach2) continue;
     double dent;
     if (shape.shape.kind == ShapeKind::kEllipsoid) {
-      glm::dvec3 scaled(glm::dot(v, shape.scaledAxes[0]), glm::dot(v, shape.scaledAxes[1]), glm::dot(v, shape.scaledAxes[2]));
+      glm::dvec3 scaled(glm::dot(v, shape.scaledAxes[0]), glm::dot(v, shape.scaledAxes[1]),
+                        glm::dot(v, shape.scaledAxes[2]));
       const double ratio2 = glm::dot(scaled, scaled);
       if (ratio2 >= shape.ratio2Outside) continue;
       if (!(ratio2 > 0.0)) {
@@ -148,7 +156,8 @@ EnergyTerms StrandEnergy::terms(std::span<const double> q) const {
   // the collision samples (two sin/cos pairs per element, whatever the number of samples).
   double height = 0.0, penalty = 0.0;
   forEachElement(root_, lengths_, q, [&](const HelixElement& element, double, size_t k) {
-    height += element.length() * (element.start().position.y - root_.position.y) + element.displacementIntegral().y;
+    height +=
+        element.length() * (element.start().position.y - root_.position.y) + element.displacementIntegral().y;
     if (shapes_.empty()) return;
     const ElementSamples& samples = samples_[k];
     element.visitGrid(samples.first, collisionStep_, samples.gridCount,

@@ -39,7 +39,10 @@ RodFrame follicleFrame(const glm::dvec3& root, const glm::dvec3& normal) {
 }
 
 HelixElement::HelixElement(const RodFrame& start, const glm::dvec3& darboux, double length)
-    : start_(start), w_(darboux), omega_(glm::length(darboux)), invOmega_(omega_ > 0.0 ? 1.0 / omega_ : 0.0),
+    : start_(start),
+      w_(darboux),
+      omega_(glm::length(darboux)),
+      invOmega_(omega_ > 0.0 ? 1.0 / omega_ : 0.0),
       length_(length) {
   wn0_ = glm::cross(w_, start.n0);
   wwn0_ = glm::cross(w_, wn0_);
@@ -98,7 +101,8 @@ RestShape restShape(double helixRadius, double helixStep) {
 }
 
 void sampleRod(const RodFrame& root, std::span<const double> lengths, std::span<const double> q,
-               std::span<const double> s, std::vector<glm::dvec3>& positions, std::vector<glm::dvec3>* tangents) {
+               std::span<const double> s, std::vector<glm::dvec3>& positions,
+               std::vector<glm::dvec3>* tangents) {
   positions.resize(s.size());
   if (tangents) tangents->resize(s.size());
   size_t i = 0;
@@ -117,7 +121,8 @@ double heightIntegral(const RodFrame& root, std::span<const double> lengths, std
   // ∫0^L (r(s) − r0) ds = Σ_Q [ℓ_Q (r_Q(0) − r0) + ∫0^ℓ (r_Q(u) − r_Q(0)) du].
   double total = 0.0;
   forEachElement(root, lengths, q, [&](const HelixElement& element, double, size_t) {
-    total += element.length() * (element.start().position.y - root.position.y) + element.displacementIntegral().y;
+    total +=
+        element.length() * (element.start().position.y - root.position.y) + element.displacementIntegral().y;
   });
   return total;
 }

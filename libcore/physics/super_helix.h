@@ -68,14 +68,15 @@ class HelixElement {
   glm::dvec3 at(double u, double cosX, double sinX) const;
 
   RodFrame start_, end_;
-  glm::dvec3 w_, wn0_, wwn0_;  // W, W×n0, W×(W×n0)
+  glm::dvec3 w_, wn0_, wwn0_;         // W, W×n0, W×(W×n0)
   double omega_, invOmega_, length_;  // invOmega_ is 0 for a straight element
-  double sinL_, cosL_;         // of Ω ℓ
+  double sinL_, cosL_;                // of Ω ℓ
 };
 
 // Walks the elements of a rod from its root: visit(element, arc length at its start, index).
 template <class Visit>
-void forEachElement(const RodFrame& root, std::span<const double> lengths, std::span<const double> q, Visit&& visit) {
+void forEachElement(const RodFrame& root, std::span<const double> lengths, std::span<const double> q,
+                    Visit&& visit) {
   RodFrame start = root;
   double s = 0.0;
   for (size_t e = 0; e < lengths.size(); ++e) {
@@ -88,7 +89,8 @@ void forEachElement(const RodFrame& root, std::span<const double> lengths, std::
 
 // Positions and unit tangents at arc lengths `s` (ascending, within [0, L]).
 void sampleRod(const RodFrame& root, std::span<const double> lengths, std::span<const double> q,
-               std::span<const double> s, std::vector<glm::dvec3>& positions, std::vector<glm::dvec3>* tangents);
+               std::span<const double> s, std::vector<glm::dvec3>& positions,
+               std::vector<glm::dvec3>* tangents);
 
 // ∫ (r(s) − r(0))·ŷ ds over the whole rod in closed form (thesis §4.1.1.3.2), metres².
 double heightIntegral(const RodFrame& root, std::span<const double> lengths, std::span<const double> q);
@@ -104,7 +106,8 @@ inline constexpr double kHelixSeriesBelow = 0.05;
 struct HelixCoefficients {
   double a, b, c;
 };
-inline HelixCoefficients helixCoefficients(double omega, double invOmega, double u, double cosX, double sinX) {
+inline HelixCoefficients helixCoefficients(double omega, double invOmega, double u, double cosX,
+                                           double sinX) {
   const double x = omega * u;
   if (std::abs(x) < kHelixSeriesBelow) {
     const double x2 = x * x;

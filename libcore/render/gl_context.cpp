@@ -15,21 +15,36 @@ namespace {
 
 const char* eglErrorName(EGLint e) {
   switch (e) {
-    case EGL_SUCCESS: return "EGL_SUCCESS";
-    case EGL_NOT_INITIALIZED: return "EGL_NOT_INITIALIZED";
-    case EGL_BAD_ACCESS: return "EGL_BAD_ACCESS";
-    case EGL_BAD_ALLOC: return "EGL_BAD_ALLOC";
-    case EGL_BAD_ATTRIBUTE: return "EGL_BAD_ATTRIBUTE";
-    case EGL_BAD_CONFIG: return "EGL_BAD_CONFIG";
-    case EGL_BAD_CONTEXT: return "EGL_BAD_CONTEXT";
-    case EGL_BAD_CURRENT_SURFACE: return "EGL_BAD_CURRENT_SURFACE";
-    case EGL_BAD_DISPLAY: return "EGL_BAD_DISPLAY";
-    case EGL_BAD_MATCH: return "EGL_BAD_MATCH";
-    case EGL_BAD_NATIVE_PIXMAP: return "EGL_BAD_NATIVE_PIXMAP";
-    case EGL_BAD_NATIVE_WINDOW: return "EGL_BAD_NATIVE_WINDOW";
-    case EGL_BAD_PARAMETER: return "EGL_BAD_PARAMETER";
-    case EGL_BAD_SURFACE: return "EGL_BAD_SURFACE";
-    case EGL_CONTEXT_LOST: return "EGL_CONTEXT_LOST";
+    case EGL_SUCCESS:
+      return "EGL_SUCCESS";
+    case EGL_NOT_INITIALIZED:
+      return "EGL_NOT_INITIALIZED";
+    case EGL_BAD_ACCESS:
+      return "EGL_BAD_ACCESS";
+    case EGL_BAD_ALLOC:
+      return "EGL_BAD_ALLOC";
+    case EGL_BAD_ATTRIBUTE:
+      return "EGL_BAD_ATTRIBUTE";
+    case EGL_BAD_CONFIG:
+      return "EGL_BAD_CONFIG";
+    case EGL_BAD_CONTEXT:
+      return "EGL_BAD_CONTEXT";
+    case EGL_BAD_CURRENT_SURFACE:
+      return "EGL_BAD_CURRENT_SURFACE";
+    case EGL_BAD_DISPLAY:
+      return "EGL_BAD_DISPLAY";
+    case EGL_BAD_MATCH:
+      return "EGL_BAD_MATCH";
+    case EGL_BAD_NATIVE_PIXMAP:
+      return "EGL_BAD_NATIVE_PIXMAP";
+    case EGL_BAD_NATIVE_WINDOW:
+      return "EGL_BAD_NATIVE_WINDOW";
+    case EGL_BAD_PARAMETER:
+      return "EGL_BAD_PARAMETER";
+    case EGL_BAD_SURFACE:
+      return "EGL_BAD_SURFACE";
+    case EGL_CONTEXT_LOST:
+      return "EGL_CONTEXT_LOST";
   }
   return "unknown EGL error";
 }
@@ -67,9 +82,15 @@ bool openOn(EGLDisplay display, EGLContext& context, std::string& error) {
   EGLConfig config = nullptr;
   EGLint count = 0;
   bool haveConfig = eglChooseConfig(display, configAttribs, &config, 1, &count) && count > 0;
-  const EGLint contextAttribs[] = {EGL_CONTEXT_MAJOR_VERSION, 4, EGL_CONTEXT_MINOR_VERSION, 5,
-                                   EGL_CONTEXT_OPENGL_PROFILE_MASK, EGL_CONTEXT_OPENGL_CORE_PROFILE_BIT, EGL_NONE};
-  context = eglCreateContext(display, haveConfig ? config : EGL_NO_CONFIG_KHR, EGL_NO_CONTEXT, contextAttribs);
+  const EGLint contextAttribs[] = {EGL_CONTEXT_MAJOR_VERSION,
+                                   4,
+                                   EGL_CONTEXT_MINOR_VERSION,
+                                   5,
+                                   EGL_CONTEXT_OPENGL_PROFILE_MASK,
+                                   EGL_CONTEXT_OPENGL_CORE_PROFILE_BIT,
+                                   EGL_NONE};
+  context =
+      eglCreateContext(display, haveConfig ? config : EGL_NO_CONFIG_KHR, EGL_NO_CONTEXT, contextAttribs);
   if (context == EGL_NO_CONTEXT) {
     error = eglFailure("eglCreateContext(OpenGL 4.5 core)");
     eglTerminate(display);
@@ -90,8 +111,10 @@ struct Platforms {
   PFNEGLGETPLATFORMDISPLAYEXTPROC getPlatformDisplay = nullptr;
   Platforms() {
     queryDevices = reinterpret_cast<PFNEGLQUERYDEVICESEXTPROC>(eglGetProcAddress("eglQueryDevicesEXT"));
-    queryDeviceString = reinterpret_cast<PFNEGLQUERYDEVICESTRINGEXTPROC>(eglGetProcAddress("eglQueryDeviceStringEXT"));
-    getPlatformDisplay = reinterpret_cast<PFNEGLGETPLATFORMDISPLAYEXTPROC>(eglGetProcAddress("eglGetPlatformDisplayEXT"));
+    queryDeviceString =
+        reinterpret_cast<PFNEGLQUERYDEVICESTRINGEXTPROC>(eglGetProcAddress("eglQueryDeviceStringEXT"));
+    getPlatformDisplay =
+        reinterpret_cast<PFNEGLGETPLATFORMDISPLAYEXTPROC>(eglGetProcAddress("eglGetPlatformDisplayEXT"));
   }
   std::vector<EGLDeviceEXT> devices() const {
     std::vector<EGLDeviceEXT> list;
@@ -109,7 +132,9 @@ struct Platforms {
 };
 
 // A device is a real GPU when it is not Mesa's software device.
-bool isSoftware(const std::string& extensions) { return extensions.find("EGL_MESA_device_software") != std::string::npos; }
+bool isSoftware(const std::string& extensions) {
+  return extensions.find("EGL_MESA_device_software") != std::string::npos;
+}
 
 }  // namespace
 
@@ -122,7 +147,8 @@ struct GlContext::State {
 GlContext::GlContext() : state_(std::make_unique<State>()) {
   Platforms p;
   std::string tried;
-  if (!p.getPlatformDisplay) throw DeviceError("EGL has no eglGetPlatformDisplayEXT; cannot open a headless display");
+  if (!p.getPlatformDisplay)
+    throw DeviceError("EGL has no eglGetPlatformDisplayEXT; cannot open a headless display");
   // 1. The EGL device platform: every device but Mesa's software one (that is the surfaceless path).
   for (EGLDeviceEXT device : p.devices()) {
     std::string ext = p.describe(device);
@@ -148,8 +174,9 @@ GlContext::GlContext() : state_(std::make_unique<State>()) {
     tried += "  Mesa surfaceless: " + error + "\n";
   }
   if (tried.empty()) tried = "  no EGL device and no surfaceless platform\n";
-  throw DeviceError("no OpenGL 4.5 core context through EGL:\n" + tried +
-                    "install Mesa (libegl-mesa0 libgl1-mesa-dri) for software rendering, or a GPU driver with EGL");
+  throw DeviceError(
+      "no OpenGL 4.5 core context through EGL:\n" + tried +
+      "install Mesa (libegl-mesa0 libgl1-mesa-dri) for software rendering, or a GPU driver with EGL");
 }
 
 GlContext::~GlContext() {
@@ -159,9 +186,15 @@ GlContext::~GlContext() {
   eglTerminate(state_->display);
 }
 
-const std::string& GlContext::platform() const { return state_->platform; }
-std::string GlContext::renderer() const { return reinterpret_cast<const char*>(glGetString(GL_RENDERER)); }
-std::string GlContext::version() const { return reinterpret_cast<const char*>(glGetString(GL_VERSION)); }
+const std::string& GlContext::platform() const {
+  return state_->platform;
+}
+std::string GlContext::renderer() const {
+  return reinterpret_cast<const char*>(glGetString(GL_RENDERER));
+}
+std::string GlContext::version() const {
+  return reinterpret_cast<const char*>(glGetString(GL_VERSION));
+}
 
 std::vector<GlDeviceInfo> GlContext::probe() {
   std::vector<GlDeviceInfo> out;
@@ -183,7 +216,8 @@ std::vector<GlDeviceInfo> GlContext::probe() {
     std::string ext = p.describe(device);
     tryOpen({"device", ext, false, ""}, p.getPlatformDisplay(EGL_PLATFORM_DEVICE_EXT, device, nullptr));
   }
-  tryOpen({"surfaceless", "", false, ""}, p.getPlatformDisplay(EGL_PLATFORM_SURFACELESS_MESA, EGL_DEFAULT_DISPLAY, nullptr));
+  tryOpen({"surfaceless", "", false, ""},
+          p.getPlatformDisplay(EGL_PLATFORM_SURFACELESS_MESA, EGL_DEFAULT_DISPLAY, nullptr));
   return out;
 }
 

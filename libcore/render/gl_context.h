@@ -13,7 +13,7 @@ struct GlDeviceInfo {
   std::string platform;  // "device" or "surfaceless"
   std::string name;      // the EGL device's extensions or the renderer string
   bool opened = false;
-  std::string error;     // why it did not open, EGL's error spelled out
+  std::string error;  // why it did not open, EGL's error spelled out
 };
 
 class GlContext {

@@ -21,15 +21,17 @@
 #include <glm/gtc/matrix_transform.hpp>
 #include <glm/gtc/type_ptr.hpp>
 
-#include "libcore/util/error.h"
 #include "libcore/render/gl_context.h"
+#include "libcore/util/error.h"
 #include "libcore/util/stopwatch.h"
 
 namespace hairgen {
 
 namespace {
 
-[[noreturn]] void fail(const std::string& what) { throw Error(ExitCode::kWorkFailed, {}, "rendering: " + what); }
+[[noreturn]] void fail(const std::string& what) {
+  throw Error(ExitCode::kWorkFailed, {}, "rendering: " + what);
+}
 
 void checkGl(const char* where) {
   GLenum e = glGetError();
@@ -336,7 +338,9 @@ class Shader {
   Shader& operator=(const Shader&) = delete;
   void use() const { glUseProgram(id); }
   GLint loc(const char* n) const { return glGetUniformLocation(id, n); }
-  void set(const char* n, const glm::mat4& m) const { glUniformMatrix4fv(loc(n), 1, GL_FALSE, glm::value_ptr(m)); }
+  void set(const char* n, const glm::mat4& m) const {
+    glUniformMatrix4fv(loc(n), 1, GL_FALSE, glm::value_ptr(m));
+  }
   void set(const char* n, const glm::vec4& v) const { glUniform4fv(loc(n), 1, glm::value_ptr(v)); }
   void set(const char* n, const glm::vec3& v) const { glUniform3fv(loc(n), 1, glm::value_ptr(v)); }
   void set(const char* n, const glm::vec2& v) const { glUniform2fv(loc(n), 1, glm::value_ptr(v)); }
@@ -375,7 +379,8 @@ struct Framebuffer {
       glNamedRenderbufferStorage(depth, GL_DEPTH_COMPONENT24, w, h);
       glNamedFramebufferRenderbuffer(id, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, depth);
     }
-    if (glCheckNamedFramebufferStatus(id, GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE) fail("framebuffer incomplete");
+    if (glCheckNamedFramebufferStatus(id, GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE)
+      fail("framebuffer incomplete");
   }
   ~Framebuffer() {
     glDeleteFramebuffers(1, &id);
@@ -446,12 +451,15 @@ struct HeadGeometry {
     interleaved.reserve(m.positions.size() * 6);
     for (size_t i = 0; i < m.positions.size(); ++i) {
       const glm::vec3 n = i < m.normals.size() ? m.normals[i] : glm::vec3(0, 1, 0);
-      interleaved.insert(interleaved.end(), {m.positions[i].x, m.positions[i].y, m.positions[i].z, n.x, n.y, n.z});
+      interleaved.insert(interleaved.end(),
+                         {m.positions[i].x, m.positions[i].y, m.positions[i].z, n.x, n.y, n.z});
     }
     glCreateBuffers(1, &vbo);
-    glNamedBufferStorage(vbo, static_cast<GLsizeiptr>(std::max<size_t>(interleaved.size() * 4, 4)), interleaved.data(), 0);
+    glNamedBufferStorage(vbo, static_cast<GLsizeiptr>(std::max<size_t>(interleaved.size() * 4, 4)),
+                         interleaved.data(), 0);
     glCreateBuffers(1, &ebo);
-    glNamedBufferStorage(ebo, static_cast<GLsizeiptr>(std::max<size_t>(m.triangles.size() * 12, 4)), m.triangles.data(), 0);
+    glNamedBufferStorage(ebo, static_cast<GLsizeiptr>(std::max<size_t>(m.triangles.size() * 12, 4)),
+                         m.triangles.data(), 0);
     indexCount = static_cast<GLsizei>(m.triangles.size() * 3);
     glCreateVertexArrays(1, &vao);
     glVertexArrayVertexBuffer(vao, 0, vbo, 0, 6 * sizeof(float));
@@ -484,9 +492,11 @@ void HairGeometry::draw(bool ribbon) const {
   if (!hasNormals) glVertexAttrib3f(3, 0.0f, 0.0f, 0.0f);
   if (lineFirsts.empty()) return;
   if (ribbon)
-    glMultiDrawArrays(GL_TRIANGLE_STRIP, ribbonFirsts.data(), ribbonCounts.data(), static_cast<GLsizei>(ribbonFirsts.size()));
+    glMultiDrawArrays(GL_TRIANGLE_STRIP, ribbonFirsts.data(), ribbonCounts.data(),
+                      static_cast<GLsizei>(ribbonFirsts.size()));
   else
-    glMultiDrawArrays(GL_LINE_STRIP, lineFirsts.data(), lineCounts.data(), static_cast<GLsizei>(lineFirsts.size()));
+    glMultiDrawArrays(GL_LINE_STRIP, lineFirsts.data(), lineCounts.data(),
+                      static_cast<GLsizei>(lineFirsts.size()));
 }
 
 // ------------------------------------------------------------------------------------- the passes
@@ -516,7 +526,8 @@ Sphere boundingSphere(const Strands& hair, const Mesh* head) {
 }
 
 glm::dvec3 anyUp(const glm::dvec3& forward, const glm::dvec3& preferred) {
-  return std::abs(glm::dot(glm::normalize(forward), glm::normalize(preferred))) > 0.999 ? glm::dvec3(0, 0, 1) : preferred;
+  return std::abs(glm::dot(glm::normalize(forward), glm::normalize(preferred))) > 0.999 ? glm::dvec3(0, 0, 1)
+                                                                                        : preferred;
 }
 
 View cameraView(const RenderSettings& r, const Sphere& scene) {
@@ -540,7 +551,8 @@ View lightView(const RenderSettings& r, const Sphere& scene, int size) {
   glm::dvec3 forward = scene.centre - r.lightPosition;
   double distance = glm::length(forward);
   v.view = glm::lookAt(r.lightPosition, scene.centre, anyUp(forward, glm::dvec3(0, 1, 0)));
-  double fov = distance > scene.radius * 1.05 ? 2.0 * std::asin(scene.radius / distance) * 1.02 : glm::radians(120.0);
+  double fov =
+      distance > scene.radius * 1.05 ? 2.0 * std::asin(scene.radius / distance) * 1.02 : glm::radians(120.0);
   double nearPlane = std::max(distance - scene.radius * 1.01, 1e-3 * std::max(distance, 1e-3));
   v.proj = glm::perspective(fov, 1.0, nearPlane, distance + scene.radius * 1.01 + 1e-3);
   v.focalPx = 0.5 * size / std::tan(0.5 * fov);
@@ -562,7 +574,8 @@ void setHairWidth(const Shader& s, const View& v, const RenderSettings& r) {
 // Reads `count` float channels of a single-sample RGBA32F texture into planes, rows top to bottom.
 void readPlanes(GLuint texture, int w, int h, std::vector<std::vector<float>*> planes) {
   std::vector<float> rgba(size_t(w) * h * 4);
-  glGetTextureImage(texture, 0, GL_RGBA, GL_FLOAT, static_cast<GLsizei>(rgba.size() * sizeof(float)), rgba.data());
+  glGetTextureImage(texture, 0, GL_RGBA, GL_FLOAT, static_cast<GLsizei>(rgba.size() * sizeof(float)),
+                    rgba.data());
   for (size_t c = 0; c < planes.size(); ++c) {
     if (!planes[c]) continue;
     planes[c]->resize(size_t(w) * h);

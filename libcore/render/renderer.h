@@ -10,9 +10,9 @@
 
 #include <glm/glm.hpp>
 
+#include "libcore/config/params.h"
 #include "libcore/model/image.h"
 #include "libcore/model/mesh.h"
-#include "libcore/config/params.h"
 #include "libcore/model/strands.h"
 
 namespace hairgen {
@@ -40,7 +40,7 @@ struct RenderInput {
   const Mesh* head = nullptr;  // may be null
   Visuality visuality;
   RenderSettings settings;
-  int domResolution = 1024;    // texels per side of the light's maps
+  int domResolution = 1024;  // texels per side of the light's maps
   bool keepDom = false;
 };
 

@@ -11,7 +11,8 @@
 //   `volumetric` = Petrovic et al. 2005 §4: the strand shaded as a surface with the stored volume
 //              normal n, diffuse max(n·l, 0) and a Phong specular max(r·e, 0)^p with r = l mirrored
 //              about n; the colour is mixed with Kajiya-Kay's by VolumetricBlend (0 = Kajiya-Kay).
-//   colour   = AmbientIntensity·AmbientColor + shadow·LightColor·(DiffuseColor·diffuse + SpecularColor·specular)
+//   colour   = AmbientIntensity·AmbientColor + shadow·LightColor·(DiffuseColor·diffuse +
+//   SpecularColor·specular)
 // A strand's per-vertex colour, where the cache has one, multiplies AmbientColor and DiffuseColor.
 // Head: AmbientIntensity·HeadColor + shadow·LightColor·HeadColor·max(n·l, 0).
 // `shadow` is the light that arrives: 1 − 0.75·opacity (the thesis maps opacity [0, 1] to [1, 0.25]).
@@ -25,8 +26,11 @@ namespace hairgen {
 
 // `n` is the strand's stored normal; only `volumetric` reads it.
 glm::dvec3 shadeHair(ShadingModel model, const glm::dvec3& t, const glm::dvec3& n, const glm::dvec3& l,
-                     const glm::dvec3& e, const Visuality& visuality, const RenderSettings& render, double shadow);
+                     const glm::dvec3& e, const Visuality& visuality, const RenderSettings& render,
+                     double shadow);
 
-inline double shadowFactor(double opacity) { return 1.0 - 0.75 * glm::clamp(opacity, 0.0, 1.0); }
+inline double shadowFactor(double opacity) {
+  return 1.0 - 0.75 * glm::clamp(opacity, 0.0, 1.0);
+}
 
 }  // namespace hairgen

@@ -12,11 +12,11 @@ namespace hairgen {
 
 // The process exit codes, the same for every command (DESIGN §3).
 enum class ExitCode : int {
-  kSuccess = 0,      // the command did what was asked
-  kWorkFailed = 1,   // the work itself failed: I/O while writing, a numerical failure
-  kBadInput = 2,     // bad usage or bad input: config, mesh, cache, command line
-  kNoDevice = 3,     // no rendering device could be opened
-  kDiffFailed = 4,   // `hairgen diff` found the images beyond its thresholds
+  kSuccess = 0,     // the command did what was asked
+  kWorkFailed = 1,  // the work itself failed: I/O while writing, a numerical failure
+  kBadInput = 2,    // bad usage or bad input: config, mesh, cache, command line
+  kNoDevice = 3,    // no rendering device could be opened
+  kDiffFailed = 4,  // `hairgen diff` found the images beyond its thresholds
 };
 
 // Where in a text file something was found. line == 0 means "the file as a whole".

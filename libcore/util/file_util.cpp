@@ -51,7 +51,9 @@ void renameInto(const std::filesystem::path& temporary, const std::filesystem::p
 
 }  // namespace
 
-std::string readFileText(const std::filesystem::path& path) { return readWhole<std::string>(path); }
+std::string readFileText(const std::filesystem::path& path) {
+  return readWhole<std::string>(path);
+}
 
 std::vector<uint8_t> readFileBytes(const std::filesystem::path& path) {
   return readWhole<std::vector<uint8_t>>(path);
@@ -73,8 +75,7 @@ void writeThroughTemporary(const std::filesystem::path& target,
 AtomicFile::AtomicFile(std::filesystem::path target) : target_(std::move(target)) {
   temporary_ = temporaryBeside(target_);
   stream_.open(temporary_, std::ios::binary | std::ios::trunc);
-  if (!stream_)
-    throw IoError({target_.string(), 0}, std::string("cannot write: ") + std::strerror(errno));
+  if (!stream_) throw IoError({target_.string(), 0}, std::string("cannot write: ") + std::strerror(errno));
 }
 
 AtomicFile::~AtomicFile() {

@@ -7,15 +7,20 @@
 namespace hairgen {
 namespace {
 
-constexpr double kQuietFor = 1.0;     // seconds before anything is printed
-constexpr double kBarEvery = 0.1;     // live bar refresh
-constexpr double kLineEvery = 5.0;    // log line interval
+constexpr double kQuietFor = 1.0;   // seconds before anything is printed
+constexpr double kBarEvery = 0.1;   // live bar refresh
+constexpr double kLineEvery = 5.0;  // log line interval
 
 }  // namespace
 
 Progress::Progress(std::string stage, std::string unit, size_t total, bool enabled)
-    : stage_(std::move(stage)), unit_(std::move(unit)), total_(total), enabled_(enabled && total > 0),
-      terminal_(isatty(STDERR_FILENO) != 0), start_(Clock::now()), nextPrint_(kQuietFor) {}
+    : stage_(std::move(stage)),
+      unit_(std::move(unit)),
+      total_(total),
+      enabled_(enabled && total > 0),
+      terminal_(isatty(STDERR_FILENO) != 0),
+      start_(Clock::now()),
+      nextPrint_(kQuietFor) {}
 
 void Progress::finish() {
   std::lock_guard lock(print_);
@@ -42,11 +47,11 @@ void Progress::print(size_t done, double seconds) {
     constexpr int kWidth = 30;
     std::string bar(kWidth * percent / 100, '#');
     bar.resize(kWidth, ' ');
-    std::fprintf(stderr, "\r%s [%s] %3d%% %zu/%zu %s %.1f s", stage_.c_str(), bar.c_str(), percent, done, total_,
-                 unit_.c_str(), seconds);
+    std::fprintf(stderr, "\r%s [%s] %3d%% %zu/%zu %s %.1f s", stage_.c_str(), bar.c_str(), percent, done,
+                 total_, unit_.c_str(), seconds);
   } else {
-    std::fprintf(stderr, "%s: %3d%% (%zu of %zu %s, %.1f s)\n", stage_.c_str(), percent, done, total_, unit_.c_str(),
-                 seconds);
+    std::fprintf(stderr, "%s: %3d%% (%zu of %zu %s, %.1f s)\n", stage_.c_str(), percent, done, total_,
+                 unit_.c_str(), seconds);
   }
   std::fflush(stderr);
   printed_ = true;

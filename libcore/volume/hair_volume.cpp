@@ -1,16 +1,16 @@
 #include "libcore/volume/hair_volume.h"
 
 #include <algorithm>
-#include <cmath>
 #include <atomic>
+#include <cmath>
 #include <cstdio>
 #include <limits>
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
-#include "libcore/util/error.h"
 #include "libcore/model/mesh.h"
+#include "libcore/util/error.h"
 
 namespace hairgen {
 
@@ -19,7 +19,8 @@ namespace {
 // Σ over the 8 nodes around p of their trilinear weight times value(i, j, k) (p clamped to the grid).
 template <class T, class Value>
 T trilinear(const Grid& grid, const glm::dvec3& p, Value value) {
-  glm::dvec3 g = glm::clamp((p - grid.origin) / grid.voxel, glm::dvec3(0.0), glm::dvec3(grid.size - 1) - 1e-9);
+  glm::dvec3 g =
+      glm::clamp((p - grid.origin) / grid.voxel, glm::dvec3(0.0), glm::dvec3(grid.size - 1) - 1e-9);
   glm::ivec3 c = glm::ivec3(glm::floor(g));
   glm::dvec3 f = g - glm::dvec3(c);
   T out(0.0);
@@ -53,14 +54,16 @@ std::vector<glm::vec3> nodeGradients(const Grid& grid) {
     };
     for (int j = 0; j < n.y; ++j)
       for (int i = 0; i < n.x; ++i)
-        out[grid.index(i, j, k)] = scale * glm::vec3(v(i + 1, j, k) - v(i - 1, j, k), v(i, j + 1, k) - v(i, j - 1, k),
-                                                     v(i, j, k + 1) - v(i, j, k - 1));
+        out[grid.index(i, j, k)] =
+            scale * glm::vec3(v(i + 1, j, k) - v(i - 1, j, k), v(i, j + 1, k) - v(i, j - 1, k),
+                              v(i, j, k + 1) - v(i, j, k - 1));
   });
   return out;
 }
 
 glm::dvec3 sampleGradient(const Grid& grid, const std::vector<glm::vec3>& gradients, const glm::dvec3& p) {
-  return trilinear<glm::dvec3>(grid, p, [&](int i, int j, int k) { return glm::dvec3(gradients[grid.index(i, j, k)]); });
+  return trilinear<glm::dvec3>(
+      grid, p, [&](int i, int j, int k) { return glm::dvec3(gradients[grid.index(i, j, k)]); });
 }
 
 }  // namespace
@@ -76,7 +79,8 @@ Grid gridAround(const std::vector<glm::vec3>& points, double voxel, int padding)
   if (cells.x * cells.y * cells.z > 4.0e8) {
     const glm::dvec3 span = hi - lo;
     char text[160];
-    std::snprintf(text, sizeof text, "the hair spans %.3g x %.3g x %.3g, which at VoxelSize %.3g is %.3g voxels (4e8 at most)",
+    std::snprintf(text, sizeof text,
+                  "the hair spans %.3g x %.3g x %.3g, which at VoxelSize %.3g is %.3g voxels (4e8 at most)",
                   span.x, span.y, span.z, voxel, cells.x * cells.y * cells.z);
     throw InputError(std::string(text) + "; raise Render.VoxelSize, or check the cache is in metres");
   }
@@ -93,28 +97,32 @@ void splat(Grid& d, const std::vector<glm::vec3>& points) {
   constexpr double kOne = 4294967296.0;  // 2^32
   std::vector<int64_t> sums(d.values.size(), 0);
   const glm::ivec3 size = d.size;
-  tbb::parallel_for(tbb::blocked_range<size_t>(0, points.size(), 4096), [&](const tbb::blocked_range<size_t>& r) {
-    for (size_t p = r.begin(); p != r.end(); ++p) {
-      glm::dvec3 g = (glm::dvec3(points[p]) - d.origin) / d.voxel;
-      glm::ivec3 c = glm::ivec3(glm::floor(g));
-      glm::dvec3 f = g - glm::dvec3(c);
-      int64_t w[8];
-      int64_t total = 0;
-      int largest = 0;
-      for (int corner = 0; corner < 8; ++corner) {
-        const int dx = corner & 1, dy = (corner >> 1) & 1, dz = corner >> 2;
-        w[corner] = int64_t((dx ? f.x : 1 - f.x) * (dy ? f.y : 1 - f.y) * (dz ? f.z : 1 - f.z) * kOne + 0.5);
-        total += w[corner];
-        if (w[corner] > w[largest]) largest = corner;
-      }
-      w[largest] += int64_t(kOne) - total;
-      for (int corner = 0; corner < 8; ++corner) {  // on the grid's edge, the outer corners fall away
-        const glm::ivec3 n = c + glm::ivec3(corner & 1, (corner >> 1) & 1, corner >> 2);
-        if (glm::any(glm::lessThan(n, glm::ivec3(0))) || glm::any(glm::greaterThanEqual(n, size))) continue;
-        std::atomic_ref<int64_t>(sums[d.index(n.x, n.y, n.z)]).fetch_add(w[corner], std::memory_order_relaxed);
-      }
-    }
-  });
+  tbb::parallel_for(
+      tbb::blocked_range<size_t>(0, points.size(), 4096), [&](const tbb::blocked_range<size_t>& r) {
+        for (size_t p = r.begin(); p != r.end(); ++p) {
+          glm::dvec3 g = (glm::dvec3(points[p]) - d.origin) / d.voxel;
+          glm::ivec3 c = glm::ivec3(glm::floor(g));
+          glm::dvec3 f = g - glm::dvec3(c);
+          int64_t w[8];
+          int64_t total = 0;
+          int largest = 0;
+          for (int corner = 0; corner < 8; ++corner) {
+            const int dx = corner & 1, dy = (corner >> 1) & 1, dz = corner >> 2;
+            w[corner] =
+                int64_t((dx ? f.x : 1 - f.x) * (dy ? f.y : 1 - f.y) * (dz ? f.z : 1 - f.z) * kOne + 0.5);
+            total += w[corner];
+            if (w[corner] > w[largest]) largest = corner;
+          }
+          w[largest] += int64_t(kOne) - total;
+          for (int corner = 0; corner < 8; ++corner) {  // on the grid's edge, the outer corners fall away
+            const glm::ivec3 n = c + glm::ivec3(corner & 1, (corner >> 1) & 1, corner >> 2);
+            if (glm::any(glm::lessThan(n, glm::ivec3(0))) || glm::any(glm::greaterThanEqual(n, size)))
+              continue;
+            std::atomic_ref<int64_t>(sums[d.index(n.x, n.y, n.z)])
+                .fetch_add(w[corner], std::memory_order_relaxed);
+          }
+        }
+      });
   for (size_t i = 0; i < sums.size(); ++i) d.values[i] += static_cast<float>(double(sums[i]) / kOne);
 }
 
@@ -184,7 +192,8 @@ Grid signedDistance(const Grid& density, double iso) {
             const int i = fx ? n.x - 1 - ii : ii, j = fy ? n.y - 1 - jj : jj, k = fz ? n.z - 1 - kk : kk;
             const size_t id = density.index(i, j, k);
             const glm::dvec3 x = node(i, j, k);
-            const bool has[3] = {fx ? i + 1 < n.x : i > 0, fy ? j + 1 < n.y : j > 0, fz ? k + 1 < n.z : k > 0};
+            const bool has[3] = {fx ? i + 1 < n.x : i > 0, fy ? j + 1 < n.y : j > 0,
+                                 fz ? k + 1 < n.z : k > 0};
             const size_t behind[3] = {fx ? id + 1 : id - 1, fy ? id + strideY : id - strideY,
                                       fz ? id + strideZ : id - strideZ};
             for (int axis = 0; axis < 3; ++axis) {
@@ -270,13 +279,14 @@ HairVolume buildVolume(const Strands& strands, double voxel, int padding, double
 std::vector<glm::vec3> volumeNormals(const Grid& distance, const Strands& strands) {
   const std::vector<glm::vec3> gradients = nodeGradients(distance);
   std::vector<glm::vec3> normals(strands.pointCount());
-  tbb::parallel_for(tbb::blocked_range<size_t>(0, strands.pointCount(), 8192), [&](const tbb::blocked_range<size_t>& r) {
-    for (size_t p = r.begin(); p != r.end(); ++p) {
-      const glm::dvec3 g = sampleGradient(distance, gradients, glm::dvec3(strands.points[p]));
-      const double len = glm::length(g);
-      normals[p] = len > 1e-12 ? glm::vec3(g / len) : glm::vec3(0, 1, 0);
-    }
-  });
+  tbb::parallel_for(
+      tbb::blocked_range<size_t>(0, strands.pointCount(), 8192), [&](const tbb::blocked_range<size_t>& r) {
+        for (size_t p = r.begin(); p != r.end(); ++p) {
+          const glm::dvec3 g = sampleGradient(distance, gradients, glm::dvec3(strands.points[p]));
+          const double len = glm::length(g);
+          normals[p] = len > 1e-12 ? glm::vec3(g / len) : glm::vec3(0, 1, 0);
+        }
+      });
   return normals;
 }
 

@@ -4,7 +4,8 @@
 //   GrowCoupe3:         the whole grow stage on every core, counters guides/s and evaluations/s.
 //   InterpolateCoupe3:  ~150,000 strands of 64 vertices from coupe 3's guides, every core.
 //   ShadeCoupe3:        `shade` on that 150,000-strand coupe with coupe 3's Render Info (grid, signed
-//                       distance, normals), every core; counters give the grid's size and each part's seconds.
+//                       distance, normals), every core; counters give the grid's size and each part's
+//                       seconds.
 //   CantileverStyling:  Anjyo's figures, 20,000 hairs of 20 segments bent around the head ellipsoid.
 //   Render/strands/width/height/samples: coupe 3 with the head and shadows, through whatever EGL opens
 //                       (llvmpipe here); counters give each pass's seconds.
@@ -15,14 +16,14 @@
 #include <tbb/global_control.h>
 #include <tbb/info.h>
 
-#include "libcore/io/obj_io.h"
 #include "libcore/config/setup.h"
+#include "libcore/io/obj_io.h"
+#include "libcore/render/gl_context.h"
+#include "libcore/render/renderer.h"
 #include "stages/cantilever.h"
 #include "stages/grow.h"
 #include "stages/interpolate.h"
 #include "stages/shade.h"
-#include "libcore/render/gl_context.h"
-#include "libcore/render/renderer.h"
 
 namespace hairgen {
 namespace {
@@ -31,7 +32,8 @@ struct Coupe3 {
   Config config;
   Mesh wick;
   Coupe3()
-      : config(loadConfig(std::filesystem::path(HAIRGEN_SOURCE_DIR) / "configs/thesis/coupe3/setup.txt", {}, SetupUse::kGrow)),
+      : config(loadConfig(std::filesystem::path(HAIRGEN_SOURCE_DIR) / "configs/thesis/coupe3/setup.txt", {},
+                          SetupUse::kGrow)),
         wick(readObj(config.setup.wickModel.path)) {}
 };
 
@@ -49,7 +51,8 @@ void EnergyEvaluation(benchmark::State& state) {
     size_t i = k * n / 50;
     RodFrame root = follicleFrame(glm::dvec3(c.wick.positions[i]), glm::dvec3(c.wick.normals[i]));
     energies.emplace_back(c.config.hairstyle, c.config.collision, root, double(k) / 50.0);
-    coordinates.push_back(growGuide(root, double(k) / 50.0, c.config.hairstyle, c.config.collision).coordinates);
+    coordinates.push_back(
+        growGuide(root, double(k) / 50.0, c.config.hairstyle, c.config.collision).coordinates);
   }
   size_t k = 0;
   for (auto _ : state) {
@@ -102,7 +105,8 @@ void ShadeCoupe3(benchmark::State& state) {
   Hairstyle style = c.config.hairstyle;
   style.visualityStep = style.totalLength() / 63.0;
   style.hairDensity = 150000.0 / (surfaceArea(c.wick) * 1e4);
-  const Strands coupe = interpolate(c.wick, grow(c.wick, style, c.config.collision, {}).guides, style, c.config.collision, {});
+  const Strands coupe =
+      interpolate(c.wick, grow(c.wick, style, c.config.collision, {}).guides, style, c.config.collision, {});
   ShadeTimings total;
   glm::ivec3 grid(0);
   for (auto _ : state) {
@@ -129,12 +133,14 @@ BENCHMARK(ShadeCoupe3)->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(3.
 
 void CantileverStyling(benchmark::State& state) {
   // 20,000 pores spread evenly over the upper head ellipsoid (a Fibonacci lattice), normals outward.
-  const CollisionShape head{ShapeKind::kEllipsoid, 0.0, 10.0, glm::dvec3(-0.001, 0.068, 0.010), glm::dvec3(0.08, 0.08, 0.11),
-                            glm::dmat3(1.0), {}};
+  const CollisionShape head{
+      ShapeKind::kEllipsoid, 0.0, 10.0, glm::dvec3(-0.001, 0.068, 0.010), glm::dvec3(0.08, 0.08, 0.11),
+      glm::dmat3(1.0),       {}};
   Mesh wick;
   const int n = 20000;
   for (int i = 0; i < n; ++i) {
-    double y = 1.0 - double(i) / (n - 1) * 1.2, r = std::sqrt(std::max(0.0, 1.0 - y * y)), phi = i * 2.399963229728653;
+    double y = 1.0 - double(i) / (n - 1) * 1.2, r = std::sqrt(std::max(0.0, 1.0 - y * y)),
+           phi = i * 2.399963229728653;
     glm::dvec3 unit(r * std::sin(phi), y, r * std::cos(phi));
     wick.positions.push_back(glm::vec3(head.centre + unit * head.halfExtents));
     wick.normals.push_back(glm::vec3(glm::normalize(unit / head.halfExtents)));
@@ -143,11 +149,13 @@ void CantileverStyling(benchmark::State& state) {
   style.model = StylingModel::kCantilever;
   style.hairLengths = {0.22};
   style.segments = 20;
-  style.forces.push_back({glm::dvec3(6, 0, 0), ForceField::Region::kSide, 0.0, glm::dvec3(1, 0, 0), {}, {}, {}});
+  style.forces.push_back(
+      {glm::dvec3(6, 0, 0), ForceField::Region::kSide, 0.0, glm::dvec3(1, 0, 0), {}, {}, {}});
   Collision collision;
   collision.shapes.push_back(head);
   for (auto _ : state) benchmark::DoNotOptimize(grow(wick, style, collision, {}).guides.points.data());
-  state.counters["hairs/s"] = benchmark::Counter(double(n) * double(state.iterations()), benchmark::Counter::kIsRate);
+  state.counters["hairs/s"] =
+      benchmark::Counter(double(n) * double(state.iterations()), benchmark::Counter::kIsRate);
 }
 BENCHMARK(CantileverStyling)->Unit(benchmark::kMillisecond)->UseRealTime();
 
