@@ -14,12 +14,15 @@ void registerCheck(CLI::App& app, int& exitCode) {
     std::string setup;
     bool json = false;
     bool canonical = false;
+    bool keys = false;
   };
   auto options = std::make_shared<Options>();
   CLI::App* cmd = app.add_subcommand(
       "check",
       "Validate a Setup and every file it names (configs, meshes); print the effective values and digest");
-  cmd->add_option("SETUP", options->setup, "The Setup file")->required();
+  cmd->add_option("SETUP", options->setup, "The Setup file");
+  cmd->add_flag("--keys", options->keys,
+                "Print the reference of every config key (Markdown, as docs/config-keys.md) and exit");
   cmd->add_flag("--json", options->json, "Print the report as JSON");
   cmd->add_flag("--canonical", options->canonical,
                 "Print every effective value, one `Section.Key value` a line");
@@ -27,6 +30,11 @@ void registerCheck(CLI::App& app, int& exitCode) {
   cmd->footer(exitCodeHelp());
   cmd->callback([options, &exitCode] {
     exitCode = runCommand("check", options->common, [&] {
+      if (options->keys) {
+        std::cout << keyReference();
+        return;
+      }
+      if (options->setup.empty()) throw InputError("check needs a SETUP (or --keys)");
       Stats stats("check");
       std::vector<Override> overrides = parseOverrides(options->common);
       Config config = loadConfig(options->setup, overrides, SetupUse::kCheck);

@@ -6,7 +6,7 @@
 #include <tbb/global_control.h>
 #include <tbb/info.h>
 
-#include "libcore/config/config.h"
+#include "libcore/config/reader.h"
 #include "libcore/util/error.h"
 #include "libcore/util/file_util.h"
 
@@ -25,12 +25,15 @@ void addCommonFlags(CLI::App& command, CommonOptions& options, bool configFlags)
   if (!configFlags) return;
   command.add_option("--seed", options.seed, "Seed of every random number (overrides Hairstyle.Seed)")
       ->type_name("N");
+  std::string sections;
+  for (const SectionSpec* s : allSections()) sections += (sections.empty() ? "" : ", ") + s->name;
   command
-      .add_option(
-          "--set", options.sets,
-          "Override a config value without editing files, e.g. --set Hairstyle.HairDensity=160 "
-          "(repeatable; sections Setup, Hairstyle, Collision, Visuality, Render; a repeatable key such as "
-          "Collision.Sphere replaces all its lines)")
+      .add_option("--set", options.sets,
+                  "Override a config value without editing files, e.g. --set Hairstyle.HairDensity=160 "
+                  "(repeatable; sections " +
+                      sections +
+                      "; a repeatable key such as Collision.Sphere replaces all its lines; every key: "
+                      "hairgen check --keys)")
       ->type_name("Section.Key=VALUE")
       ->take_all()
       ->allow_extra_args(false);

@@ -6,7 +6,7 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 
 packages=(
-  build-essential cmake ninja-build pkg-config git
+  build-essential cmake ninja-build pkg-config git clang-format
   libglm-dev libcli11-dev libtinyobjloader-dev libtinygltf-dev nlohmann-json3-dev libstb-dev
   libopenexr-dev openexr libopenimageio-dev openimageio-tools libtbb-dev zlib1g-dev
   libopenvdb-dev libopenvdb-tools libboost-dev  # OpenVDB's headers include Boost's; its package does not pull them

@@ -53,7 +53,7 @@ std::vector<glm::dvec3> bendHair(const glm::dvec3& pore, const glm::dvec3& norma
   const double a = style.hairRadius1, b = style.hairRadius2;
   const double rigidity =
       style.flexuralRigidity > 0.0 ? style.flexuralRigidity : style.young * M_PI * a * b * b * b / 4.0;
-  const double massPerLength = style.density * M_PI * a * b;
+  const double massPerLength = style.massDensity * M_PI * a * b;
   const double limit = glm::radians(style.jointLimit);
   std::vector<glm::dvec3> p{pore};
   glm::dvec3 a0 = glm::normalize(normal);  // the direction of the segment before: the follicle's at the pore

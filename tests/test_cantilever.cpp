@@ -60,7 +60,7 @@ TEST(Cantilever, ASingleSegmentDeflectsByEquationThree) {
   Hairstyle h = beam(0.02, 1);
   h.flexuralRigidity = 1e-10;
   std::vector<glm::dvec3> p = bendHair(glm::dvec3(0.0), glm::dvec3(1, 0, 0), h, nullptr);
-  const double d = 0.02, load = h.density * M_PI * h.hairRadius1 * h.hairRadius2 * h.gravity * d;
+  const double d = 0.02, load = h.massDensity * M_PI * h.hairRadius1 * h.hairRadius2 * h.gravity * d;
   const double moment = -load * d * 1.0 / 2.0;                    // (2) with k = i = 1
   const double y = -0.5 * (moment / h.flexuralRigidity) * d * d;  // (3)
   EXPECT_DOUBLE_EQ(cantileverDeflection(load, d, h.flexuralRigidity, 1, 1), y);

@@ -55,7 +55,7 @@ TEST(ThesisConfigs, AppendixBHairstyleParsesAsPrinted) {
   EXPECT_DOUBLE_EQ(h.helixStep, 0.05);
   EXPECT_DOUBLE_EQ(h.poisson, 0.48);
   EXPECT_DOUBLE_EQ(h.young, 1e9);
-  EXPECT_DOUBLE_EQ(h.density, 13000);
+  EXPECT_DOUBLE_EQ(h.massDensity, 13000);
   EXPECT_DOUBLE_EQ(h.gravity, 9.81);
 }
 
@@ -63,13 +63,13 @@ TEST(ThesisConfigs, AppendixBCollisionParsesAsPrinted) {
   Collision c = readCollision(readConfigText(thesis("appendix-b/Properties/Collision/Collision1.txt")), {});
   ASSERT_EQ(c.shapes.size(), 2u);
   EXPECT_EQ(c.shapes[0].kind, ShapeKind::kEllipsoid);  // "Elipsoid", the thesis' spelling
-  EXPECT_DOUBLE_EQ(c.shapes[0].volume, 0.04);
+  EXPECT_DOUBLE_EQ(c.shapes[0].envelopeGrowth, 0.04);
   EXPECT_DOUBLE_EQ(c.shapes[0].penalty, 10.0);
   EXPECT_EQ(c.shapes[0].centre, glm::dvec3(0.0, 0.07, 0.01));
   EXPECT_EQ(c.shapes[0].halfExtents, glm::dvec3(0.08, 0.08, 0.11));
   EXPECT_EQ(c.shapes[0].axes, glm::dmat3(1.0));
   EXPECT_EQ(c.shapes[1].kind, ShapeKind::kSphere);
-  EXPECT_DOUBLE_EQ(c.shapes[1].volume, -0.02);
+  EXPECT_DOUBLE_EQ(c.shapes[1].envelopeGrowth, -0.02);
   EXPECT_DOUBLE_EQ(c.shapes[1].penalty, 0.01);
   EXPECT_EQ(c.shapes[1].centre, glm::dvec3(0.0, 0.04, 0.16));
   EXPECT_DOUBLE_EQ(c.shapes[1].halfExtents.x, 0.10);
@@ -104,8 +104,8 @@ TEST_P(ThesisCoupe, ParsesToAppendixCTables) {
   EXPECT_DOUBLE_EQ(c.hairstyle.helixStep, t.helixStep);
   EXPECT_EQ(c.hairstyle.maxIter, 20);
   EXPECT_DOUBLE_EQ(c.hairstyle.epsilon, 0.0001);
-  EXPECT_DOUBLE_EQ(c.hairstyle.young, 1e8);      // the thesis' own value, kept (DESIGN §7)
-  EXPECT_DOUBLE_EQ(c.hairstyle.density, 13000);  // likewise
+  EXPECT_DOUBLE_EQ(c.hairstyle.young, 1e8);          // the thesis' own value, kept (DESIGN §7)
+  EXPECT_DOUBLE_EQ(c.hairstyle.massDensity, 13000);  // likewise
   EXPECT_DOUBLE_EQ(c.hairstyle.hairRadius1, 0.000035);
   EXPECT_DOUBLE_EQ(c.hairstyle.hairRadius2, 0.000050);
   EXPECT_EQ(c.visuality.ambientColor, glm::dvec3(0.1, 0.1, 0.1));
@@ -114,7 +114,7 @@ TEST_P(ThesisCoupe, ParsesToAppendixCTables) {
   ASSERT_EQ(c.collision.shapes.size(), t.shapes);
   EXPECT_EQ(c.collision.shapes[0].centre, glm::dvec3(-0.001, 0.068, 0.010));
   EXPECT_EQ(c.collision.shapes[0].halfExtents, glm::dvec3(0.080, 0.080, 0.110));
-  EXPECT_DOUBLE_EQ(c.collision.shapes[0].volume, t.ellipsoidVolume);
+  EXPECT_DOUBLE_EQ(c.collision.shapes[0].envelopeGrowth, t.ellipsoidVolume);
   EXPECT_DOUBLE_EQ(c.collision.shapes[0].penalty, 10.0);
 }
 
@@ -131,7 +131,7 @@ TEST(ThesisConfigs, Coupe3FrontSphereAsTable11) {
   Config c = loadConfig(thesis("coupe3/setup.txt"), {}, SetupUse::kCheck);
   const CollisionShape& s = c.collision.shapes[1];
   EXPECT_EQ(s.kind, ShapeKind::kSphere);
-  EXPECT_DOUBLE_EQ(s.volume, 0.15);
+  EXPECT_DOUBLE_EQ(s.envelopeGrowth, 0.15);
   EXPECT_DOUBLE_EQ(s.penalty, 0.01);
   EXPECT_EQ(s.centre, glm::dvec3(0.0, 0.033, 0.165));
   EXPECT_DOUBLE_EQ(s.halfExtents.x, 0.080);
@@ -238,8 +238,8 @@ TEST(Config, KeysAreCaseInsensitiveCommentsAndQuotesWork) {
 
 TEST(Config, MissingKeysTakePhysicalDefaults) {
   Hairstyle h = readHairstyle(text("HairLengths 0.04\n"), {});
-  EXPECT_DOUBLE_EQ(h.density, 1300.0);  // Table 3, not the examples' 13000
-  EXPECT_DOUBLE_EQ(h.young, 2.0e9);     // Table 1
+  EXPECT_DOUBLE_EQ(h.massDensity, 1300.0);  // Table 3, not the examples' 13000
+  EXPECT_DOUBLE_EQ(h.young, 2.0e9);         // Table 1
   EXPECT_DOUBLE_EQ(h.helixRadius, 0.0);
   EXPECT_GT(h.hairRadius1, h.hairRadius2);
 }
@@ -281,6 +281,58 @@ TEST(Config, DigestFollowsValuesNotFormatting) {
   EXPECT_EQ(a.digest(), b.digest());
   b.hairstyle.young = 1e9;
   EXPECT_NE(a.digest(), b.digest());
+}
+
+// A key declared once, in a section of its own that only this test knows: the reader, the canonical
+// text behind the digest, --set and the key reference all find it with no other edit.
+struct ProbeSettings {
+  double strength = 1.5;  // newtons
+};
+
+TEST(ConfigKeys, AKeyDeclaredOnceReachesTheReaderTheDigestSetAndTheReference) {
+  const Section<ProbeSettings> probe = makeSection<ProbeSettings>(
+      "Probe", "Probe Info", "ProbeInfo",
+      {realKey<ProbeSettings>({"Strength", "N", "how hard the probe pulls", {"Pull"}},
+                              &ProbeSettings::strength, Range::positive())});
+  SectionList sections = allSections();
+  sections.push_back(&probe.spec);
+
+  EXPECT_EQ(readSection(probe, text("Strength 2.5\n", "p.txt"), {}).strength, 2.5);
+  EXPECT_EQ(readSection(probe, text("pull 3\n", "p.txt"), {}).strength, 3.0);
+  EXPECT_EQ(readSection(probe, text("# nothing\n", "p.txt"), {}).strength, 1.5);  // the struct's default
+  EXPECT_NE(inputError([&] { readSection(probe, text("Strength -1\n", "p.txt"), {}); }).find("p.txt:1:"),
+            std::string::npos);
+
+  Override set = parseOverride("Probe.Strength=4", sections);
+  EXPECT_EQ(readSection(probe, text("Strength 2.5\n", "p.txt"), {set}).strength, 4.0);
+  EXPECT_THROW(parseOverride("Probe.Strength=4"), InputError);  // unknown to hairgen's own sections
+
+  EXPECT_EQ(probe.canonicalText(ProbeSettings{2.5}), "Probe.Strength 2.5\n");
+
+  std::string reference = keyReference(sections);
+  EXPECT_NE(reference.find("## Probe Info"), std::string::npos);
+  EXPECT_NE(
+      reference.find("| `Strength` | real > 0 | N | 1.5 | how hard the probe pulls. Also spelled `Pull`. |"),
+      std::string::npos)
+      << reference.substr(reference.find("## Probe Info"));
+}
+
+// Every key that shapes the output is in the canonical text, so two configs that differ in any of them
+// have different digests.
+TEST(ConfigKeys, EveryDigestKeyIsInTheCanonicalText) {
+  Config config;
+  config.hairstyle.hairLengths = {0.04};
+  config.hairstyle.forces.push_back(ForceField{});
+  config.hairstyle.cuts.push_back(HairCut{});
+  for (ShapeKind kind : {ShapeKind::kSphere, ShapeKind::kEllipsoid, ShapeKind::kCuboid})
+    config.collision.shapes.push_back(
+        CollisionShape{kind, 0, 1, glm::dvec3(0), glm::dvec3(0.1), glm::dmat3(1), {}});
+  const std::string canonical = config.canonicalText();
+  for (const SectionSpec* section : allSections())
+    for (const KeySpec& key : section->keys) {
+      bool found = canonical.find(section->name + "." + key.name + " ") != std::string::npos;
+      EXPECT_EQ(found, key.inDigest) << section->name << "." << key.name;
+    }
 }
 
 }  // namespace

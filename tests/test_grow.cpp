@@ -84,7 +84,7 @@ TEST(Grow, Coupe3CollisionSamplesStayOutOfTheHeadEnvelope) {
   double deepest = -1.0, deepestInHead = -1.0;
   std::vector<glm::dvec3> p;
   for (size_t i = 0; i < wick.vertexCount(); ++i) {
-    const double extra = head.volume * envelope[i];
+    const double extra = head.envelopeGrowth * envelope[i];
     RodFrame root = follicleFrame(glm::dvec3(wick.positions[i]), glm::dvec3(wick.normals[i]));
     sampleRod(root, c.hairstyle.hairLengths, g.reports[i].coordinates, s, p, nullptr);
     for (size_t k = 0; k < p.size(); ++k) {
@@ -178,7 +178,7 @@ TEST(Grow, NonFiniteEnergyNamesTheGuide) {
   wick.positions = {{0, 0.1f, 0}, {0.01f, 0.1f, 0}};
   wick.normals = {{0, 1, 0}, {1, 0, 0}};
   Hairstyle h = style({0.04});
-  h.density = 1e308;  // ρ S g overflows: the energy is not finite
+  h.massDensity = 1e308;  // ρ S g overflows: the energy is not finite
   h.gravity = 1e308;
   try {
     grow(wick, h, Collision{}, {});

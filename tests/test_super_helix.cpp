@@ -98,24 +98,29 @@ TEST(SuperHelix, SeriesAndClosedFormAgreeAtTheSwitch) {
   EXPECT_NEAR(glm::length(straight.position - (root.position + l * root.n0)), 0.0, 1e-18);
 }
 
-TEST(SuperHelix, ClosedFormGravityMatchesQuadrature) {
+TEST(StrandEnergy, ClosedFormGravityMatchesQuadrature) {
+  // The gravity term of the energy the minimiser calls, ρ S g ∫ (y(s) − y(0)) ds in closed form per
+  // element, against Simpson's rule on the sampled centreline.
   std::mt19937 rng(11);
   std::uniform_real_distribution<double> k(-300.0, 300.0);
+  Hairstyle style;
+  style.hairLengths = {0.04, 0.03, 0.05, 0.04};
+  const double weight = style.massDensity * M_PI * style.hairRadius1 * style.hairRadius2 * style.gravity;
   for (int trial = 0; trial < 20; ++trial) {
-    std::vector<double> lengths = {0.04, 0.03, 0.05, 0.04}, q;
+    std::vector<double> q;
     for (int i = 0; i < 12; ++i) q.push_back(trial == 0 ? 0.0 : k(rng) * (trial % 3 == 0 ? 1e-4 : 1.0));
     RodFrame root = verticalRoot();
-    // Composite Simpson on 20000 intervals of ∫ (y(s) − y(0)) ds.
     const int n = 20000;
     std::vector<double> s(n + 1);
     for (int i = 0; i <= n; ++i) s[i] = 0.16 * i / n;
     std::vector<glm::dvec3> p;
-    sampleRod(root, lengths, q, s, p, nullptr);
+    sampleRod(root, style.hairLengths, q, s, p, nullptr);
     double sum = 0.0;
     for (int i = 0; i <= n; ++i) sum += (i == 0 || i == n ? 1 : (i % 2 ? 4 : 2)) * (p[i].y - root.position.y);
-    double quadrature = sum * (0.16 / n) / 3.0;
-    double closed = heightIntegral(root, lengths, q);
-    EXPECT_NEAR(closed, quadrature, 1e-9 * std::max(std::abs(quadrature), 1e-6)) << "trial " << trial;
+    double quadrature = weight * sum * (0.16 / n) / 3.0;
+    double closed = StrandEnergy(style, Collision{}, root, 0.0).terms(q).gravity;
+    EXPECT_NEAR(closed, quadrature, 1e-9 * std::max(std::abs(quadrature), 1e-6 * weight))
+        << "trial " << trial;
   }
 }
 
@@ -164,7 +169,7 @@ TEST(StrandEnergy, CollisionTermEqualsDirectSamplingOfEveryShape) {
     double direct = 0.0;
     for (const glm::dvec3& x : p)
       for (const CollisionShape& shape : collision.shapes) {
-        double d = penetration(shape, x) + shape.volume * envelope;
+        double d = penetration(shape, x) + shape.envelopeGrowth * envelope;
         if (d > 0.0) direct += 0.5 * shape.penalty * d * d;
       }
     direct *= style.collisionStep;

@@ -7,7 +7,7 @@
 #include <random>
 #include <string>
 
-#include "libcore/config/config.h"
+#include "libcore/config/reader.h"
 #include "libcore/config/setup.h"
 #include "libcore/io/obj_io.h"
 #include "libcore/model/strands.h"

@@ -55,7 +55,7 @@ struct Hairstyle {
   double helixStep = 0.0;           // metres, Δ_h, the rise per turn of the rest helix
   double poisson = 0.48;            // σ, dimensionless (Table 1)
   double young = 2.0e9;             // E, pascals (Table 1, Caucasian)
-  double density = 1300.0;          // ρ, kilograms per cubic metre (Table 3)
+  double massDensity = 1300.0;      // ρ, kilograms per cubic metre (Table 3), key Density
   double gravity = 9.81;            // g, newtons per kilogram (Table 3)
   StylingModel model = StylingModel::kSuperHelix;
   double clump = 0.25;     // tip weights v1, v2 drawn in [0, Clump): 0 gathers tips at the nearest guide
@@ -78,7 +78,7 @@ const char* name(ShapeKind kind);
 // One collision body of Collision Info.
 struct CollisionShape {
   ShapeKind kind = ShapeKind::kSphere;
-  double volume = 0.0;          // metres: envelope growth from the lowest to the highest follicle
+  double envelopeGrowth = 0.0;  // metres: envelope growth from the lowest to the highest follicle
   double penalty = 0.0;         // k of the penalty ½k·max(dent + extra, 0)²
   glm::dvec3 centre{0.0};       // metres
   glm::dvec3 halfExtents{0.0};  // metres: radius, semi-axes or half-extents along `axes`
@@ -159,7 +159,6 @@ struct Config {
   Collision collision;
   Visuality visuality;
   RenderSettings render;
-  std::vector<Override> overrides;  // as applied, for --stats
 
   // Canonical text of every value that shapes the output (not the paths), one `Section.Key value` a
   // line; and its 64-bit FNV-1a digest in hex. Two configs with equal digests give equal output.

@@ -4,18 +4,11 @@
 #include <filesystem>
 #include <vector>
 
-#include "libcore/config/config.h"
+#include "libcore/config/keys.h"
 #include "libcore/config/params.h"
+#include "libcore/config/reader.h"
 
 namespace hairgen {
-
-// Each reader parses one file's text (after applying the overrides of its section) and rejects any
-// unknown, duplicate, malformed, non-finite or out-of-range value with its file:line.
-Setup readSetup(const ConfigText& text, const std::vector<Override>& overrides);
-Hairstyle readHairstyle(const ConfigText& text, const std::vector<Override>& overrides);
-Collision readCollision(const ConfigText& text, const std::vector<Override>& overrides);
-Visuality readVisuality(const ConfigText& text, const std::vector<Override>& overrides);
-RenderSettings readRender(const ConfigText& text, const std::vector<Override>& overrides);
 
 // What the command about to run needs from the Setup.
 enum class SetupUse {

@@ -57,10 +57,10 @@ StrandEnergy::StrandEnergy(const Hairstyle& style, const Collision& collision, c
   bend1_ = 0.5 * style.young * i1;
   bend2_ = 0.5 * style.young * i2;
   twist_ = 0.5 * mu * j;
-  weight_ = style.density * M_PI * a * b * style.gravity;
+  weight_ = style.massDensity * M_PI * a * b * style.gravity;
   for (const CollisionShape& s : collision.shapes) {
     if (!(s.penalty > 0.0)) continue;
-    double extra = s.volume * envelope;
+    double extra = s.envelopeGrowth * envelope;
     double reach = boundingRadius(s) + std::max(extra, 0.0);
     Shape shape{s, extra, reach * reach, {}, HUGE_VAL};
     if (s.kind == ShapeKind::kEllipsoid) {

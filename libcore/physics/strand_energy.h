@@ -2,7 +2,7 @@
 //   E = E_elastic + E_gravity + E_collision
 // E_elastic = Σ_Q ℓ_Q [E I1/2 (κ1 − κ1⁰)² + E I2/2 (κ2 − κ2⁰)² + μ J/2 (τ − τ⁰)²], I1 = π a b³/4,
 //             I2 = π b a³/4, J = π a b (a² + b²)/4, μ = E/(2(1 + σ));
-// E_gravity = ρ S g ∫ (z(s) − z(0)) ds in closed form, S = π a b;
+// E_gravity = ρ S g ∫ (y(s) − y(0)) ds in closed form (y is up), S = π a b;
 // E_collision = Δs Σ_samples Σ_shapes ½ k max(dent + extra, 0)², samples every CollisionStep after the
 //               root, extra = volume · (y_follicle − y_min)/(y_max − y_min) (layered envelopes).
 // Joules throughout.

@@ -117,16 +117,6 @@ void sampleRod(const RodFrame& root, std::span<const double> lengths, std::span<
   });
 }
 
-double heightIntegral(const RodFrame& root, std::span<const double> lengths, std::span<const double> q) {
-  // ∫0^L (r(s) − r0) ds = Σ_Q [ℓ_Q (r_Q(0) − r0) + ∫0^ℓ (r_Q(u) − r_Q(0)) du].
-  double total = 0.0;
-  forEachElement(root, lengths, q, [&](const HelixElement& element, double, size_t) {
-    total +=
-        element.length() * (element.start().position.y - root.position.y) + element.displacementIntegral().y;
-  });
-  return total;
-}
-
 std::vector<double> sampleArcLengths(double total, double step, bool includeRoot) {
   std::vector<double> s;
   if (includeRoot) s.push_back(0.0);

@@ -92,9 +92,6 @@ void sampleRod(const RodFrame& root, std::span<const double> lengths, std::span<
                std::span<const double> s, std::vector<glm::dvec3>& positions,
                std::vector<glm::dvec3>* tangents);
 
-// ∫ (r(s) − r(0))·ŷ ds over the whole rod in closed form (thesis §4.1.1.3.2), metres².
-double heightIntegral(const RodFrame& root, std::span<const double> lengths, std::span<const double> q);
-
 // Output arc lengths: every `step` from 0, the last exactly at `total`.
 std::vector<double> sampleArcLengths(double total, double step, bool includeRoot);
 

@@ -1,4 +1,4 @@
-#include "libcore/config/config.h"
+#include "libcore/config/reader.h"
 
 #include <cmath>
 
@@ -8,84 +8,6 @@
 namespace hairgen {
 namespace {
 
-KeySpec key(std::string name, std::string hint, std::vector<std::string> aliases = {},
-            bool repeatable = false) {
-  return KeySpec{std::move(name), std::move(aliases), std::move(hint), repeatable};
-}
-
-std::vector<SectionSpec> makeSections() {
-  return {
-      {"Setup",
-       "Setup",
-       {key("Load", "true or false: read the coupe from LoadFile instead of growing it"),
-        key("Save", "true or false: write the coupe to SaveFile"),
-        key("LoadFile", "path of a .hair/.gltf/.glb coupe", {"LoadPath"}),
-        key("SaveFile", "path of a .hair/.gltf/.glb coupe", {"SavePath"}),
-        key("HairstyleInfo", "path of the Hairstyle Info file"),
-        key("CollisionInfo", "path of the Collision Info file"),
-        key("VisualityInfo", "path of the Visuality Info file"),
-        key("RenderInfo", "path of the Render Info file"),
-        key("WickModel", "path of the wick OBJ (every vertex a follicle)", {"HairModel"}),
-        key("HeadModel", "path of the head OBJ"),
-        key("HairVert", "path of a GLSL vertex shader for the hair"),
-        key("HairFrag", "path of a GLSL fragment shader for the hair"),
-        key("HeadVert", "path of a GLSL vertex shader for the head"),
-        key("HeadFrag", "path of a GLSL fragment shader for the head")}},
-      {"Hairstyle",
-       "Hairstyle Info",
-       {key("VisualityStep", "metres between output vertices, e.g. 0.0025"),
-        key("CollisionStep", "metres between collision samples, e.g. 0.005"),
-        key("MaxIter", "Rosenbrock stages at most, an integer >= 1, e.g. 20"),
-        key("Epsilon", "relative energy change that ends minimisation, e.g. 0.0001"),
-        key("HairLengths", "metres, one per Super-Helix element, e.g. 0.04 0.04 0.04 0.04", {"HairLength"}),
-        key("HairDensity", "strands per square centimetre, e.g. 80"),
-        key("HairRadius1", "metres, semi-axis a of the cross-section, e.g. 0.000035"),
-        key("HairRadius2", "metres, semi-axis b of the cross-section, e.g. 0.000050"),
-        key("HelixRadius", "metres, radius of the rest helix (0 = straight), e.g. 0.025"),
-        key("HelixStep", "metres, rise per turn of the rest helix, e.g. 0.025"),
-        key("Poisson", "Poisson's ratio in (-1, 0.5], e.g. 0.48"),
-        key("Young", "Young's modulus in pascals, e.g. 2e9"),
-        key("Density", "kilograms per cubic metre, e.g. 1300"),
-        key("Gravity", "newtons per kilogram, e.g. 9.81"),
-        key("Model", "superhelix or cantilever"),
-        key("Clump", "0 to 1, e.g. 0.25"),
-        key("StrayHairs", "true or false"),
-        key("Seed", "a non-negative integer"),
-        key("Segments", "cantilever: equal segments per hair, e.g. 20"),
-        key("FlexuralRigidity", "cantilever: E*I in N m^2 (0 = from Young and the radii)"),
-        key("JointAngleLimit", "cantilever: degrees [first node], e.g. 15 5"),
-        key("Force", "ax ay az all | above Y | below Y | side +x|-x|+z|-z | box x0 y0 z0 x1 y1 z1", {}, true),
-        key("Cut", "azimuthFrom azimuthTo zenithMax height (degrees, degrees, degrees, metres)", {}, true)}},
-      {"Collision",
-       "Collision Info",
-       {key("Sphere", "volume penalty cx cy cz r", {}, true),
-        key("Ellipsoid", "volume penalty cx cy cz a b c ux uy uz vx vy vz wx wy wz", {"Elipsoid"}, true),
-        key("Cuboid", "volume penalty cx cy cz a b c ux uy uz vx vy vz wx wy wz", {}, true)}},
-      {"Visuality",
-       "Visuality Info",
-       {key("AmbientColor", "r g b, e.g. 0.10 0.10 0.10"), key("DiffuseColor", "r g b, e.g. 0.45 0.25 0.00"),
-        key("SpecularColor", "r g b, e.g. 0.20 0.20 0.20"), key("Glossiness", "specular exponent, e.g. 60"),
-        key("AmbientMean", "hairgen shade: mean of the per-strand coefficient, e.g. 1"),
-        key("AmbientDeviation", "hairgen shade: its standard deviation, e.g. 0.15")}},
-      {"Render",
-       "Render Info",
-       {key("Resolution", "width height in pixels, e.g. 640 640"), key("CameraPosition", "x y z in metres"),
-        key("CameraTarget", "x y z in metres"), key("CameraUp", "x y z"),
-        key("FieldOfView", "vertical, degrees in (0, 180), e.g. 38"), key("LightPosition", "x y z in metres"),
-        key("LightColor", "r g b"), key("AmbientIntensity", ">= 0, e.g. 0.2"),
-        key("Samples", "antialiasing samples per pixel, 1 to 64"),
-        key("LayerSizes", "four depths in metres, e.g. 0.002 0.006 0.015 0.04"),
-        key("StrandOpacity", "0 to 1, e.g. 0.7"), key("StrandWidth", "metres, e.g. 0.00008"),
-        key("ShadingModel", "kajiya-kay, thesis, anjyo or volumetric"), key("Background", "r g b"),
-        key("HeadColor", "r g b, the head's albedo"),
-        key("VoxelSize", "hairgen shade: metres between density grid nodes, e.g. 0.004"),
-        key("VolumePadding", "hairgen shade: empty voxels around the hair, e.g. 3"),
-        key("ShellDensity",
-            "hairgen shade: the shell's density as a fraction of a typical hair point's, e.g. 0.25"),
-        key("VolumetricBlend", "0 (Kajiya-Kay) to 1 (volumetric), e.g. 1")}},
-  };
-}
-
 std::vector<std::string> spellings(const SectionSpec& section) {
   std::vector<std::string> names;
   for (const KeySpec& k : section.keys) names.push_back(k.name);
@@ -94,20 +16,15 @@ std::vector<std::string> spellings(const SectionSpec& section) {
 
 // The canonical name of `written` in `section`, or "" if the section has no such key.
 std::string canonicalKey(const SectionSpec& section, std::string_view written) {
-  std::string lower = toLower(written);
-  for (const KeySpec& k : section.keys) {
-    if (toLower(k.name) == lower) return k.name;
-    for (const std::string& alias : k.aliases)
-      if (toLower(alias) == lower) return k.name;
-  }
-  return {};
+  const KeySpec* key = section.find(written);
+  return key ? key->name : std::string();
 }
 
 // "did you mean ...", or "it belongs in ..." when another section knows the key.
 std::string unknownKeyHint(const SectionSpec& section, std::string_view written) {
-  for (const SectionSpec& other : allSections())
-    if (&other != &section && !canonicalKey(other, written).empty())
-      return "; '" + canonicalKey(other, written) + "' belongs in " + other.title;
+  for (const SectionSpec* other : allSections())
+    if (other->name != section.name && !canonicalKey(*other, written).empty())
+      return "; '" + canonicalKey(*other, written) + "' belongs in " + other->title;
   std::string close = closestMatch(written, spellings(section));
   if (!close.empty()) return "; did you mean '" + close + "'?";
   return "; " + section.title + " knows: " + [&] {
@@ -119,14 +36,27 @@ std::string unknownKeyHint(const SectionSpec& section, std::string_view written)
 
 }  // namespace
 
-const std::vector<SectionSpec>& allSections() {
-  static const std::vector<SectionSpec> sections = makeSections();
-  return sections;
+std::string KeySpec::hint() const {
+  std::string text = value;
+  if (!range.empty()) text += " " + range;
+  if (!unit.empty()) text += " (" + unit + ")";
+  if (!defaultText.empty()) text += ", e.g. " + defaultText;
+  return text;
+}
+
+const KeySpec* SectionSpec::find(std::string_view written) const {
+  std::string lower = toLower(written);
+  for (const KeySpec& k : keys) {
+    if (toLower(k.name) == lower) return &k;
+    for (const std::string& alias : k.aliases)
+      if (toLower(alias) == lower) return &k;
+  }
+  return nullptr;
 }
 
 const SectionSpec& sectionSpec(std::string_view name) {
-  for (const SectionSpec& s : allSections())
-    if (toLower(s.name) == toLower(name)) return s;
+  for (const SectionSpec* s : allSections())
+    if (toLower(s->name) == toLower(name)) return *s;
   throw InputError("unknown config section '" + std::string(name) + "'");
 }
 
@@ -187,7 +117,7 @@ ConfigText readConfigText(const std::filesystem::path& file) {
   return parseConfigText(readFileText(file), file.string(), file.parent_path());
 }
 
-Override parseOverride(std::string_view argument) {
+Override parseOverride(std::string_view argument, const SectionList& sections) {
   FileLoc where{"--set " + std::string(argument), 0};
   size_t dot = argument.find('.');
   size_t eq = argument.find('=');
@@ -195,20 +125,23 @@ Override parseOverride(std::string_view argument) {
     throw InputError(where, "expected Section.Key=VALUE, e.g. --set Hairstyle.HairDensity=160");
   std::string sectionName(argument.substr(0, dot));
   const SectionSpec* section = nullptr;
-  for (const SectionSpec& s : allSections())
-    if (toLower(s.name) == toLower(sectionName) || toLower(s.name) + "info" == toLower(sectionName))
-      section = &s;
+  for (const SectionSpec* s : sections)
+    if (toLower(s->name) == toLower(sectionName) || toLower(s->name) + "info" == toLower(sectionName))
+      section = s;
   if (!section) {
     std::vector<std::string> names;
-    for (const SectionSpec& s : allSections()) names.push_back(s.name);
+    std::string all;
+    for (const SectionSpec* s : sections) {
+      names.push_back(s->name);
+      all += (all.empty() ? "" : ", ") + s->name;
+    }
     std::string close = closestMatch(sectionName, names);
     throw InputError(where,
                      "unknown section '" + sectionName + "'" +
-                         (close.empty() ? "; sections are Setup, Hairstyle, Collision, Visuality, Render"
-                                        : "; did you mean '" + close + "'?"));
+                         (close.empty() ? "; sections are " + all : "; did you mean '" + close + "'?"));
   }
   std::string keyName(argument.substr(dot + 1, eq - dot - 1));
-  if (canonicalKey(*section, keyName).empty())
+  if (!section->find(keyName))
     throw InputError(
         where, "unknown key '" + keyName + "' in " + section->title + unknownKeyHint(*section, keyName));
   ConfigText parsed = parseConfigText(argument.substr(eq + 1), where.file, std::filesystem::current_path());
@@ -229,6 +162,7 @@ bool Range::contains(double v) const {
 
 std::string Range::describe() const {
   bool hasMin = min > -1e299, hasMax = max < 1e299;
+  if (!hasMin && !hasMax) return "";
   if (hasMin && !hasMax) return std::string(openMin ? "> " : ">= ") + formatReal(min);
   if (!hasMin && hasMax) return std::string(openMax ? "< " : "<= ") + formatReal(max);
   return std::string(openMin ? "(" : "[") + formatReal(min) + ", " + formatReal(max) + (openMax ? ")" : "]");
@@ -283,7 +217,7 @@ FileLoc SectionReader::where(std::string_view key) const {
   return {text_.name, 0};
 }
 
-const ConfigLine* SectionReader::single(std::string_view key) {
+const ConfigLine* SectionReader::line(std::string_view key) {
   spec(key);
   const ConfigLine* found = nullptr;
   for (size_t i = 0; i < text_.lines.size(); ++i) {
@@ -295,7 +229,7 @@ const ConfigLine* SectionReader::single(std::string_view key) {
     used_[i] = true;
   }
   if (found && found->values.empty())
-    throw InputError(found->where, "'" + std::string(key) + "' has no value; expected " + spec(key).hint);
+    throw InputError(found->where, "'" + std::string(key) + "' has no value; expected " + spec(key).hint());
   return found;
 }
 
@@ -304,7 +238,7 @@ void SectionReader::expectCount(const ConfigLine& line, size_t count) const {
     throw InputError(line.where, "'" + line.key + "' takes " + std::to_string(count) + " value" +
                                      (count == 1 ? "" : "s") + ", found " +
                                      std::to_string(line.values.size()) + "; expected " +
-                                     spec(canonicalKey(section_, line.key)).hint);
+                                     spec(canonicalKey(section_, line.key)).hint());
 }
 
 double SectionReader::checkReal(const ConfigLine& line, size_t index, Range range,
@@ -320,11 +254,11 @@ double SectionReader::checkReal(const ConfigLine& line, size_t index, Range rang
 }
 
 double SectionReader::real(std::string_view key, std::optional<double> fallback, Range range) {
-  const ConfigLine* line = single(key);
+  const ConfigLine* line = this->line(key);
   if (!line) {
     if (!fallback)
       throw InputError({text_.name, 0},
-                       "missing required key '" + std::string(key) + "' (" + spec(key).hint + ")");
+                       "missing required key '" + std::string(key) + "' (" + spec(key).hint() + ")");
     return *fallback;
   }
   expectCount(*line, 1);
@@ -333,11 +267,11 @@ double SectionReader::real(std::string_view key, std::optional<double> fallback,
 
 int64_t SectionReader::integer(std::string_view key, std::optional<int64_t> fallback, int64_t min,
                                int64_t max) {
-  const ConfigLine* line = single(key);
+  const ConfigLine* line = this->line(key);
   if (!line) {
     if (!fallback)
       throw InputError({text_.name, 0},
-                       "missing required key '" + std::string(key) + "' (" + spec(key).hint + ")");
+                       "missing required key '" + std::string(key) + "' (" + spec(key).hint() + ")");
     return *fallback;
   }
   expectCount(*line, 1);
@@ -352,7 +286,7 @@ int64_t SectionReader::integer(std::string_view key, std::optional<int64_t> fall
 }
 
 uint64_t SectionReader::unsignedInteger(std::string_view key, uint64_t fallback) {
-  const ConfigLine* line = single(key);
+  const ConfigLine* line = this->line(key);
   if (!line) return fallback;
   expectCount(*line, 1);
   std::optional<uint64_t> value = parseUInt(line->values[0]);
@@ -364,11 +298,11 @@ uint64_t SectionReader::unsignedInteger(std::string_view key, uint64_t fallback)
 
 std::vector<double> SectionReader::reals(std::string_view key, size_t count,
                                          std::optional<std::vector<double>> fallback, Range range) {
-  const ConfigLine* line = single(key);
+  const ConfigLine* line = this->line(key);
   if (!line) {
     if (!fallback)
       throw InputError({text_.name, 0},
-                       "missing required key '" + std::string(key) + "' (" + spec(key).hint + ")");
+                       "missing required key '" + std::string(key) + "' (" + spec(key).hint() + ")");
     return *fallback;
   }
   expectCount(*line, count);
@@ -379,10 +313,10 @@ std::vector<double> SectionReader::reals(std::string_view key, size_t count,
 }
 
 std::vector<double> SectionReader::realList(std::string_view key, Range range) {
-  const ConfigLine* line = single(key);
+  const ConfigLine* line = this->line(key);
   if (!line)
     throw InputError({text_.name, 0},
-                     "missing required key '" + std::string(key) + "' (" + spec(key).hint + ")");
+                     "missing required key '" + std::string(key) + "' (" + spec(key).hint() + ")");
   std::vector<double> values;
   for (size_t i = 0; i < line->values.size(); ++i)
     values.push_back(checkReal(*line, i, range, "value " + std::to_string(i + 1)));
@@ -395,7 +329,7 @@ glm::dvec3 SectionReader::vec3(std::string_view key, glm::dvec3 fallback, Range 
 }
 
 bool SectionReader::boolean(std::string_view key, bool fallback) {
-  const ConfigLine* line = single(key);
+  const ConfigLine* line = this->line(key);
   if (!line) return fallback;
   expectCount(*line, 1);
   std::string v = toLower(line->values[0]);
@@ -407,7 +341,7 @@ bool SectionReader::boolean(std::string_view key, bool fallback) {
 
 std::string SectionReader::word(std::string_view key, const std::string& fallback,
                                 const std::vector<std::string>& choices) {
-  const ConfigLine* line = single(key);
+  const ConfigLine* line = this->line(key);
   if (!line) return fallback;
   expectCount(*line, 1);
   for (const std::string& choice : choices)
@@ -418,7 +352,7 @@ std::string SectionReader::word(std::string_view key, const std::string& fallbac
 }
 
 PathRef SectionReader::path(std::string_view key) {
-  const ConfigLine* line = single(key);
+  const ConfigLine* line = this->line(key);
   if (!line) return {};
   expectCount(*line, 1);
   std::filesystem::path p(line->values[0]);

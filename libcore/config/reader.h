@@ -36,28 +36,46 @@ ConfigText parseConfigText(std::string_view text, const std::string& name,
                            const std::filesystem::path& baseDir);
 ConfigText readConfigText(const std::filesystem::path& file);
 
-// One key a section knows: its canonical spelling, other accepted spellings, and a one-line hint of
-// what its value looks like (used in error messages).
+// What the reader, --set and the key reference know of one key (schema.h declares the keys).
 struct KeySpec {
-  std::string name;
-  std::vector<std::string> aliases;
-  std::string hint;
-  bool repeatable = false;
+  std::string name;                  // canonical spelling
+  std::vector<std::string> aliases;  // other accepted spellings (the thesis' own)
+  std::string value;                 // what the value looks like: "real", "x y z", "superhelix | cantilever"
+  std::string unit;                  // SI unit; "" when dimensionless
+  std::string range;                 // "(0, 1]", ">= 0"; "" when any value goes
+  std::string defaultText;           // the default as the canonical text writes it; "" when none
+  std::string help;                  // one line
+  bool repeatable = false;           // any number of lines, kept in file order
+  bool required = false;
+  bool inDigest = true;  // the value shapes the output (paths and flags of the job do not)
+
+  // For messages: the value's shape, range and unit, then an example.
+  std::string hint() const;
 };
 
 struct SectionSpec {
   std::string name;   // "Hairstyle", as used by --set
   std::string title;  // "Hairstyle Info", as used in messages
+  std::string file;   // the Setup key that names the section's file ("" for the Setup itself)
   std::vector<KeySpec> keys;
+
+  // The key `written` names (its canonical spelling or an alias, case-insensitively), or null.
+  const KeySpec* find(std::string_view written) const;
 };
 
-// All sections hairgen knows (Setup, Hairstyle, Collision, Visuality, Render).
-const std::vector<SectionSpec>& allSections();
+using SectionList = std::vector<const SectionSpec*>;
+
+// Every section hairgen reads, in the order of the canonical text (defined beside the declarations).
+const SectionList& allSections();
 const SectionSpec& sectionSpec(std::string_view name);
 
-// Parses "Section.Key=VALUE" (VALUE split on whitespace). Throws InputError naming the argument, with
-// a hint for an unknown section or key.
-Override parseOverride(std::string_view argument);
+// Parses "Section.Key=VALUE" (VALUE split on whitespace) against `sections`. Throws InputError naming
+// the argument, with a hint for an unknown section or key.
+Override parseOverride(std::string_view argument, const SectionList& sections = allSections());
+
+// The reference of every key of `sections` as Markdown: what `hairgen check --keys` prints and
+// docs/config-keys.md holds.
+std::string keyReference(const SectionList& sections = allSections());
 
 // The inclusive range a number must lie in; `open*` excludes that end.
 struct Range {
@@ -94,6 +112,8 @@ class SectionReader {
 
   glm::dvec3 vec3(std::string_view key, glm::dvec3 fallback, Range range = {});
 
+  // The one line of a key (null when absent), marked as read; a duplicate or an empty value is an error.
+  const ConfigLine* line(std::string_view key);
   // Every line of a repeatable key, in file order; each value checked by the caller with checkReal().
   std::vector<const ConfigLine*> lines(std::string_view key);
   double checkReal(const ConfigLine& line, size_t index, Range range, std::string_view what) const;
@@ -106,7 +126,6 @@ class SectionReader {
 
  private:
   const KeySpec& spec(std::string_view key) const;
-  const ConfigLine* single(std::string_view key);  // marks used; rejects duplicates
   void expectCount(const ConfigLine& line, size_t count) const;
 
   ConfigText text_;

@@ -1,0 +1,449 @@
+// Every config key hairgen reads, declared once (DESIGN §4): the sections Setup, Hairstyle Info,
+// Collision Info, Visuality Info and Render Info. The reader, the canonical text behind the config
+// digest, --set and `hairgen check --keys` all come from these tables; a new key is one line here and
+// the code that uses its value.
+#include "libcore/config/keys.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "libcore/util/text.h"
+
+namespace hairgen {
+namespace {
+
+std::string join(std::initializer_list<double> values) {
+  std::string out;
+  for (double v : values) out += (out.empty() ? "" : " ") + formatReal(v);
+  return out;
+}
+std::string join(const glm::dvec3& v) { return join({v.x, v.y, v.z}); }
+
+// Builds the frame of an Ellipsoid or Cuboid from the three axis vectors of its config line:
+// normalised and made orthogonal (Gram-Schmidt in the given order), right-handed.
+glm::dmat3 orthonormalAxes(const SectionReader& reader, const ConfigLine& line, glm::dvec3 u, glm::dvec3 v,
+                           glm::dvec3 w) {
+  double scale = std::max(glm::length(u), std::max(glm::length(v), glm::length(w)));
+  if (glm::length(u) < 1e-9 || glm::length(v) < 1e-9 || glm::length(w) < 1e-9)
+    throw reader.error(
+        line,
+        "'" + line.key + "': an axis vector is zero; give three independent axes, e.g. 1 0 0 0 1 0 0 0 1");
+  u = glm::normalize(u);
+  v -= glm::dot(v, u) * u;
+  if (glm::length(v) < 1e-6 * scale)
+    throw reader.error(line, "'" + line.key + "': the second axis is parallel to the first");
+  v = glm::normalize(v);
+  glm::dvec3 n = glm::cross(u, v);
+  if (std::abs(glm::dot(glm::normalize(w), n)) < 1e-6)
+    throw reader.error(line, "'" + line.key + "': the third axis lies in the plane of the first two");
+  return glm::dmat3(u, v, glm::dot(w, n) < 0.0 ? -n : n);
+}
+
+// The values after the kind: volume penalty centre, then the radius or the half-extents and axes.
+std::string shapeText(const CollisionShape& c) {
+  std::string out = join({c.envelopeGrowth, c.penalty}) + " " + join(c.centre) + " " + join(c.halfExtents);
+  if (c.kind != ShapeKind::kSphere) out += " " + join(c.axes[0]) + " " + join(c.axes[1]) + " " + join(c.axes[2]);
+  return out;
+}
+
+CollisionShape readShape(const SectionReader& reader, const ConfigLine& line, ShapeKind kind) {
+  size_t count = kind == ShapeKind::kSphere ? 6 : 17;
+  if (line.values.size() != count)
+    throw reader.error(
+        line, "'" + line.key + "' takes " + std::to_string(count) + " values, found " +
+                  std::to_string(line.values.size()) + "; expected " +
+                  (kind == ShapeKind::kSphere ? "volume penalty cx cy cz r"
+                                              : "volume penalty cx cy cz a b c ux uy uz vx vy vz wx wy wz"));
+  CollisionShape shape;
+  shape.kind = kind;
+  shape.where = line.where;
+  shape.envelopeGrowth = reader.checkReal(line, 0, {}, "volume");
+  shape.penalty = reader.checkReal(line, 1, Range::nonNegative(), "penalty");
+  for (int i = 0; i < 3; ++i) shape.centre[i] = reader.checkReal(line, 2 + i, {}, "centre");
+  if (kind == ShapeKind::kSphere) {
+    shape.halfExtents = glm::dvec3(reader.checkReal(line, 5, Range::positive(), "radius"));
+    return shape;
+  }
+  for (int i = 0; i < 3; ++i)
+    shape.halfExtents[i] = reader.checkReal(line, 5 + i, Range::positive(), "dimension");
+  glm::dvec3 axis[3];
+  for (int a = 0; a < 3; ++a)
+    for (int i = 0; i < 3; ++i) axis[a][i] = reader.checkReal(line, 8 + 3 * a + i, {}, "axis");
+  shape.axes = orthonormalAxes(reader, line, axis[0], axis[1], axis[2]);
+  return shape;
+}
+
+ForceField readForce(const SectionReader& r, const ConfigLine& line) {
+  auto bad = [&](const std::string& why) {
+    return r.error(
+        line, "Force " + why +
+                  "; expected ax ay az all | above Y | below Y | side +x|-x|+z|-z | box x0 y0 z0 x1 y1 z1");
+  };
+  if (line.values.size() < 4) throw bad("needs an acceleration and a region");
+  ForceField f;
+  f.where = line.where;
+  for (int i = 0; i < 3; ++i)
+    f.acceleration[i] = r.checkReal(line, i, Range::closed(-1e4, 1e4), "acceleration");
+  const std::string region = toLower(line.values[3]);
+  const size_t extra = line.values.size() - 4;
+  if (region == "all" && extra == 0) {
+    f.region = ForceField::Region::kAll;
+  } else if ((region == "above" || region == "below") && extra == 1) {
+    f.region = region == "above" ? ForceField::Region::kAbove : ForceField::Region::kBelow;
+    f.level = r.checkReal(line, 4, {}, "height");
+  } else if (region == "side" && extra == 1) {
+    const std::string& s = line.values[4];
+    f.region = ForceField::Region::kSide;
+    if (s == "+x")
+      f.side = {1, 0, 0};
+    else if (s == "-x")
+      f.side = {-1, 0, 0};
+    else if (s == "+z")
+      f.side = {0, 0, 1};
+    else if (s == "-z")
+      f.side = {0, 0, -1};
+    else
+      throw bad("side '" + s + "' is not +x, -x, +z or -z");
+  } else if (region == "box" && extra == 6) {
+    f.region = ForceField::Region::kBox;
+    for (int i = 0; i < 3; ++i) f.lo[i] = r.checkReal(line, 4 + i, {}, "box corner");
+    for (int i = 0; i < 3; ++i) f.hi[i] = r.checkReal(line, 7 + i, {}, "box corner");
+  } else {
+    throw bad("region '" + line.values[3] + "' with " + std::to_string(extra) + " values is not understood");
+  }
+  return f;
+}
+
+// ---------------------------------------------------------------------------------------------- Setup
+
+Section<Setup> makeSetup() {
+  auto notInDigest = [](Key<Setup> key) {
+    key.spec.inDigest = false;
+    return key;
+  };
+  return makeSection<Setup>(
+      "Setup", "Setup", "",
+      {notInDigest(boolKey<Setup>({"Load", "", "read the coupe from LoadFile instead of growing it"}, &Setup::load)),
+       notInDigest(boolKey<Setup>({"Save", "", "write the coupe to SaveFile"}, &Setup::save)),
+       pathKey<Setup>({"LoadFile", "", "the coupe to load (.hair, .gltf, .glb)", {"LoadPath"}}, &Setup::loadFile),
+       pathKey<Setup>({"SaveFile", "", "where to save the coupe (.hair, .gltf, .glb)", {"SavePath"}},
+                      &Setup::saveFile),
+       pathKey<Setup>({"HairstyleInfo", "", "the Hairstyle Info file"}, &Setup::hairstyleInfo),
+       pathKey<Setup>({"CollisionInfo", "", "the Collision Info file"}, &Setup::collisionInfo),
+       pathKey<Setup>({"VisualityInfo", "", "the Visuality Info file"}, &Setup::visualityInfo),
+       pathKey<Setup>({"RenderInfo", "", "the Render Info file"}, &Setup::renderInfo),
+       pathKey<Setup>({"WickModel", "", "the wick OBJ: every vertex a follicle", {"HairModel"}}, &Setup::wickModel),
+       pathKey<Setup>({"HeadModel", "", "the head OBJ: rendered, and shadows the hair"}, &Setup::headModel),
+       pathKey<Setup>({"HairVert", "", "GLSL vertex stage for the hair, in place of hairgen's (README, Shaders)"},
+                      &Setup::hairVert),
+       pathKey<Setup>({"HairFrag", "", "GLSL fragment stage shading the hair, in place of hairgen's"},
+                      &Setup::hairFrag),
+       pathKey<Setup>({"HeadVert", "", "GLSL vertex stage for the head, in place of hairgen's"}, &Setup::headVert),
+       pathKey<Setup>({"HeadFrag", "", "GLSL fragment stage shading the head, in place of hairgen's"},
+                      &Setup::headFrag)},
+      [](SectionReader& r, Setup& s) {
+        if (s.load && !s.loadFile.given())
+          throw InputError(r.where("Load"),
+                           "Load is true but no LoadFile names the coupe to load; add `LoadFile PATH`");
+        if (s.save && !s.saveFile.given())
+          throw InputError(r.where("Save"),
+                           "Save is true but no SaveFile names where to save; add `SaveFile PATH`");
+        s.file = r.fileName();
+      });
+}
+
+// ------------------------------------------------------------------------------------------ Hairstyle
+
+Key<Hairstyle> hairLengthsKey() {
+  return required(customKey<Hairstyle>(
+      {"HairLengths", "m", "one length per Super-Helix element (at most 256), e.g. 0.04 0.04 0.04 0.04",
+       {"HairLength"}},
+      "real ...", "(0, 10]",
+      [](SectionReader& r, Hairstyle& h) {
+        h.hairLengths = r.realList("HairLengths", {0.0, 10.0, true, false});
+        if (h.hairLengths.size() > 256)
+          throw InputError(r.where("HairLengths"), "at most 256 Super-Helix elements are supported, found " +
+                                                       std::to_string(h.hairLengths.size()));
+      },
+      [](const Hairstyle& h) {
+        std::string out;
+        for (double l : h.hairLengths) out += (out.empty() ? "" : " ") + formatReal(l);
+        return std::vector<std::string>{out};
+      }));
+}
+
+Key<Hairstyle> jointLimitKey() {
+  return customKey<Hairstyle>(
+      {"JointAngleLimit", "degrees",
+       "cantilever: the largest turn between consecutive segments, from node n on (180 = none)"},
+      "degrees [n]", "[0, 180], n >= 1",
+      [](SectionReader& r, Hairstyle& h) {
+        if (!r.has("JointAngleLimit")) return;
+        const ConfigLine& line = *r.line("JointAngleLimit");
+        if (line.values.size() > 2)
+          throw r.error(line, "JointAngleLimit takes degrees and, optionally, the first node it applies to");
+        h.jointLimit = r.checkReal(line, 0, Range::closed(0.0, 180.0), "degrees");
+        if (line.values.size() == 2) {
+          double from = r.checkReal(line, 1, Range::closed(1.0, 100000.0), "first node");
+          if (from != std::floor(from)) throw r.error(line, "the first node must be a whole number");
+          h.jointLimitFrom = static_cast<int>(from);
+        }
+      },
+      [](const Hairstyle& h) {
+        return std::vector<std::string>{formatReal(h.jointLimit) + " " + std::to_string(h.jointLimitFrom)};
+      });
+}
+
+Key<Hairstyle> forceKey() {
+  return repeatable(customKey<Hairstyle>(
+      {"Force", "m/s²", "cantilever: an acceleration added to gravity on the segments starting in a region"},
+      "ax ay az all | above Y | below Y | side +x|-x|+z|-z | box x0 y0 z0 x1 y1 z1", "",
+      [](SectionReader& r, Hairstyle& h) {
+        for (const ConfigLine* line : r.lines("Force")) h.forces.push_back(readForce(r, *line));
+      },
+      [](const Hairstyle& h) {
+        std::vector<std::string> lines;
+        for (const ForceField& f : h.forces)
+          lines.push_back(join(f.acceleration) + " " + std::to_string(int(f.region)) + " " + formatReal(f.level) +
+                          " " + join(f.side) + " " + join(f.lo) + " " + join(f.hi));
+        return lines;
+      }));
+}
+
+Key<Hairstyle> cutKey() {
+  return repeatable(customKey<Hairstyle>(
+      {"Cut", "degrees, m",
+       "cantilever: pores with azimuth in [from, to] (from the face toward +x) and zenith <= max end at "
+       "their last node above the height"},
+      "azimuthFrom azimuthTo zenithMax height", "",
+      [](SectionReader& r, Hairstyle& h) {
+        for (const ConfigLine* line : r.lines("Cut")) {
+          if (line->values.size() != 4)
+            throw r.error(*line, "Cut takes azimuthFrom azimuthTo zenithMax height, found " +
+                                     std::to_string(line->values.size()) + " values");
+          HairCut c;
+          c.azimuthFrom = r.checkReal(*line, 0, Range::closed(-360.0, 360.0), "azimuth");
+          c.azimuthTo = r.checkReal(*line, 1, Range::closed(-360.0, 360.0), "azimuth");
+          c.zenithMax = r.checkReal(*line, 2, Range::closed(0.0, 180.0), "zenith");
+          c.height = r.checkReal(*line, 3, {}, "height");
+          c.where = line->where;
+          h.cuts.push_back(c);
+        }
+      },
+      [](const Hairstyle& h) {
+        std::vector<std::string> lines;
+        for (const HairCut& c : h.cuts) lines.push_back(join({c.azimuthFrom, c.azimuthTo, c.zenithMax, c.height}));
+        return lines;
+      }));
+}
+
+Section<Hairstyle> makeHairstyle() {
+  using H = Hairstyle;
+  const Range aboveZeroToOne{0.0, 1.0, true, false};
+  return makeSection<H>(
+      "Hairstyle", "Hairstyle Info", "HairstyleInfo",
+      {realKey<H>({"VisualityStep", "m", "arc length between output vertices"}, &H::visualityStep, aboveZeroToOne),
+       realKey<H>({"CollisionStep", "m", "arc length between collision samples"}, &H::collisionStep,
+                  aboveZeroToOne),
+       integerKey<H>({"MaxIter", "", "Rosenbrock stages at most"}, &H::maxIter, 1, 1000000),
+       realKey<H>({"Epsilon", "", "relative energy change between stages that ends minimisation"}, &H::epsilon,
+                  Range::positive()),
+       hairLengthsKey(),
+       realKey<H>({"HairDensity", "strands/cm²", "strands per square centimetre of wick"}, &H::hairDensity,
+                  Range::nonNegative()),
+       realKey<H>({"HairRadius1", "m", "semi-axis a of the elliptic cross-section"}, &H::hairRadius1,
+                  {0.0, 0.01, true, false}),
+       realKey<H>({"HairRadius2", "m", "semi-axis b of the elliptic cross-section"}, &H::hairRadius2,
+                  {0.0, 0.01, true, false}),
+       realKey<H>({"HelixRadius", "m", "radius of the rest helix; 0 = straight"}, &H::helixRadius,
+                  Range::closed(0.0, 1000.0)),
+       realKey<H>({"HelixStep", "m", "rise per turn of the rest helix"}, &H::helixStep,
+                  Range::closed(-1000.0, 1000.0)),
+       realKey<H>({"Poisson", "", "Poisson's ratio σ"}, &H::poisson, {-1.0, 0.5, true, false}),
+       realKey<H>({"Young", "Pa", "Young's modulus E"}, &H::young, Range::positive()),
+       realKey<H>({"Density", "kg/m³", "mass density ρ of the hair fibre"}, &H::massDensity, Range::nonNegative()),
+       realKey<H>({"Gravity", "N/kg", "gravitational acceleration g, pulling along -y"}, &H::gravity,
+                  Range::closed(0.0, 1000.0)),
+       choiceKey<H, StylingModel>({"Model", "", "the styling model: Super-Helix guides or Anjyo's cantilever"},
+                                  &H::model, {StylingModel::kSuperHelix, StylingModel::kCantilever}),
+       realKey<H>({"Clump", "", "tip weights drawn in [0, Clump): 0 gathers tips at the nearest guide"}, &H::clump,
+                  Range::closed(0.0, 1.0)),
+       boolKey<H>({"StrayHairs", "", "true = the thesis' barycentric assignment (§4.1.4.4)"}, &H::strayHairs),
+       unsignedKey<H>({"Seed", "", "keys every random number; --seed overrides it"}, &H::seed),
+       integerKey<H>({"Segments", "", "cantilever: equal segments per hair"}, &H::segments, 1, 100000),
+       realKey<H>({"FlexuralRigidity", "N·m²", "cantilever: E·I; 0 = Young × π a b³/4"}, &H::flexuralRigidity,
+                  Range::nonNegative()),
+       jointLimitKey(), forceKey(), cutKey()});
+}
+
+// ------------------------------------------------------------------------------------------ Collision
+
+Key<Collision> shapeKey(const char* name, ShapeKind kind, std::vector<std::string> aliases) {
+  return repeatable(customKey<Collision>(
+      {name, "m", kind == ShapeKind::kSphere
+                      ? "a sphere: envelope growth, penalty k >= 0, centre, radius > 0"
+                      : std::string(kind == ShapeKind::kEllipsoid ? "an ellipsoid" : "a box") +
+                            ": envelope growth, penalty k >= 0, centre, half-extents > 0 along three axes",
+       std::move(aliases)},
+      kind == ShapeKind::kSphere ? "volume penalty cx cy cz r"
+                                 : "volume penalty cx cy cz a b c ux uy uz vx vy vz wx wy wz",
+      "",
+      [name, kind](SectionReader& r, Collision& c) {
+        for (const ConfigLine* line : r.lines(name)) c.shapes.push_back(readShape(r, *line, kind));
+      },
+      [kind](const Collision& c) {
+        std::vector<std::string> lines;
+        for (const CollisionShape& s : c.shapes)
+          if (s.kind == kind) lines.push_back(shapeText(s));
+        return lines;
+      }));
+}
+
+Section<Collision> makeCollision() {
+  return makeSection<Collision>(
+      "Collision", "Collision Info", "CollisionInfo",
+      {shapeKey("Sphere", ShapeKind::kSphere, {}), shapeKey("Ellipsoid", ShapeKind::kEllipsoid, {"Elipsoid"}),
+       shapeKey("Cuboid", ShapeKind::kCuboid, {})},
+      [](SectionReader&, Collision& c) {
+        // The shapes keep their file order whatever their kind (it is part of the output's identity):
+        // the file's lines in order, then those of --set.
+        std::stable_sort(c.shapes.begin(), c.shapes.end(), [](const CollisionShape& a, const CollisionShape& b) {
+          if (a.where.file != b.where.file) return a.where.line > 0 && b.where.line == 0;
+          return a.where.line < b.where.line;
+        });
+      },
+      [](const Collision& c) {
+        std::vector<std::string> lines;
+        for (const CollisionShape& s : c.shapes) lines.push_back(std::string(name(s.kind)) + " " + shapeText(s));
+        return lines;
+      });
+}
+
+// ------------------------------------------------------------------------------------------ Visuality
+
+Section<Visuality> makeVisuality() {
+  using V = Visuality;
+  const Range colour = Range::closed(0.0, 1000.0);
+  return makeSection<V>(
+      "Visuality", "Visuality Info", "VisualityInfo",
+      {vectorKey<V, 3>({"AmbientColor", "", "ambient reflectance of the hair"}, &V::ambientColor, "r g b", colour),
+       vectorKey<V, 3>({"DiffuseColor", "", "diffuse reflectance of the hair"}, &V::diffuseColor, "r g b", colour),
+       vectorKey<V, 3>({"SpecularColor", "", "specular reflectance of the hair"}, &V::specularColor, "r g b",
+                       colour),
+       realKey<V>({"Glossiness", "", "specular exponent p"}, &V::glossiness, Range::closed(0.0, 100000.0)),
+       realKey<V>({"AmbientMean", "", "hairgen shade: mean of the per-strand ambient coefficient (Anjyo)"},
+                  &V::ambientMean, colour),
+       realKey<V>({"AmbientDeviation", "", "hairgen shade: its standard deviation"}, &V::ambientDeviation,
+                  colour)});
+}
+
+// --------------------------------------------------------------------------------------------- Render
+
+Key<RenderSettings> resolutionKey() {
+  return customKey<RenderSettings>(
+      {"Resolution", "pixels", "width and height of the image"}, "width height", "[1, 16384]",
+      [](SectionReader& r, RenderSettings& s) {
+        std::vector<double> res =
+            r.reals("Resolution", 2, std::vector<double>{double(s.resolution.x), double(s.resolution.y)},
+                    Range::closed(1, 16384));
+        if (res[0] != std::floor(res[0]) || res[1] != std::floor(res[1]))
+          throw InputError(r.where("Resolution"), "Resolution must be two whole numbers of pixels");
+        s.resolution = glm::ivec2(static_cast<int>(res[0]), static_cast<int>(res[1]));
+      },
+      [](const RenderSettings& s) {
+        return std::vector<std::string>{std::to_string(s.resolution.x) + " " + std::to_string(s.resolution.y)};
+      });
+}
+
+Section<RenderSettings> makeRender() {
+  using R = RenderSettings;
+  const Range colour = Range::closed(0.0, 1e6);
+  return makeSection<R>(
+      "Render", "Render Info", "RenderInfo",
+      {resolutionKey(),
+       vectorKey<R, 3>({"CameraPosition", "m", "where the camera is"}, &R::cameraPosition, "x y z"),
+       vectorKey<R, 3>({"CameraTarget", "m", "the point the camera looks at"}, &R::cameraTarget, "x y z"),
+       vectorKey<R, 3>({"CameraUp", "", "the camera's up direction"}, &R::cameraUp, "x y z"),
+       realKey<R>({"FieldOfView", "degrees", "vertical field of view"}, &R::fieldOfView, {0.0, 180.0, true, true}),
+       vectorKey<R, 3>({"LightPosition", "m", "the point light"}, &R::lightPosition, "x y z"),
+       vectorKey<R, 3>({"LightColor", "", "the light's colour and intensity"}, &R::lightColor, "r g b", colour),
+       realKey<R>({"AmbientIntensity", "", "ambient light"}, &R::ambientIntensity, colour),
+       integerKey<R>({"Samples", "", "antialiasing samples per pixel (k² for k×k sub-pixels)"}, &R::samples, 1, 64),
+       vectorKey<R, 4>({"LayerSizes", "m", "the depths of the four deep-opacity layers"}, &R::layerSizes,
+                       "d1 d2 d3 d4", Range::positive()),
+       realKey<R>({"StrandOpacity", "", "opacity of one strand"}, &R::strandOpacity, Range::closed(0.0, 1.0)),
+       realKey<R>({"StrandWidth", "m", "on-screen diameter of a strand"}, &R::strandWidth, {0.0, 1.0, true, false}),
+       choiceKey<R, ShadingModel>({"ShadingModel", "", "how strands are lit (README, Rendering)"}, &R::shadingModel,
+                                  {ShadingModel::kKajiyaKay, ShadingModel::kThesis, ShadingModel::kAnjyo,
+                                   ShadingModel::kVolumetric}),
+       vectorKey<R, 3>({"Background", "", "the preview's background colour"}, &R::background, "r g b", colour),
+       vectorKey<R, 3>({"HeadColor", "", "Lambert albedo of the head"}, &R::headColor, "r g b",
+                       Range::closed(0.0, 1.0)),
+       realKey<R>({"VoxelSize", "m", "hairgen shade: spacing of the density grid (large for caches in cm or mm)"},
+                  &R::voxelSize, {0.0, 1000.0, true, false}),
+       integerKey<R>({"VolumePadding", "voxels", "hairgen shade: empty voxels around the hair"}, &R::volumePadding,
+                     1, 64),
+       realKey<R>({"ShellDensity", "", "hairgen shade: the shell's density as a fraction of a typical hair point's"},
+                  &R::shellDensity, {0.0, 100.0, true, false}),
+       realKey<R>({"VolumetricBlend", "", "0 = Kajiya-Kay, 1 = volumetric"}, &R::volumetricBlend,
+                  Range::closed(0.0, 1.0))},
+      [](SectionReader& r, R& s) {
+        if (glm::length(s.cameraTarget - s.cameraPosition) < 1e-9)
+          throw InputError(r.where("CameraTarget"), "CameraTarget equals CameraPosition; the camera needs a direction");
+        if (glm::length(glm::cross(s.cameraUp, s.cameraTarget - s.cameraPosition)) < 1e-9)
+          throw InputError(r.where("CameraUp"), "CameraUp is zero or parallel to the view direction");
+      });
+}
+
+}  // namespace
+
+const Section<Setup>& setupKeys() {
+  static const Section<Setup> section = makeSetup();
+  return section;
+}
+const Section<Hairstyle>& hairstyleKeys() {
+  static const Section<Hairstyle> section = makeHairstyle();
+  return section;
+}
+const Section<Collision>& collisionKeys() {
+  static const Section<Collision> section = makeCollision();
+  return section;
+}
+const Section<Visuality>& visualityKeys() {
+  static const Section<Visuality> section = makeVisuality();
+  return section;
+}
+const Section<RenderSettings>& renderKeys() {
+  static const Section<RenderSettings> section = makeRender();
+  return section;
+}
+
+const SectionList& allSections() {
+  static const SectionList sections = {&setupKeys().spec, &hairstyleKeys().spec, &collisionKeys().spec,
+                                       &visualityKeys().spec, &renderKeys().spec};
+  return sections;
+}
+
+Setup readSetup(const ConfigText& text, const std::vector<Override>& overrides) {
+  return readSection(setupKeys(), text, overrides);
+}
+Hairstyle readHairstyle(const ConfigText& text, const std::vector<Override>& overrides) {
+  return readSection(hairstyleKeys(), text, overrides);
+}
+Collision readCollision(const ConfigText& text, const std::vector<Override>& overrides) {
+  return readSection(collisionKeys(), text, overrides);
+}
+Visuality readVisuality(const ConfigText& text, const std::vector<Override>& overrides) {
+  return readSection(visualityKeys(), text, overrides);
+}
+RenderSettings readRender(const ConfigText& text, const std::vector<Override>& overrides) {
+  return readSection(renderKeys(), text, overrides);
+}
+
+std::string Config::canonicalText() const {
+  return setupKeys().canonicalText(setup) + hairstyleKeys().canonicalText(hairstyle) +
+         collisionKeys().canonicalText(collision) + visualityKeys().canonicalText(visuality) +
+         renderKeys().canonicalText(render);
+}
+
+}  // namespace hairgen
