@@ -71,8 +71,6 @@ int runCommand(const std::string& command, const CommonOptions& options, const s
     tbb::global_control limit(tbb::global_control::max_allowed_parallelism, static_cast<size_t>(threads));
     body();
     return static_cast<int>(ExitCode::kSuccess);
-  } catch (const ExitWith& e) {
-    return static_cast<int>(e.code);
   } catch (const Error& e) {
     std::cerr << "hairgen " << command << ": error: " << e.what() << "\n";
     return static_cast<int>(e.code());
@@ -103,12 +101,10 @@ void note(const CommonOptions& options, const std::string& line) {
 }
 
 std::string exitCodeHelp() {
-  return "Exit codes:\n"
-         "  0  success\n"
-         "  1  the work failed (I/O while writing, a numerical failure)\n"
-         "  2  bad usage or bad input (config, mesh, cache, command line)\n"
-         "  3  no rendering device could be opened\n"
-         "  4  `hairgen diff` found the images beyond the thresholds\n";
+  std::string text = "Exit codes:\n";
+  for (const ExitCodeInfo& e : kExitCodes)
+    text += "  " + std::to_string(int(e.code)) + "  " + e.meaning + "\n";
+  return text;
 }
 
 }  // namespace hairgen::cli

@@ -54,11 +54,6 @@ class Stats {
 // "1.23 s"
 std::string formatSeconds(double seconds);
 
-// Thrown by a command body that has said what it had to and ends with `code` (diff's verdict).
-struct ExitWith {
-  ExitCode code;
-};
-
 // Parses --set and --seed, records them in `stats`, and reads the Setup for `use`.
 Config loadStageConfig(const std::filesystem::path& setup, const CommonOptions& options, SetupUse use,
                        Stats& stats);

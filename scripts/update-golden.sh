@@ -6,7 +6,7 @@ cd "$(dirname "$0")/.."
 src=$(pwd)
 bash scripts/setup.sh
 cases=("$@")
-[ ${#cases[@]} -gt 0 ] || mapfile -t cases < <(find golden -mindepth 1 -maxdepth 1 -type d -printf '%f\n' | sort)
+[ ${#cases[@]} -gt 0 ] || mapfile -t cases < <(find golden -mindepth 2 -maxdepth 2 -name case.sh -printf '%h\n' | xargs -n1 basename | sort)
 for case in "${cases[@]}"; do
   [ -f "golden/$case/case.sh" ] || { echo "update-golden: no golden/$case/case.sh" >&2; exit 2; }
   out="$src/build/golden-update/$case"

@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # One golden case: runs golden/CASE/case.sh's command into the build tree and compares its image with
-# golden/CASE/reference.exr by `hairgen diff` (default thresholds). On failure the rendered image and
-# the difference image stay in WORK for a person to look at.
+# golden/CASE/reference.exr by `hairgen diff` (default thresholds). On failure WORK/CASE keeps the
+# rendered image, a copy of the reference, the difference (diff.exr) and the three side by side
+# (sheet.png: reference | rendered | 10 × difference) for a person to look at.
 # Usage: golden_test.sh HAIRGEN SOURCE_DIR CASE WORK
 set -uo pipefail
 hairgen=$1 src=$2 case=$3 work=$4
@@ -12,8 +13,10 @@ rm -rf "$out" && mkdir -p "$out"
 source "$dir/case.sh"
 [ -f "$dir/reference.exr" ] || { echo "golden $case: no reference.exr; run scripts/update-golden.sh $case"; exit 1; }
 "$hairgen" "${args[@]}" || { echo "golden $case: the command failed"; exit 1; }
-if "$hairgen" diff "$dir/reference.exr" "$image" --out "$out/diff.exr"; then
+if "$hairgen" diff "$dir/reference.exr" "$image" --quiet; then
   exit 0
 fi
-echo "golden $case: differs from its reference; kept $image and $out/diff.exr"
+cp "$dir/reference.exr" "$out/reference.exr"
+"$hairgen" diff "$dir/reference.exr" "$image" --out "$out/diff.exr" --sheet "$out/sheet.png"
+echo "golden $case: differs from its reference; look at $out/sheet.png (reference | rendered | 10 x difference)"
 exit 1

@@ -10,13 +10,29 @@
 
 namespace hairgen {
 
-// The process exit codes, the same for every command (DESIGN §3).
+// The process exit codes, the same for every command (DESIGN §3), each declared once here with its
+// meaning; `--help` lists them from this table.
+#define HAIRGEN_EXIT_CODES(X)                                                   \
+  X(kSuccess, 0, "success")                                                     \
+  X(kWorkFailed, 1, "the work failed (I/O while writing, a numerical failure)") \
+  X(kBadInput, 2, "bad usage or bad input (config, mesh, cache, command line)") \
+  X(kNoDevice, 3, "no rendering device could be opened")                        \
+  X(kDiffFailed, 4, "`hairgen diff` found the images beyond the thresholds")
+
 enum class ExitCode : int {
-  kSuccess = 0,     // the command did what was asked
-  kWorkFailed = 1,  // the work itself failed: I/O while writing, a numerical failure
-  kBadInput = 2,    // bad usage or bad input: config, mesh, cache, command line
-  kNoDevice = 3,    // no rendering device could be opened
-  kDiffFailed = 4,  // `hairgen diff` found the images beyond its thresholds
+#define HAIRGEN_EXIT_ENUMERATOR(name, value, meaning) name = value,
+  HAIRGEN_EXIT_CODES(HAIRGEN_EXIT_ENUMERATOR)
+#undef HAIRGEN_EXIT_ENUMERATOR
+};
+
+struct ExitCodeInfo {
+  ExitCode code;
+  const char* meaning;
+};
+inline constexpr ExitCodeInfo kExitCodes[] = {
+#define HAIRGEN_EXIT_INFO(name, value, meaning) {ExitCode::name, meaning},
+    HAIRGEN_EXIT_CODES(HAIRGEN_EXIT_INFO)
+#undef HAIRGEN_EXIT_INFO
 };
 
 // Where in a text file something was found. line == 0 means "the file as a whole".
