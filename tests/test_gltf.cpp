@@ -24,6 +24,19 @@ TEST(Gltf, GltfJsonRoundTripKeepsEveryAttribute) {
   test::expectSameStrands(decodeGltf(json.data(), json.size(), "s.gltf"), s);
 }
 
+TEST(Gltf, ColoursAboveOneAreClampedInColor0AndKeptInTheirOwnAttribute) {
+  Strands s = test::sampleStrands(4, 3);
+  for (size_t i = 0; i < s.colors.size(); ++i)
+    s.colors[i] = glm::vec3(0.2f + 0.5f * float(i % 4));  // up to 1.7
+  std::vector<uint8_t> json = encodeGltf(s, false);
+  const std::string text(json.begin(), json.end());
+  EXPECT_NE(text.find("\"_COLOR\""), std::string::npos);
+  test::expectSameStrands(decodeGltf(json.data(), json.size(), "s.gltf"), s);  // the values themselves
+  Strands inRange = test::sampleStrands(4, 3);
+  json = encodeGltf(inRange, false);
+  EXPECT_EQ(std::string(json.begin(), json.end()).find("\"_COLOR\""), std::string::npos);
+}
+
 TEST(Gltf, EncodingIsDeterministic) {
   EXPECT_EQ(encodeGltf(test::sampleStrands(), true), encodeGltf(test::sampleStrands(), true));
 }

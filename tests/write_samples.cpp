@@ -11,10 +11,10 @@ int main(int argc, char** argv) {
   }
   std::filesystem::path dir = argv[1];
   hairgen::Strands full = hairgen::test::sampleStrands(25, 3);
-  hairgen::writeGltf(dir / "full.glb", full);
-  hairgen::writeGltf(dir / "full.gltf", full);
+  hairgen::writeGltf(dir / "full.glb", full, true);
+  hairgen::writeGltf(dir / "full.gltf", full, false);
   hairgen::Strands bare;
   bare.addStrand({glm::vec3(0, 0, 0), glm::vec3(0, -0.01f, 0.001f), glm::vec3(0, -0.02f, 0.003f)});
-  hairgen::writeGltf(dir / "bare.glb", bare);
+  hairgen::writeGltf(dir / "bare.glb", bare, true);
   return 0;
 }

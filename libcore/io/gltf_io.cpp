@@ -222,7 +222,19 @@ std::vector<uint8_t> encodeGltf(const Strands& s, bool binary) {
     }
     prim.attributes["NORMAL"] = b.add(unit, kFloat, TINYGLTF_TYPE_VEC3, kArray);
   }
-  if (!s.colors.empty()) prim.attributes["COLOR_0"] = b.add(s.colors, kFloat, TINYGLTF_TYPE_VEC3, kArray);
+  if (!s.colors.empty()) {
+    // glTF colours lie in [0, 1]. A shaded coupe's per-strand ambient coefficient may pass 1: COLOR_0
+    // holds the colours clamped, and _COLOR the values themselves, which a reader prefers.
+    std::vector<glm::vec3> clamped(s.colors);
+    bool outside = false;
+    for (glm::vec3& c : clamped) {
+      glm::vec3 in = glm::clamp(c, 0.0f, 1.0f);
+      outside = outside || in != c;
+      c = in;
+    }
+    prim.attributes["COLOR_0"] = b.add(clamped, kFloat, TINYGLTF_TYPE_VEC3, kArray);
+    if (outside) prim.attributes["_COLOR"] = b.add(s.colors, kFloat, TINYGLTF_TYPE_VEC3, kArray);
+  }
   if (!s.transparency.empty())
     prim.attributes["_TRANSPARENCY"] = b.add(s.transparency, kFloat, TINYGLTF_TYPE_SCALAR, kArray);
   if (!s.tangents.empty())
@@ -375,7 +387,7 @@ Strands decodeGltf(const uint8_t* data, size_t size, const std::string& name,
       };
       vec3s("NORMAL", s.normals);
       vec3s("_TANGENT", s.tangents);
-      if (auto v = attribute("COLOR_0")) {
+      if (auto v = attribute(prim.attributes.count("_COLOR") ? "_COLOR" : "COLOR_0")) {
         v->expect(TINYGLTF_COMPONENT_TYPE_FLOAT, 3);
         s.colors.resize(n);
         for (size_t i = 0; i < n; ++i) s.colors[i] = {v->f(i, 0), v->f(i, 1), v->f(i, 2)};
@@ -437,8 +449,8 @@ Strands readGltf(const std::filesystem::path& file) {
   return decodeGltf(bytes.data(), bytes.size(), file.string(), file.parent_path());
 }
 
-void writeGltf(const std::filesystem::path& file, const Strands& strands) {
-  std::vector<uint8_t> bytes = encodeGltf(strands, file.extension() == ".glb");
+void writeGltf(const std::filesystem::path& file, const Strands& strands, bool binary) {
+  std::vector<uint8_t> bytes = encodeGltf(strands, binary);
   writeFileAtomic(file, bytes.data(), bytes.size());
 }
 

@@ -21,10 +21,11 @@ Strands readStrands(const std::filesystem::path& file) {
 }
 
 void writeStrands(const std::filesystem::path& file, const Strands& strands) {
-  if (hairFormatOf(file) == HairFormat::kHair)
+  const HairFormat format = hairFormatOf(file);
+  if (format == HairFormat::kHair)
     writeHair(file, strands);
   else
-    writeGltf(file, strands);
+    writeGltf(file, strands, format == HairFormat::kGlb);
 }
 
 }  // namespace hairgen

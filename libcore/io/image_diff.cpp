@@ -79,7 +79,8 @@ ImageDiff diffImages(const Image& a, const Image& b, const std::vector<std::stri
       interleavedB[i * nc + c] = p.b[i];
     }
     ChannelDiff stats{names[c]};
-    OIIO::ImageBuf ca = buffer(a.width, a.height, 1, p.a.data()), cb = buffer(a.width, a.height, 1, p.b.data());
+    OIIO::ImageBuf ca = buffer(a.width, a.height, 1, p.a.data()),
+                   cb = buffer(a.width, a.height, 1, p.b.data());
     const OIIO::ImageBufAlgo::CompareResults r =
         OIIO::ImageBufAlgo::compare(ca, cb, float(thresholds.fail), float(thresholds.fail));
     stats.mean = r.meanerror;
@@ -118,15 +119,16 @@ ImageDiff diffImages(const Image& a, const Image& b, const std::vector<std::stri
   diff.failingPercent = pixels ? 100.0 * double(diff.failingPixels) / double(pixels) : 0.0;
 
   if (diff.worst > thresholds.hardFail)
-    return fail("a difference of " + number(diff.worst) + " is beyond --hardfail " + number(thresholds.hardFail));
+    return fail("a difference of " + number(diff.worst) + " is beyond --hardfail " +
+                number(thresholds.hardFail));
   if (diff.failingPercent > thresholds.failPercent)
     return fail(number(diff.failingPercent) + "% of pixels are beyond --fail " + number(thresholds.fail) +
                 ", more than --failpercent " + number(thresholds.failPercent));
   return diff;
 }
 
-void writeComparisonSheet(const std::filesystem::path& file, const Image& a, const Image& b, const ImageDiff& diff,
-                          double gain) {
+void writeComparisonSheet(const std::filesystem::path& file, const Image& a, const Image& b,
+                          const ImageDiff& diff, double gain) {
   const int w = a.width, h = a.height;
   Image sheet;
   sheet.width = 3 * w;
