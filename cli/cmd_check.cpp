@@ -4,7 +4,7 @@
 #include "cli/commands.h"
 #include "cli/common.h"
 #include "libcore/config/setup.h"
-#include "libcore/io/obj_io.h"
+#include "libcore/io/info.h"
 
 namespace hairgen::cli {
 
@@ -39,39 +39,14 @@ void registerCheck(CLI::App& app, int& exitCode) {
       std::vector<Override> overrides = parseOverrides(options->common);
       Config config = loadConfig(options->setup, overrides, SetupUse::kCheck);
       stats.setOverrides(overrides);
-      nlohmann::ordered_json report;
-      report["setup"] = options->setup;
-      report["digest"] = config.digest();
-      report["load"] = config.setup.load;
-      report["collisionShapes"] = config.collision.shapes.size();
-      report["superHelixElements"] = config.hairstyle.hairLengths.size();
-      report["hairLength"] = config.hairstyle.totalLength();
-      for (auto [ref, key] :
-           {std::pair{&config.setup.wickModel, "wick"}, {&config.setup.headModel, "head"}}) {
-        if (!ref->given()) continue;
-        MeshReadStats meshStats;
-        Mesh mesh = readObj(ref->path, &meshStats);
-        report[key] = {{"file", ref->path.string()},
-                       {"vertices", mesh.vertexCount()},
-                       {"triangles", mesh.triangleCount()},
-                       {"area_cm2", surfaceArea(mesh) * 1e4},
-                       {"degenerateFacesDropped", meshStats.degenerateDropped}};
-      }
+      const nlohmann::ordered_json report = describeSetup(options->setup, config);
       stats.json()["report"] = report;
       if (options->canonical) {
         std::cout << config.canonicalText();
       } else if (options->json) {
         std::cout << report.dump(2) << "\n";
       } else {
-        std::cout << options->setup << ": ok, config digest " << config.digest() << "\n";
-        std::cout << "  " << config.hairstyle.hairLengths.size() << " Super-Helix elements, hair length "
-                  << config.hairstyle.totalLength() << " m, " << config.collision.shapes.size()
-                  << " collision shapes\n";
-        for (const char* key : {"wick", "head"})
-          if (report.contains(key))
-            std::cout << "  " << key << " " << report[key]["file"].get<std::string>() << ": "
-                      << report[key]["vertices"] << " vertices, " << report[key]["triangles"]
-                      << " triangles\n";
+        std::cout << formatSetupReport(report);
       }
       stats.write(options->common);
     });

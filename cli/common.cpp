@@ -16,7 +16,7 @@ void addCommonFlags(CLI::App& command, CommonOptions& options, bool configFlags)
   command
       .add_option("--threads", options.threads,
                   "Worker threads; 0 uses every core (output is identical for any value)")
-      ->default_val(0)
+      ->capture_default_str()
       ->check(CLI::Range(0, 4096));
   command.add_flag("--quiet,-q", options.quiet, "Print nothing but errors");
   command

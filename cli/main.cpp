@@ -9,10 +9,12 @@
 
 int main(int argc, char** argv) {
   using namespace hairgen::cli;
-  CLI::App app{"hairgen " HAIRGEN_VERSION
-               ": grows, styles, caches and renders hair for CG characters (Super-Helix guides, "
-               "interpolation, Kajiya-Kay shading with deep opacity maps).",
-               "hairgen"};
+  CLI::App app{
+      "hairgen " HAIRGEN_VERSION
+      ": grows, styles, caches and renders hair for CG characters (Super-Helix guides, "
+      "interpolation, Anjyo's cantilever styling, hair shading (Kajiya-Kay, Anjyo, volumetric) with deep "
+      "opacity maps).",
+      "hairgen"};
   app.footer(exitCodeHelp());
   app.require_subcommand(1);
   app.set_version_flag("--version", "hairgen " HAIRGEN_VERSION);

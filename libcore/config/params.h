@@ -90,7 +90,7 @@ struct Collision {
   std::vector<CollisionShape> shapes;
 };
 
-// Visuality Info: Kajiya-Kay reflectance.
+// Visuality Info: the hair's reflectance, for every shading model.
 struct Visuality {
   glm::dvec3 ambientColor{0.10, 0.10, 0.10};
   glm::dvec3 diffuseColor{0.45, 0.25, 0.00};

@@ -149,4 +149,38 @@ std::string formatDescription(const nlohmann::ordered_json& j) {
   return out.str();
 }
 
+nlohmann::ordered_json describeSetup(const std::string& setupName, const Config& config) {
+  nlohmann::ordered_json report;
+  report["setup"] = setupName;
+  report["digest"] = config.digest();
+  report["load"] = config.setup.load;
+  report["collisionShapes"] = config.collision.shapes.size();
+  report["superHelixElements"] = config.hairstyle.hairLengths.size();
+  report["hairLength"] = config.hairstyle.totalLength();
+  for (auto [ref, key] : {std::pair{&config.setup.wickModel, "wick"}, {&config.setup.headModel, "head"}}) {
+    if (!ref->given()) continue;
+    MeshReadStats meshStats;
+    Mesh mesh = readObj(ref->path, &meshStats);
+    report[key] = {{"file", ref->path.string()},
+                   {"vertices", mesh.vertexCount()},
+                   {"triangles", mesh.triangleCount()},
+                   {"area_cm2", surfaceArea(mesh) * 1e4},
+                   {"degenerateFacesDropped", meshStats.degenerateDropped}};
+  }
+  return report;
+}
+
+std::string formatSetupReport(const nlohmann::ordered_json& report) {
+  std::ostringstream out;
+  out << report["setup"].get<std::string>() << ": ok, config digest " << report["digest"].get<std::string>()
+      << "\n";
+  out << "  " << report["superHelixElements"] << " Super-Helix elements, hair length "
+      << report["hairLength"].get<double>() << " m, " << report["collisionShapes"] << " collision shapes\n";
+  for (const char* key : {"wick", "head"})
+    if (report.contains(key))
+      out << "  " << key << " " << report[key]["file"].get<std::string>() << ": " << report[key]["vertices"]
+          << " vertices, " << report[key]["triangles"] << " triangles\n";
+  return out.str();
+}
+
 }  // namespace hairgen

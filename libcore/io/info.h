@@ -5,6 +5,8 @@
 
 #include <nlohmann/json.hpp>
 
+#include "libcore/config/params.h"
+
 namespace hairgen {
 
 // Describes a .hair, .gltf, .glb or .obj file as JSON (counts, bounds, arrays present, provenance).
@@ -13,5 +15,10 @@ nlohmann::ordered_json describeFile(const std::filesystem::path& file);
 
 // The same description as a few human-readable lines.
 std::string formatDescription(const nlohmann::ordered_json& description);
+
+// What `hairgen check` reports of a job: the digest, the counts that shape the work, and each mesh the
+// Setup names (read, so a broken mesh is found before the work).
+nlohmann::ordered_json describeSetup(const std::string& setupName, const Config& config);
+std::string formatSetupReport(const nlohmann::ordered_json& report);
 
 }  // namespace hairgen
