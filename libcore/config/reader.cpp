@@ -63,16 +63,8 @@ const SectionSpec& sectionSpec(std::string_view name) {
 ConfigText parseConfigText(std::string_view text, const std::string& name,
                            const std::filesystem::path& baseDir) {
   ConfigText config{name, baseDir, {}};
-  int lineNumber = 0;
-  size_t pos = 0;
-  while (pos <= text.size()) {
-    size_t end = text.find('\n', pos);
-    if (end == std::string_view::npos) end = text.size();
-    std::string_view line = text.substr(pos, end - pos);
-    ++lineNumber;
-    pos = end + 1;
+  forEachLine(withoutBom(text), [&](std::string_view line, int lineNumber) {
     FileLoc where{name, lineNumber};
-
     std::vector<std::string> tokens;
     std::string token;
     bool inToken = false, quoted = false;
@@ -91,7 +83,7 @@ ConfigText parseConfigText(std::string_view text, const std::string& name,
         quoted = inToken = true;
         continue;
       }
-      if (c == ' ' || c == '\t' || c == '\r' || c == '\f' || c == '\v') {
+      if (c == ' ' || c == '\t' || c == '\f' || c == '\v') {
         if (inToken) tokens.push_back(std::move(token));
         token.clear();
         inToken = false;
@@ -105,11 +97,9 @@ ConfigText parseConfigText(std::string_view text, const std::string& name,
     }
     if (quoted) throw InputError(where, "unterminated quoted string; close it with \"");
     if (inToken) tokens.push_back(std::move(token));
-    if (tokens.empty()) continue;
-    ConfigLine parsed{where, tokens.front(), {tokens.begin() + 1, tokens.end()}};
-    config.lines.push_back(std::move(parsed));
-    if (end == text.size()) break;
-  }
+    if (!tokens.empty())
+      config.lines.push_back(ConfigLine{where, tokens.front(), {tokens.begin() + 1, tokens.end()}});
+  });
   return config;
 }
 

@@ -15,6 +15,7 @@
 
 #include "libcore/util/error.h"
 #include "libcore/util/file_util.h"
+#include "libcore/util/resources.h"
 
 namespace hairgen {
 namespace {
@@ -28,6 +29,11 @@ Imath::M44f toImath(const glm::dmat4& m) {
     for (int col = 0; col < 4; ++col) r[row][col] = static_cast<float>(m[row][col]);
   return r;
 }
+
+// Far beyond any frame hairgen renders (Resolution is at most 16384), and small enough that a header
+// cannot make the reader allocate without bound.
+constexpr int kMaxImageSide = 65536;
+constexpr int kMaxImageChannels = 1024;
 
 bool isHalf(const std::string& c) {
   return c == "R" || c == "G" || c == "B" || c == "A";
@@ -71,9 +77,29 @@ void writeExr(const fs::path& file, const Image& image, const ExrMetadata& metad
 }
 
 Image readImage(const fs::path& file) {
+  requireRegularFile(file);
   auto in = OIIO::ImageInput::open(file.string());
   if (!in) throw InputError({file.string(), 0}, "cannot read image: " + OIIO::geterror());
   const OIIO::ImageSpec& spec = in->spec();
+  // The header is the attacker's: a 12 kB file can declare a 7 GB image. Size it before allocating.
+  const FileLoc where{file.string(), 0};
+  if (spec.width <= 0 || spec.height <= 0 || spec.nchannels <= 0 || spec.depth > 1)
+    throw InputError(where, "declares an image of " + std::to_string(spec.width) + "x" +
+                                std::to_string(spec.height) + " pixels and " +
+                                std::to_string(spec.nchannels) + " channels; expected a 2D image");
+  if (spec.width > kMaxImageSide || spec.height > kMaxImageSide || spec.nchannels > kMaxImageChannels)
+    throw InputError(where, "declares " + std::to_string(spec.width) + "x" + std::to_string(spec.height) +
+                                " pixels and " + std::to_string(spec.nchannels) +
+                                " channels; hairgen reads at most " + std::to_string(kMaxImageSide) +
+                                " pixels a side and " + std::to_string(kMaxImageChannels) + " channels");
+  // Read interleaved, then split into planes: twice the float image at the peak.
+  const uint64_t bytes =
+      2ull * uint64_t(spec.width) * uint64_t(spec.height) * uint64_t(spec.nchannels) * 4ull;
+  if (bytes > memoryBudget())
+    throw InputError(where, "declares " + std::to_string(spec.width) + "x" + std::to_string(spec.height) +
+                                " pixels of " + std::to_string(spec.nchannels) + " channels, " +
+                                formatBytes(bytes) + " to read, more than the " +
+                                formatBytes(memoryBudget()) + " this machine has free");
   Image image;
   image.width = spec.width;
   image.height = spec.height;

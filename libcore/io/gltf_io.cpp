@@ -1,14 +1,18 @@
 #include "libcore/io/gltf_io.h"
 
+#include <cctype>
 #include <cmath>
 #include <cstring>
 #include <optional>
 #include <sstream>
 
 #include <tiny_gltf.h>
+#include <nlohmann/json.hpp>
 
+#include "libcore/util/checked.h"
 #include "libcore/util/error.h"
 #include "libcore/util/file_util.h"
+#include "libcore/util/text.h"
 
 namespace hairgen {
 namespace {
@@ -120,14 +124,13 @@ class AccessorView {
     if (componentSize <= 0 || components <= 0) throw fail("invalid componentType or type");
     int stride = a.ByteStride(v);
     if (stride <= 0) throw fail("invalid byteStride");
-    uint64_t elementSize = uint64_t(componentSize) * uint64_t(components);
+    const uint64_t elementSize = uint64_t(componentSize) * uint64_t(components);
     if (v.byteOffset > data.size() || v.byteLength > data.size() - v.byteOffset)
       throw fail("bufferView reaches past the end of its buffer");
-    if (a.count > 0) {
-      uint64_t needed = uint64_t(a.byteOffset) + uint64_t(stride) * (a.count - 1) + elementSize;
-      if (a.byteOffset > v.byteLength || needed > v.byteLength)
-        throw fail("accessor reaches past the end of its bufferView");
-    }
+    // In exact arithmetic: a count near 2^64 must not wrap past the check and read outside the buffer.
+    if (!extentFits(a.byteOffset, a.count, uint64_t(stride), elementSize, v.byteLength))
+      throw fail("accessor of " + std::to_string(a.count) +
+                 " elements reaches past the end of its bufferView");
     base_ = data.data() + v.byteOffset + a.byteOffset;
     count_ = a.count;
     stride_ = static_cast<size_t>(stride);
@@ -185,6 +188,125 @@ double numberOr(const Value& object, const char* key, double fallback) {
 std::string stringOr(const Value& object, const char* key) {
   if (!object.IsObject() || !object.Has(key) || !object.Get(key).IsString()) return {};
   return object.Get(key).Get<std::string>();
+}
+
+// ---------------------------------------------------------------------------------- external files
+//
+// A glTF may name buffers and images by URI. hairgen reads only what sits beside the file: a data: URI,
+// or a relative path to a regular file inside the glTF's own folder. An absolute path, "..", a
+// directory, a device or a FIFO is refused by name; the file-system callbacks given to tinygltf enforce
+// the same rule again on the paths it builds (it also tries the working directory, and an absolute
+// path with no base folder), so nothing outside the folder is ever opened.
+
+// The JSON text of a .gltf, or the JSON chunk of a .glb ("" when the chunk is malformed: tinygltf then
+// reports the file as unreadable).
+std::string jsonOf(const uint8_t* data, size_t size, bool binary) {
+  if (!binary) return std::string(reinterpret_cast<const char*>(data), size);
+  if (size < 20) return {};
+  uint32_t length, type;
+  std::memcpy(&length, data + 12, 4);
+  std::memcpy(&type, data + 16, 4);
+  if (type != 0x4E4F534Au || length > size - 20) return {};  // "JSON"
+  return std::string(reinterpret_cast<const char*>(data) + 20, length);
+}
+
+// %XX decoded, as tinygltf decodes URIs before it opens them.
+std::string decodeUri(const std::string& uri) {
+  std::string out;
+  for (size_t i = 0; i < uri.size(); ++i) {
+    if (uri[i] == '%' && i + 2 < uri.size() && std::isxdigit(static_cast<unsigned char>(uri[i + 1])) &&
+        std::isxdigit(static_cast<unsigned char>(uri[i + 2]))) {
+      out += char(std::stoi(uri.substr(i + 1, 2), nullptr, 16));
+      i += 2;
+    } else {
+      out += uri[i];
+    }
+  }
+  return out;
+}
+
+// Why the file `path` (reached from `uri`) may not be read, or "" when it may: it must be a regular
+// file whose real path lies inside the real `baseDir`.
+std::string refusal(const std::filesystem::path& path, const std::filesystem::path& baseDir) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  if (baseDir.empty()) return "a glTF read from memory has no folder to read external files from";
+  const fs::path base = fs::weakly_canonical(fs::absolute(baseDir, ec), ec);
+  const fs::path real = fs::weakly_canonical(fs::absolute(path, ec), ec);
+  const fs::path relative = real.lexically_relative(base);
+  if (ec || relative.empty() || *relative.begin() == "..") return "it lies outside the glTF's folder";
+  const fs::file_status status = fs::status(real, ec);
+  if (!fs::exists(status)) return "there is no such file beside the glTF";
+  if (fs::is_directory(status)) return "it is a directory";
+  if (!fs::is_regular_file(status)) return "it is not a regular file (a device, FIFO or socket)";
+  return {};
+}
+
+void checkExternalUris(const std::string& json, const std::filesystem::path& baseDir,
+                       const std::string& name) {
+  const nlohmann::json doc = nlohmann::json::parse(json, nullptr, /*allow_exceptions=*/false);
+  if (!doc.is_object()) return;  // tinygltf says what is wrong with it
+  for (const char* list : {"buffers", "images"}) {
+    if (!doc.contains(list) || !doc[list].is_array()) continue;
+    for (const nlohmann::json& entry : doc[list]) {
+      if (!entry.is_object() || !entry.contains("uri") || !entry["uri"].is_string()) continue;
+      const std::string uri = entry["uri"].get<std::string>();
+      if (uri.rfind("data:", 0) == 0) continue;
+      const std::string path = decodeUri(uri);
+      auto refuse = [&](const std::string& why) {
+        return InputError({name, 0},
+                          std::string(list) + " URI '" + oneLine(uri) + "' is refused: " + why +
+                              "; hairgen reads only data: URIs and files in the glTF's own folder");
+      };
+      const size_t colon = path.find(':');
+      if (colon != std::string::npos && colon > 0 && path.find('/') > colon)  // "file:", "http:"
+        throw refuse("it names a scheme other than data:");
+      const std::filesystem::path relative(path);
+      if (relative.is_absolute()) throw refuse("it is an absolute path");
+      for (const auto& part : relative)
+        if (part == "..") throw refuse("it climbs out of the folder with '..'");
+      if (std::string why = refusal(baseDir / relative, baseDir); !why.empty()) throw refuse(why);
+    }
+  }
+}
+
+struct ExternalFiles {
+  std::filesystem::path baseDir;
+  std::string name;
+
+  tinygltf::FsCallbacks callbacks() {
+    tinygltf::FsCallbacks fs{};
+    fs.FileExists = [](const std::string& path, void* self) {
+      return refusal(path, static_cast<ExternalFiles*>(self)->baseDir).empty();
+    };
+    fs.ExpandFilePath = [](const std::string& path, void*) { return path; };  // no ~ or $VAR expansion
+    fs.ReadWholeFile = [](std::vector<unsigned char>* out, std::string* err, const std::string& path,
+                          void* self) {
+      const std::string why = refusal(path, static_cast<ExternalFiles*>(self)->baseDir);
+      if (!why.empty()) {
+        if (err) *err = path + ": " + why;
+        return false;
+      }
+      try {
+        *out = readFileBytes(path);
+      } catch (const Error& e) {
+        if (err) *err = e.what();
+        return false;
+      }
+      return true;
+    };
+    fs.WriteWholeFile = [](std::string* err, const std::string&, const std::vector<unsigned char>&, void*) {
+      if (err) *err = "hairgen does not write through tinygltf's file system";
+      return false;
+    };
+    fs.user_data = this;
+    return fs;
+  }
+};
+
+bool skipImage(tinygltf::Image*, const int, std::string*, std::string*, int, int, const unsigned char*, int,
+               void*) {
+  return true;
 }
 
 }  // namespace
@@ -301,15 +423,19 @@ std::vector<uint8_t> encodeGltf(const Strands& s, bool binary) {
 Strands decodeGltf(const uint8_t* data, size_t size, const std::string& name,
                    const std::filesystem::path& baseDir) {
   if (size > UINT32_MAX) throw InputError({name, 0}, "file larger than 4 GiB; glTF cannot address it");
+  const bool binary = size >= 4 && std::memcmp(data, "glTF", 4) == 0;
+  checkExternalUris(jsonOf(data, size, binary), baseDir, name);
+  ExternalFiles external{baseDir, name};
   tinygltf::TinyGLTF loader;
+  loader.SetFsCallbacks(external.callbacks());
+  loader.SetImageLoader(skipImage, nullptr);  // hair has no textures; no image decoder sees the bytes
   tinygltf::Model m;
   std::string err, warn;
-  bool binary = size >= 4 && std::memcmp(data, "glTF", 4) == 0;
-  bool ok = binary ? loader.LoadBinaryFromMemory(&m, &err, &warn, data, static_cast<unsigned>(size),
-                                                 baseDir.string())
-                   : loader.LoadASCIIFromString(&m, &err, &warn, reinterpret_cast<const char*>(data),
-                                                static_cast<unsigned>(size), baseDir.string());
-  if (!ok) throw InputError({name, 0}, "not a readable glTF file: " + (err.empty() ? warn : err));
+  const bool ok = binary ? loader.LoadBinaryFromMemory(&m, &err, &warn, data, static_cast<unsigned>(size),
+                                                       baseDir.string())
+                         : loader.LoadASCIIFromString(&m, &err, &warn, reinterpret_cast<const char*>(data),
+                                                      static_cast<unsigned>(size), baseDir.string());
+  if (!ok) throw InputError({name, 0}, "not a readable glTF file: " + oneLine(err.empty() ? warn : err));
 
   Strands s;
   s.provenance.producer = stringOr(m.asset.extras, "producer");

@@ -55,19 +55,12 @@ void checkCorner(std::string_view corner, const FileLoc& where, const size_t cou
 
 void validate(std::string_view text, const std::string& name) {
   size_t counts[3] = {0, 0, 0};  // v, vt, vn
-  int lineNumber = 0;
-  size_t pos = 0;
-  while (pos < text.size()) {
-    size_t end = text.find('\n', pos);
-    if (end == std::string_view::npos) end = text.size();
-    std::string_view line = text.substr(pos, end - pos);
-    pos = end + 1;
-    ++lineNumber;
+  forEachLine(text, [&](std::string_view line, int lineNumber) {
     FileLoc where{name, lineNumber};
     if (line.find('\0') != std::string_view::npos)
       throw InputError(where, "NUL byte in an OBJ file; is this a text file?");
     std::vector<std::string_view> words = splitWords(line);
-    if (words.empty() || words[0][0] == '#') continue;
+    if (words.empty() || words[0][0] == '#') return;
     std::string_view tag = words[0];
     auto numbers = [&](size_t minCount, size_t maxCount, const char* what) {
       size_t n = words.size() - 1;
@@ -100,12 +93,13 @@ void validate(std::string_view text, const std::string& name) {
       if (words.size() < 4) throw InputError(where, "a face needs at least three corners");
       for (size_t i = 1; i < words.size(); ++i) checkCorner(words[i], where, counts);
     }
-  }
+  });
 }
 
 }  // namespace
 
 Mesh parseObj(std::string_view text, const std::string& name, MeshReadStats* statsOut) {
+  text = withoutBom(text);  // tinyobjloader would read "\xEF\xBB\xBFv" as an unknown tag and drop the vertex
   validate(text, name);
   MeshReadStats stats;
 

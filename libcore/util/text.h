@@ -29,4 +29,26 @@ std::string closestMatch(std::string_view word, const std::vector<std::string>& 
 std::string formatReal(double value);
 std::string formatFloat(float value);  // shortest text that parses back to the same float
 
+// `text` with every line end replaced by a space: library messages (a compiler's log, a parser's
+// warnings) in hairgen's one-line errors.
+std::string oneLine(std::string text);
+
+// `text` without a leading UTF-8 byte-order mark (editors on Windows write one).
+std::string_view withoutBom(std::string_view text);
+
+// Calls visit(line, number) for each line of `text` (numbers from 1, without the line end). A line
+// ends at "\r\n", "\n" or a lone "\r" (old Mac editors), as tinyobjloader reads them, so a validator
+// and the parser behind it see the same lines. A final line end starts no extra line.
+template <class Visit>
+void forEachLine(std::string_view text, Visit&& visit) {
+  size_t pos = 0;
+  int number = 0;
+  while (pos < text.size()) {
+    size_t end = text.find_first_of("\r\n", pos);
+    if (end == std::string_view::npos) end = text.size();
+    visit(text.substr(pos, end - pos), ++number);
+    pos = end + (end + 1 < text.size() && text[end] == '\r' && text[end + 1] == '\n' ? 2 : 1);
+  }
+}
+
 }  // namespace hairgen
