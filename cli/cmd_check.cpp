@@ -5,6 +5,7 @@
 #include "cli/common.h"
 #include "libcore/config/setup.h"
 #include "libcore/io/info.h"
+#include "libcore/util/json.h"
 
 namespace hairgen::cli {
 
@@ -44,7 +45,7 @@ void registerCheck(CLI::App& app, int& exitCode) {
       if (options->canonical) {
         std::cout << config.canonicalText();
       } else if (options->json) {
-        std::cout << report.dump(2) << "\n";
+        std::cout << jsonText(report) << "\n";
       } else {
         std::cout << formatSetupReport(report);
       }

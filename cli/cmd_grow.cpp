@@ -5,6 +5,7 @@
 #include "libcore/io/hair_cache.h"
 #include "libcore/io/obj_io.h"
 #include "libcore/util/file_util.h"
+#include "libcore/util/json.h"
 #include "stages/grow.h"
 
 namespace hairgen::cli {
@@ -27,7 +28,7 @@ void writeDiagnostics(const std::string& file, const std::string& setup, const C
                       {"evaluations", r.evaluations},
                       {"stoppedOn", name(r.stop)}});
   nlohmann::ordered_json doc = {{"setup", setup}, {"configDigest", config.digest()}, {"guides", guides}};
-  writeFileAtomic(file, doc.dump(1) + "\n");
+  writeFileAtomic(file, jsonText(doc, 1) + "\n");
 }
 
 }  // namespace
@@ -37,7 +38,8 @@ GrowResult growStage(const CommonOptions& common, const Config& config, const Me
                    config.setup.wickModel.path.string());
   Stopwatch clock;
   Progress progress("grow", "guides", wick.vertexCount(), !common.quiet);
-  GrowResult result = grow(wick, config.hairstyle, config.collision, GrowOptions{config.digest(), &progress});
+  GrowResult result =
+      grow(wick, config.hairstyle, config.collision, GrowOptions{config.digest(), &progress, common.force});
   double seconds = clock.lap();
   stats.time("grow", seconds);
   stats.counts()["guides"] = result.guides.strandCount();

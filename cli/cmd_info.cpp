@@ -4,6 +4,7 @@
 #include "cli/commands.h"
 #include "cli/common.h"
 #include "libcore/io/info.h"
+#include "libcore/util/json.h"
 
 namespace hairgen::cli {
 
@@ -24,7 +25,7 @@ void registerInfo(CLI::App& app, int& exitCode) {
     exitCode = runCommand("info", options->common, [&] {
       Stats stats("info");
       nlohmann::ordered_json description = describeFile(options->file);
-      std::cout << (options->json ? description.dump(2) + "\n" : formatDescription(description));
+      std::cout << (options->json ? jsonText(description) + "\n" : formatDescription(description));
       stats.json()["file"] = description;
       stats.write(options->common);
     });

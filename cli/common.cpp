@@ -9,6 +9,8 @@
 #include "libcore/config/reader.h"
 #include "libcore/util/error.h"
 #include "libcore/util/file_util.h"
+#include "libcore/util/json.h"
+#include "libcore/util/text.h"
 
 namespace hairgen::cli {
 
@@ -23,6 +25,9 @@ void addCommonFlags(CLI::App& command, CommonOptions& options, bool configFlags)
       .add_option("--stats", options.statsFile, "Write timings and counts as JSON to FILE (for farm scripts)")
       ->type_name("FILE.json");
   if (!configFlags) return;
+  command.add_flag(
+      "--force", options.force,
+      "Run work estimated to take more than an hour (work that cannot fit in memory is always refused)");
   command.add_option("--seed", options.seed, "Seed of every random number (overrides Hairstyle.Seed)")
       ->type_name("N");
   std::string sections;
@@ -62,24 +67,29 @@ void Stats::setOverrides(const std::vector<Override>& overrides) {
 void Stats::write(const CommonOptions& options) {
   json_["seconds"]["total"] =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
-  if (!options.statsFile.empty()) writeFileAtomic(options.statsFile, json_.dump(2) + "\n");
+  if (!options.statsFile.empty()) writeFileAtomic(options.statsFile, jsonText(json_) + "\n");
 }
 
 int runCommand(const std::string& command, const CommonOptions& options, const std::function<void()>& body) {
+  installInterruptCleanup();
+  forgetCommittedOutputs();
+  auto failed = [&](const std::string& message, ExitCode code) {
+    discardCommittedOutputs();  // a failed command leaves none of its outputs
+    std::cerr << "hairgen " << command << ": error: " << oneLine(message) << "\n";
+    return static_cast<int>(code);
+  };
   try {
     int threads = options.threads > 0 ? options.threads : static_cast<int>(tbb::info::default_concurrency());
     tbb::global_control limit(tbb::global_control::max_allowed_parallelism, static_cast<size_t>(threads));
     body();
+    forgetCommittedOutputs();
     return static_cast<int>(ExitCode::kSuccess);
   } catch (const Error& e) {
-    std::cerr << "hairgen " << command << ": error: " << e.what() << "\n";
-    return static_cast<int>(e.code());
+    return failed(e.what(), e.code());
   } catch (const std::bad_alloc&) {
-    std::cerr << "hairgen " << command << ": error: out of memory\n";
-    return static_cast<int>(ExitCode::kWorkFailed);
+    return failed("out of memory", ExitCode::kWorkFailed);
   } catch (const std::exception& e) {
-    std::cerr << "hairgen " << command << ": error: internal: " << e.what() << "\n";
-    return static_cast<int>(ExitCode::kWorkFailed);
+    return failed(std::string("internal: ") + e.what(), ExitCode::kWorkFailed);
   }
 }
 

@@ -22,6 +22,7 @@ struct CommonOptions {
   std::optional<uint64_t> seed;   // overrides Hairstyle.Seed
   std::vector<std::string> sets;  // --set Section.Key=VALUE, as given
   bool quiet = false;
+  bool force = false;     // run work estimated to take absurdly long
   std::string statsFile;  // --stats FILE.json
 };
 

@@ -8,6 +8,7 @@
 #include "libcore/io/hair_io.h"
 #include "libcore/io/obj_io.h"
 #include "libcore/util/error.h"
+#include "libcore/util/json.h"
 #include "libcore/util/text.h"
 
 namespace hairgen {
@@ -113,7 +114,7 @@ std::string formatDescription(const nlohmann::ordered_json& j) {
       std::snprintf(buffer, sizeof buffer, "%.6g", v.get<double>());
       return std::string(buffer);
     }
-    return v.dump();
+    return jsonText(v, -1);
   };
   auto box = [&](const nlohmann::ordered_json& b) {
     return "(" + num(b["min"][0]) + ", " + num(b["min"][1]) + ", " + num(b["min"][2]) + ") to (" +

@@ -1,103 +1,302 @@
 #include "libcore/util/file_util.h"
 
+#include <fcntl.h>
+#include <signal.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
+#include <array>
 #include <atomic>
 #include <cerrno>
 #include <cstring>
+#include <mutex>
 #include <system_error>
 
 #include "libcore/util/error.h"
+#include "libcore/util/resources.h"
 
 namespace hairgen {
+namespace fs = std::filesystem;
 namespace {
 
+// ---------------------------------------------------------------------------------------------- inputs
+
 template <typename Container>
-Container readWhole(const std::filesystem::path& path) {
-  std::error_code ec;
-  if (std::filesystem::is_directory(path, ec))
-    throw InputError({path.string(), 0}, "is a directory, expected a file");
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw InputError({path.string(), 0}, std::string("cannot open: ") + std::strerror(errno));
-  in.seekg(0, std::ios::end);
-  std::streamoff size = in.tellg();
-  if (size < 0) throw InputError({path.string(), 0}, "cannot determine the file size");
-  in.seekg(0, std::ios::beg);
+Container readWhole(const fs::path& path) {
+  const FileLoc where{path.string(), 0};
+  // O_NONBLOCK: opening a FIFO must not wait for a writer; fstat then refuses it.
+  const int fd = ::open(path.c_str(), O_RDONLY | O_NONBLOCK | O_CLOEXEC);
+  if (fd < 0) throw InputError(where, std::string("cannot open: ") + std::strerror(errno));
+  struct Closer {
+    int fd;
+    ~Closer() { ::close(fd); }
+  } closer{fd};
+  struct stat st {};
+  if (::fstat(fd, &st) != 0) throw InputError(where, std::string("cannot read: ") + std::strerror(errno));
+  if (S_ISDIR(st.st_mode)) throw InputError(where, "is a directory, expected a file");
+  if (!S_ISREG(st.st_mode))
+    throw InputError(where, "is not a regular file (a FIFO, device or socket); name a file, not a stream");
+  const uint64_t size = uint64_t(st.st_size), budget = memoryBudget();
+  if (size > budget)
+    throw InputError(where, "is " + formatBytes(size) + ", more than the " + formatBytes(budget) +
+                                " of memory this machine has free for it");
   Container data(static_cast<size_t>(size), 0);
-  if (size > 0 && !in.read(reinterpret_cast<char*>(data.data()), size))
-    throw IoError({path.string(), 0}, "read failed");
+  size_t done = 0;
+  while (done < data.size()) {
+    const ssize_t n = ::read(fd, reinterpret_cast<char*>(data.data()) + done, data.size() - done);
+    if (n < 0 && errno == EINTR) continue;
+    if (n < 0) throw IoError(where, std::string("read failed: ") + std::strerror(errno));
+    if (n == 0) throw InputError(where, "the file shrank while it was read");
+    done += size_t(n);
+  }
   return data;
 }
 
-// A fresh name beside `target` (its folder created): TARGET.tmp-PID-N.
-std::filesystem::path temporaryBeside(const std::filesystem::path& target) {
+// ------------------------------------------------------------------------- the interrupt cleanup table
+
+// Temporaries of writes in flight, readable from a signal handler: a fixed table of paths, each slot
+// free (0), being filled (1) or live (2). A handler unlinks only live slots.
+struct TemporarySlot {
+  std::atomic<int> state{0};
+  char path[4096];
+};
+std::array<TemporarySlot, 256> gTemporaries;
+
+int registerTemporary(const fs::path& path) {
+  const std::string text = path.string();
+  if (text.size() >= sizeof gTemporaries[0].path) return -1;
+  for (size_t i = 0; i < gTemporaries.size(); ++i) {
+    int expected = 0;
+    if (!gTemporaries[i].state.compare_exchange_strong(expected, 1)) continue;
+    std::memcpy(gTemporaries[i].path, text.c_str(), text.size() + 1);
+    gTemporaries[i].state.store(2);
+    return int(i);
+  }
+  return -1;  // more writes in flight than slots: still written, only not cleaned on a signal
+}
+
+void releaseTemporary(int slot) {
+  if (slot >= 0) gTemporaries[size_t(slot)].state.store(0);
+}
+
+extern "C" void removeTemporariesAndExit(int signal) {
+  for (TemporarySlot& slot : gTemporaries)
+    if (slot.state.load() == 2) ::unlink(slot.path);
+  ::_exit(128 + signal);
+}
+
+// Files committed by this command, removed if it fails.
+std::mutex gCommittedMutex;
+std::vector<fs::path> gCommitted;
+
+void recordCommitted(const fs::path& path) {
+  std::lock_guard<std::mutex> lock(gCommittedMutex);
+  gCommitted.push_back(path);
+}
+
+// ---------------------------------------------------------------------------------------------- outputs
+
+std::string hostName() {
+  char name[256] = {};
+  if (::gethostname(name, sizeof name - 1) != 0 || !name[0]) return "host";
+  std::string host(name);
+  for (char& c : host)
+    if (c == '-' || c == '/') c = '_';  // the name's fields are split on '-'
+  return host;
+}
+
+// Where a write to `requested` goes: a link's destination; what kind of file is there.
+struct Destination {
+  fs::path path;
+  bool direct = false;  // a device, FIFO or socket: written in place
+};
+
+Destination destinationOf(const fs::path& requested) {
+  std::error_code ec;
+  const fs::file_status status = fs::status(requested, ec);  // through any links
+  if (fs::is_directory(status))
+    throw InputError({requested.string(), 0}, "is a directory; name a file to write");
+  // A device, FIFO or socket, however reached (/dev/stdout is a link to /proc/self/fd/1): written as is.
+  if (fs::exists(status) && !fs::is_regular_file(status)) return {requested, true};
+  // A link to a file, or a dangling one: the file it names is replaced, the link stays.
+  fs::path path = requested;
+  for (int depth = 0; fs::is_symlink(fs::symlink_status(path, ec)); ++depth) {
+    if (depth == 40) throw InputError({requested.string(), 0}, "too many levels of symbolic links");
+    const fs::path to = fs::read_symlink(path, ec);
+    if (ec) throw IoError({requested.string(), 0}, "cannot follow the symbolic link: " + ec.message());
+    path = to.is_absolute() ? to : path.parent_path() / to;
+  }
+  return {path, false};
+}
+
+// Removes temporaries beside `target` that a process of this host left when it died (a kill -9, a
+// lost node): NAME.tmp-HOST-PID-N whose PID no longer runs.
+void sweepStaleTemporaries(const fs::path& target, const std::string& prefix) {
+  std::error_code ec;
+  const fs::path dir = target.parent_path().empty() ? fs::path(".") : target.parent_path();
+  for (fs::directory_iterator it(dir, ec), end; !ec && it != end; it.increment(ec)) {
+    const std::string name = it->path().filename().string();
+    if (name.compare(0, prefix.size(), prefix) != 0) continue;
+    const std::string rest = name.substr(prefix.size());  // PID-N
+    const size_t dash = rest.find('-');
+    if (dash == std::string::npos) continue;
+    char* parsed = nullptr;
+    const long pid = std::strtol(rest.c_str(), &parsed, 10);
+    if (parsed != rest.c_str() + dash || pid <= 0) continue;
+    if (::kill(pid_t(pid), 0) == 0 || errno != ESRCH) continue;  // alive, or not ours to judge
+    std::error_code ignored;
+    fs::remove(it->path(), ignored);
+  }
+}
+
+// A fresh name beside `target` (its folder created), registered for cleanup.
+fs::path temporaryBeside(const fs::path& target, int& slot) {
   static std::atomic<unsigned> counter{0};
-  std::filesystem::path dir = target.parent_path();
+  static const std::string host = hostName();
+  const fs::path dir = target.parent_path();
   if (!dir.empty()) {
     std::error_code ec;
-    std::filesystem::create_directories(dir, ec);
+    fs::create_directories(dir, ec);
     if (ec) throw IoError({dir.string(), 0}, "cannot create directory: " + ec.message());
   }
-  std::filesystem::path temporary = target;
-  temporary += ".tmp-" + std::to_string(::getpid()) + "-" + std::to_string(counter++);
+  const std::string prefix = target.filename().string() + ".tmp-" + host + "-";
+  sweepStaleTemporaries(target, prefix);
+  fs::path temporary = target;
+  temporary.replace_filename(prefix + std::to_string(::getpid()) + "-" + std::to_string(counter++));
+  slot = registerTemporary(temporary);
   return temporary;
 }
 
-void renameInto(const std::filesystem::path& temporary, const std::filesystem::path& target) {
+void renameInto(const fs::path& temporary, const fs::path& target) {
   std::error_code ec;
-  std::filesystem::rename(temporary, target, ec);
+  fs::rename(temporary, target, ec);
   if (ec) throw IoError({target.string(), 0}, "cannot rename into place: " + ec.message());
+}
+
+// Copies a finished file into a device or FIFO.
+void copyInto(const fs::path& from, const fs::path& device) {
+  std::ifstream in(from, std::ios::binary);
+  std::ofstream out(device, std::ios::binary);
+  if (!out) throw IoError({device.string(), 0}, std::string("cannot write: ") + std::strerror(errno));
+  out << in.rdbuf();
+  out.flush();
+  if (!in || !out) throw IoError({device.string(), 0}, "write failed (no space left on the device?)");
 }
 
 }  // namespace
 
-std::string readFileText(const std::filesystem::path& path) {
+void requireRegularFile(const fs::path& path) {
+  std::error_code ec;
+  const fs::file_status status = fs::status(path, ec);
+  const FileLoc where{path.string(), 0};
+  if (!fs::exists(status)) throw InputError(where, "cannot open: no such file");
+  if (fs::is_directory(status)) throw InputError(where, "is a directory, expected a file");
+  if (!fs::is_regular_file(status))
+    throw InputError(where, "is not a regular file (a FIFO, device or socket); name a file, not a stream");
+}
+
+std::string readFileText(const fs::path& path) {
   return readWhole<std::string>(path);
 }
 
-std::vector<uint8_t> readFileBytes(const std::filesystem::path& path) {
+std::vector<uint8_t> readFileBytes(const fs::path& path) {
   return readWhole<std::vector<uint8_t>>(path);
 }
 
-void writeThroughTemporary(const std::filesystem::path& target,
-                           const std::function<void(const std::filesystem::path&)>& write) {
-  const std::filesystem::path temporary = temporaryBeside(target);
-  try {
-    write(temporary);
-    renameInto(temporary, target);
-  } catch (...) {
-    std::error_code ec;
-    std::filesystem::remove(temporary, ec);
-    throw;
+AtomicFile::AtomicFile(fs::path target) {
+  const Destination destination = destinationOf(target);
+  target_ = destination.path;
+  if (!destination.direct) temporary_ = temporaryBeside(target_, slot_);
+  const fs::path& path = destination.direct ? target_ : temporary_;
+  stream_.open(path, std::ios::binary | std::ios::trunc);
+  if (!stream_) {
+    const std::string reason = std::strerror(errno);
+    releaseTemporary(slot_);
+    throw IoError({target.string(), 0}, "cannot write: " + reason);
   }
-}
-
-AtomicFile::AtomicFile(std::filesystem::path target) : target_(std::move(target)) {
-  temporary_ = temporaryBeside(target_);
-  stream_.open(temporary_, std::ios::binary | std::ios::trunc);
-  if (!stream_) throw IoError({target_.string(), 0}, std::string("cannot write: ") + std::strerror(errno));
 }
 
 AtomicFile::~AtomicFile() {
   if (committed_) return;
   stream_.close();
-  std::error_code ec;
-  std::filesystem::remove(temporary_, ec);
+  if (!temporary_.empty()) {
+    std::error_code ec;
+    fs::remove(temporary_, ec);
+  }
+  releaseTemporary(slot_);
 }
 
 void AtomicFile::commit() {
   stream_.flush();
-  bool ok = static_cast<bool>(stream_);
+  const bool ok = static_cast<bool>(stream_);
   stream_.close();
-  if (!ok || stream_.fail()) throw IoError({target_.string(), 0}, "write failed (disk full?)");
-  renameInto(temporary_, target_);
+  if (!ok || stream_.fail())
+    throw IoError({target_.string(), 0}, "write failed (no space left on the device?)");
+  if (!temporary_.empty()) {
+    renameInto(temporary_, target_);
+    recordCommitted(target_);
+  }
+  releaseTemporary(slot_);
   committed_ = true;
 }
 
-void writeFileAtomic(const std::filesystem::path& target, const void* data, size_t size) {
+void writeThroughTemporary(const fs::path& target, const std::function<void(const fs::path&)>& write) {
+  const Destination destination = destinationOf(target);
+  int slot = -1;
+  // A device's folder (/dev) is no place for a temporary: the system's temporary folder is.
+  const fs::path temporary = destination.direct
+                                 ? temporaryBeside(fs::temp_directory_path() / target.filename(), slot)
+                                 : temporaryBeside(destination.path, slot);
+  try {
+    write(temporary);
+    if (destination.direct) {
+      copyInto(temporary, destination.path);
+      fs::remove(temporary);
+    } else {
+      renameInto(temporary, destination.path);
+      recordCommitted(destination.path);
+    }
+  } catch (...) {
+    std::error_code ec;
+    fs::remove(temporary, ec);
+    releaseTemporary(slot);
+    throw;
+  }
+  releaseTemporary(slot);
+}
+
+void writeFileAtomic(const fs::path& target, const void* data, size_t size) {
   AtomicFile file(target);
   file.stream().write(static_cast<const char*>(data), static_cast<std::streamsize>(size));
   file.commit();
+}
+
+void installInterruptCleanup() {
+  static std::once_flag once;
+  std::call_once(once, [] {
+    for (int signal : {SIGINT, SIGTERM, SIGHUP}) {
+      struct sigaction current {};
+      if (::sigaction(signal, nullptr, &current) == 0 && current.sa_handler == SIG_IGN) continue;
+      struct sigaction action {};
+      action.sa_handler = removeTemporariesAndExit;
+      sigemptyset(&action.sa_mask);
+      ::sigaction(signal, &action, nullptr);
+    }
+  });
+}
+
+void discardCommittedOutputs() {
+  std::lock_guard<std::mutex> lock(gCommittedMutex);
+  for (const fs::path& path : gCommitted) {
+    std::error_code ec;
+    fs::remove(path, ec);
+  }
+  gCommitted.clear();
+}
+
+void forgetCommittedOutputs() {
+  std::lock_guard<std::mutex> lock(gCommittedMutex);
+  gCommitted.clear();
 }
 
 }  // namespace hairgen

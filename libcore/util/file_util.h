@@ -1,4 +1,17 @@
-// Whole-file reading and all-or-nothing writing.
+// Reading inputs whole and writing outputs all or nothing (DESIGN §2).
+//
+// Inputs: only regular files are read (a FIFO, device or directory named as an input is refused before
+// it is opened, so nothing waits on a pipe), and a file larger than the memory budget is refused.
+//
+// Outputs: a regular file (or a new name) is written to a temporary beside it, NAME.tmp-HOST-PID-N,
+// and renamed over it on commit. A symbolic link is followed: the file it points to is replaced, the link
+// stays. A device, FIFO or socket (`--stats /dev/stdout`, a pipe) is written directly and never
+// replaced. A directory is refused. Write errors (a full disk, /dev/full) are IoErrors (exit 1).
+//
+// Interruptions and failures: installInterruptCleanup() makes SIGINT, SIGTERM and SIGHUP remove the
+// temporaries of writes in flight and end the process with 128 + the signal; a later write beside the
+// same target removes temporaries that dead processes of this host left. A command that fails calls
+// discardCommittedOutputs(), which removes every file it had already committed.
 #pragma once
 
 #include <cstdint>
@@ -10,18 +23,18 @@
 
 namespace hairgen {
 
-// Reads a whole file. A missing or unreadable file is an InputError naming it (exit 2): the files
-// hairgen reads are its inputs.
+// Reads a whole input file. A missing, unreadable, non-regular or too large file is an InputError
+// naming it (exit 2): the files hairgen reads are its inputs.
 std::string readFileText(const std::filesystem::path& path);
 std::vector<uint8_t> readFileBytes(const std::filesystem::path& path);
 
-// Writes to a temporary file beside `target` and renames it over the target on commit(), so a failed
-// or interrupted command leaves no partial output (DESIGN §2). Destroying an uncommitted AtomicFile
-// removes the temporary.
+// For inputs a library opens by name: an InputError unless `path` is a regular file.
+void requireRegularFile(const std::filesystem::path& path);
+
 class AtomicFile {
  public:
   explicit AtomicFile(std::filesystem::path target);
-  ~AtomicFile();
+  ~AtomicFile();  // an uncommitted file's temporary is removed
   AtomicFile(const AtomicFile&) = delete;
   AtomicFile& operator=(const AtomicFile&) = delete;
 
@@ -30,15 +43,16 @@ class AtomicFile {
   void commit();
 
  private:
-  std::filesystem::path target_;
-  std::filesystem::path temporary_;
+  std::filesystem::path target_;     // the file written: a symbolic link's destination
+  std::filesystem::path temporary_;  // empty when writing a device or FIFO directly
+  int slot_ = -1;                    // the temporary's entry in the interrupt cleanup table
   std::ofstream stream_;
   bool committed_ = false;
 };
 
-// Writes `target` through a temporary file beside it that `write` fills by name (for libraries that
-// want a path, such as OpenEXR and OpenImageIO): renamed into place when `write` returns, removed
-// when it throws. Throws IoError when the rename fails.
+// Writes `target` through a file that `write` fills by name (for libraries that want a path, such as
+// OpenEXR and OpenImageIO), with the same rules as AtomicFile: renamed into place when `write` returns,
+// removed when it throws; for a device or FIFO the file's bytes are copied into it.
 void writeThroughTemporary(const std::filesystem::path& target,
                            const std::function<void(const std::filesystem::path&)>& write);
 
@@ -47,5 +61,14 @@ void writeFileAtomic(const std::filesystem::path& target, const void* data, size
 inline void writeFileAtomic(const std::filesystem::path& target, const std::string& text) {
   writeFileAtomic(target, text.data(), text.size());
 }
+
+// Installs the SIGINT, SIGTERM and SIGHUP handlers (once; a signal the parent set to be ignored stays
+// ignored).
+void installInterruptCleanup();
+
+// Removes every regular file committed since the last call of either (a failed command's outputs),
+// resp. forgets them (a command that succeeded).
+void discardCommittedOutputs();
+void forgetCommittedOutputs();
 
 }  // namespace hairgen
