@@ -51,7 +51,7 @@ Strands interpolateStage(const CommonOptions& common, const Config& config, cons
   Stopwatch clock;
   Progress progress("interpolate", "triangles", wick.triangles.size(), !common.quiet);
   Strands coupe = interpolate(wick, guides, config.hairstyle, config.collision,
-                              InterpolateOptions{config.digest(), guidesName, &progress});
+                              InterpolateOptions{config.digest(), guidesName, &progress, common.force});
   double seconds = clock.lap();
   stats.time("interpolate", seconds);
   stats.counts()["triangles"] = wick.triangles.size();

@@ -16,8 +16,8 @@
 namespace hairgen::cli {
 
 ShadeResult shadeStage(const CommonOptions& common, const Config& config, Strands coupe, Stats& stats) {
-  ShadeResult result =
-      shade(std::move(coupe), config.visuality, config.render, config.hairstyle.seed, config.digest());
+  ShadeResult result = shade(std::move(coupe), config.visuality, config.render,
+                             ShadeOptions{config.hairstyle.seed, config.digest(), common.force});
   const Strands& shaded = result.coupe;
   const Grid& grid = result.volume.density;
   stats.time("volume", result.timings.volume);

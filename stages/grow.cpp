@@ -5,9 +5,11 @@
 #include <cmath>
 
 #include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
 
 #include "libcore/util/error.h"
 #include "stages/cantilever.h"
+#include "stages/estimate.h"
 
 namespace hairgen {
 
@@ -62,6 +64,8 @@ GrowResult grow(const Mesh& wick, const Hairstyle& style, const Collision& colli
       throw InputError("wick vertex " + std::to_string(i) +
                        " has a zero or non-finite normal; a follicle needs a direction");
   }
+  requireFits(estimateGrow(style, collision, count, size_t(tbb::this_task_arena::max_concurrency())),
+              options.force);
   if (style.model == StylingModel::kCantilever) return growCantilever(wick, style, collision, options);
   const std::vector<double> envelopes = follicleEnvelopes(wick);
   GrowResult result;

@@ -17,6 +17,7 @@ namespace hairgen {
 struct GrowOptions {
   std::string configDigest;      // recorded in the guides' provenance
   Progress* progress = nullptr;  // advanced once per guide
+  bool force = false;            // run work estimated to take absurdly long (never work that cannot fit)
 };
 
 // What minimisation did for one guide.

@@ -12,6 +12,7 @@
 
 #include "libcore/util/error.h"
 #include "libcore/util/random.h"
+#include "stages/estimate.h"
 
 namespace hairgen {
 namespace {
@@ -77,6 +78,9 @@ void checkGuides(const Mesh& wick, const Strands& guides, const std::string& nam
 
 uint32_t strandsInTriangle(double areaCm2, double density, double u) {
   double n = areaCm2 * density;
+  // More than 32 bits hold is saturated, and refused by the caller's offset check; converting such a
+  // double to uint32_t would be undefined.
+  if (!(n < double(std::numeric_limits<uint32_t>::max()))) return std::numeric_limits<uint32_t>::max();
   double whole = std::floor(n);
   return static_cast<uint32_t>(whole) + (u < n - whole ? 1u : 0u);
 }
@@ -143,6 +147,11 @@ Strands interpolate(const Mesh& wick, const Strands& guides, const Hairstyle& st
                     const Collision& collision, const InterpolateOptions& options) {
   checkGuides(wick, guides, options.guidesName);
   const size_t triangleCount = wick.triangles.size();
+  size_t pointsPerGuide = 0;
+  for (size_t g = 0; g < guides.strandCount(); ++g)
+    pointsPerGuide = std::max<size_t>(pointsPerGuide, guides.pointsOf(g));
+  requireFits(estimateInterpolate(style, surfaceArea(wick) * 1e4, triangleCount, pointsPerGuide),
+              options.force);
   const uint64_t seed = style.seed;
   const std::vector<glm::vec3> guideTangents = tangentsOf(guides);
 

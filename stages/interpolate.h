@@ -19,6 +19,7 @@ struct InterpolateOptions {
   std::string configDigest;      // recorded in the coupe's provenance
   std::string guidesName;        // names the guides in error messages
   Progress* progress = nullptr;  // advanced once per triangle
+  bool force = false;            // run work estimated to take absurdly long (never work that cannot fit)
 };
 
 // Fills every wick triangle. Guide i must be the one grown from wick vertex i. The coupe is ordered by

@@ -6,6 +6,7 @@
 #include "libcore/util/error.h"
 #include "libcore/util/random.h"
 #include "libcore/util/stopwatch.h"
+#include "stages/estimate.h"
 
 namespace hairgen {
 namespace {
@@ -23,8 +24,14 @@ double strandAmbient(uint64_t seed, uint32_t strandId, double mean, double devia
   return std::max(0.0, mean + deviation * normal);
 }
 
-ShadeResult shade(Strands coupe, const Visuality& visuality, const RenderSettings& render, uint64_t seed,
-                  const std::string& configDigest) {
+ShadeResult shade(Strands coupe, const Visuality& visuality, const RenderSettings& render,
+                  const ShadeOptions& options) {
+  if (coupe.points.empty()) throw InputError("the coupe has no points to build a volume from");
+  const Bounds box = bounds(coupe.points);
+  requireFits(estimateShade(render, coupe.strandCount(), coupe.pointCount(),
+                            glm::dvec3(box.max) - glm::dvec3(box.min)),
+              options.force);
+  const uint64_t seed = options.seed;
   ShadeResult result;
   Stopwatch clock;
   result.volume = buildVolume(coupe, render.voxelSize, render.volumePadding, render.shellDensity);
@@ -41,7 +48,7 @@ ShadeResult shade(Strands coupe, const Visuality& visuality, const RenderSetting
       for (uint32_t p = out.firstPoint[s]; p < out.firstPoint[s + 1]; ++p) out.colors[p] = glm::vec3(a);
     }
   }
-  out.provenance = {"hairgen " HAIRGEN_VERSION, "shade", seed, configDigest};
+  out.provenance = {"hairgen " HAIRGEN_VERSION, "shade", seed, options.configDigest};
   result.timings.normals = clock.lap();
   return result;
 }

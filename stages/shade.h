@@ -40,11 +40,17 @@ struct ShadeResult {
   ShadeTimings timings;
 };
 
+struct ShadeOptions {
+  uint64_t seed = 0;         // keys the per-strand ambient
+  std::string configDigest;  // recorded in the coupe's provenance
+  bool force = false;        // run work estimated to take absurdly long (never work that cannot fit)
+};
+
 // Normals from the coupe's own volume (VoxelSize, VolumePadding and ShellDensity of Render Info), and
-// the ambient colours when `visuality` asks for them.
+// the ambient colours when `visuality` asks for them. The grid is estimated before it is allocated.
 // Takes the coupe by value: a caller done with it moves it in, and 10 million vertices are not copied.
-ShadeResult shade(Strands coupe, const Visuality& visuality, const RenderSettings& render, uint64_t seed,
-                  const std::string& configDigest);
+ShadeResult shade(Strands coupe, const Visuality& visuality, const RenderSettings& render,
+                  const ShadeOptions& options);
 
 // `deformed` with the normals of `rest` (a shaded coupe of the same strands) re-posed onto it, and the
 // rest's colours where `deformed` has none. InputError when the two coupes differ in strands, vertex

@@ -147,7 +147,7 @@ TEST(Shade, PerStrandAmbientHasItsMeanAndDeviationAndRepeats) {
   v.ambientMean = 0.8;
   v.ambientDeviation = 0.1;
   const RenderSettings r;
-  Strands a = shade(s, v, r, 42, "x").coupe, b = shade(s, v, r, 42, "x").coupe;
+  Strands a = shade(s, v, r, {42, "x"}).coupe, b = shade(s, v, r, {42, "x"}).coupe;
   EXPECT_TRUE(a == b);
   double sum = 0.0, sum2 = 0.0;
   for (size_t i = 0; i < a.strandCount(); ++i) {
@@ -159,7 +159,7 @@ TEST(Shade, PerStrandAmbientHasItsMeanAndDeviationAndRepeats) {
   const double mean = sum / 10000, deviation = std::sqrt(sum2 / 10000 - mean * mean);
   EXPECT_NEAR(mean, 0.8, 0.02 * 0.8);
   EXPECT_NEAR(deviation, 0.1, 0.02 * 0.1);
-  EXPECT_FALSE(a == shade(s, v, r, 43, "x").coupe);
+  EXPECT_FALSE(a == shade(s, v, r, {43, "x"}).coupe);
 }
 
 }  // namespace

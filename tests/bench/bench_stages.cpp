@@ -113,7 +113,7 @@ void ShadeCoupe3(benchmark::State& state) {
     state.PauseTiming();  // the copy `shade` takes: hairgen shade moves its coupe in
     Strands input = coupe;
     state.ResumeTiming();
-    ShadeResult r = shade(std::move(input), c.config.visuality, c.config.render, style.seed, "");
+    ShadeResult r = shade(std::move(input), c.config.visuality, c.config.render, {style.seed, ""});
     total.volume += r.timings.volume;
     total.normals += r.timings.normals;
     grid = r.volume.density.size;

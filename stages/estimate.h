@@ -1,0 +1,47 @@
+// The work a stage is about to do, estimated from the config and the sizes of its inputs before any of
+// it is done: its peak memory and a rough time on this machine. A stage refuses (InputError, exit 2)
+// work that cannot fit the memory free for it, or that would run absurdly long, naming the key to
+// change; `force` overrides the time limit, never the memory one. `hairgen check` prints the same
+// estimates, and a farm plan asks its scheduler for their memory.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <string>
+
+#include "libcore/config/params.h"
+#include "libcore/model/mesh.h"
+#include "libcore/model/strands.h"
+
+namespace hairgen {
+
+struct WorkEstimate {
+  std::string stage;      // "grow", "interpolate", "shade", "render"
+  uint64_t bytes = 0;     // peak memory of the work itself
+  double seconds = 0.0;   // rough wall time on this machine's cores
+  std::string memoryKey;  // the key that drives the memory, e.g. "Hairstyle.VisualityStep"
+  std::string timeKey;    // the key that drives the time
+  std::string detail;     // what the figures come from: "759 guides x 65 points"
+};
+
+// Beyond this a stage is stopped before it starts unless --force: an hour is far past any coupe or
+// frame hairgen's bundled configs make (the slowest takes seconds).
+inline constexpr double kTimeLimitSeconds = 3600.0;
+
+// Throws InputError when the work needs more memory than is free (memoryBudget()), or when it would
+// take longer than kTimeLimitSeconds and `force` is false.
+void requireFits(const WorkEstimate& estimate, bool force);
+
+// `threads`: the worker threads the stage may use (each holds its own scratch).
+WorkEstimate estimateGrow(const Hairstyle& style, const Collision& collision, size_t follicles, size_t threads);
+// `wickAreaCm2`: the wick's area; `pointsPerGuide`: the guides' largest vertex count.
+WorkEstimate estimateInterpolate(const Hairstyle& style, double wickAreaCm2, size_t triangles,
+                                 size_t pointsPerGuide);
+// `span`: the coupe's bounding box size, metres.
+WorkEstimate estimateShade(const RenderSettings& render, size_t strands, size_t points, const glm::dvec3& span);
+// `nearest`: the distance from the camera to the nearest point of the scene, metres; `hairLength`: the
+// longest strand, metres.
+WorkEstimate estimateRender(const RenderSettings& render, size_t strands, size_t points, size_t headTriangles,
+                            double nearest, double hairLength, int maxTextureSize);
+
+}  // namespace hairgen
