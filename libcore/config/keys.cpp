@@ -17,7 +17,9 @@ std::string join(std::initializer_list<double> values) {
   for (double v : values) out += (out.empty() ? "" : " ") + formatReal(v);
   return out;
 }
-std::string join(const glm::dvec3& v) { return join({v.x, v.y, v.z}); }
+std::string join(const glm::dvec3& v) {
+  return join({v.x, v.y, v.z});
+}
 
 // Builds the frame of an Ellipsoid or Cuboid from the three axis vectors of its config line:
 // normalised and made orthogonal (Gram-Schmidt in the given order), right-handed.
@@ -42,7 +44,8 @@ glm::dmat3 orthonormalAxes(const SectionReader& reader, const ConfigLine& line, 
 // The values after the kind: volume penalty centre, then the radius or the half-extents and axes.
 std::string shapeText(const CollisionShape& c) {
   std::string out = join({c.envelopeGrowth, c.penalty}) + " " + join(c.centre) + " " + join(c.halfExtents);
-  if (c.kind != ShapeKind::kSphere) out += " " + join(c.axes[0]) + " " + join(c.axes[1]) + " " + join(c.axes[2]);
+  if (c.kind != ShapeKind::kSphere)
+    out += " " + join(c.axes[0]) + " " + join(c.axes[1]) + " " + join(c.axes[2]);
   return out;
 }
 
@@ -123,22 +126,27 @@ Section<Setup> makeSetup() {
   };
   return makeSection<Setup>(
       "Setup", "Setup", "",
-      {notInDigest(boolKey<Setup>({"Load", "", "read the coupe from LoadFile instead of growing it"}, &Setup::load)),
+      {notInDigest(
+           boolKey<Setup>({"Load", "", "read the coupe from LoadFile instead of growing it"}, &Setup::load)),
        notInDigest(boolKey<Setup>({"Save", "", "write the coupe to SaveFile"}, &Setup::save)),
-       pathKey<Setup>({"LoadFile", "", "the coupe to load (.hair, .gltf, .glb)", {"LoadPath"}}, &Setup::loadFile),
+       pathKey<Setup>({"LoadFile", "", "the coupe to load (.hair, .gltf, .glb)", {"LoadPath"}},
+                      &Setup::loadFile),
        pathKey<Setup>({"SaveFile", "", "where to save the coupe (.hair, .gltf, .glb)", {"SavePath"}},
                       &Setup::saveFile),
        pathKey<Setup>({"HairstyleInfo", "", "the Hairstyle Info file"}, &Setup::hairstyleInfo),
        pathKey<Setup>({"CollisionInfo", "", "the Collision Info file"}, &Setup::collisionInfo),
        pathKey<Setup>({"VisualityInfo", "", "the Visuality Info file"}, &Setup::visualityInfo),
        pathKey<Setup>({"RenderInfo", "", "the Render Info file"}, &Setup::renderInfo),
-       pathKey<Setup>({"WickModel", "", "the wick OBJ: every vertex a follicle", {"HairModel"}}, &Setup::wickModel),
+       pathKey<Setup>({"WickModel", "", "the wick OBJ: every vertex a follicle", {"HairModel"}},
+                      &Setup::wickModel),
        pathKey<Setup>({"HeadModel", "", "the head OBJ: rendered, and shadows the hair"}, &Setup::headModel),
-       pathKey<Setup>({"HairVert", "", "GLSL vertex stage for the hair, in place of hairgen's (README, Shaders)"},
-                      &Setup::hairVert),
+       pathKey<Setup>(
+           {"HairVert", "", "GLSL vertex stage for the hair, in place of hairgen's (README, Shaders)"},
+           &Setup::hairVert),
        pathKey<Setup>({"HairFrag", "", "GLSL fragment stage shading the hair, in place of hairgen's"},
                       &Setup::hairFrag),
-       pathKey<Setup>({"HeadVert", "", "GLSL vertex stage for the head, in place of hairgen's"}, &Setup::headVert),
+       pathKey<Setup>({"HeadVert", "", "GLSL vertex stage for the head, in place of hairgen's"},
+                      &Setup::headVert),
        pathKey<Setup>({"HeadFrag", "", "GLSL fragment stage shading the head, in place of hairgen's"},
                       &Setup::headFrag)},
       [](SectionReader& r, Setup& s) {
@@ -156,7 +164,9 @@ Section<Setup> makeSetup() {
 
 Key<Hairstyle> hairLengthsKey() {
   return required(customKey<Hairstyle>(
-      {"HairLengths", "m", "one length per Super-Helix element (at most 256), e.g. 0.04 0.04 0.04 0.04",
+      {"HairLengths",
+       "m",
+       "one length per Super-Helix element (at most 256), e.g. 0.04 0.04 0.04 0.04",
        {"HairLength"}},
       "real ...", "(0, 10]",
       [](SectionReader& r, Hairstyle& h) {
@@ -204,8 +214,8 @@ Key<Hairstyle> forceKey() {
       [](const Hairstyle& h) {
         std::vector<std::string> lines;
         for (const ForceField& f : h.forces)
-          lines.push_back(join(f.acceleration) + " " + std::to_string(int(f.region)) + " " + formatReal(f.level) +
-                          " " + join(f.side) + " " + join(f.lo) + " " + join(f.hi));
+          lines.push_back(join(f.acceleration) + " " + std::to_string(int(f.region)) + " " +
+                          formatReal(f.level) + " " + join(f.side) + " " + join(f.lo) + " " + join(f.hi));
         return lines;
       }));
 }
@@ -232,7 +242,8 @@ Key<Hairstyle> cutKey() {
       },
       [](const Hairstyle& h) {
         std::vector<std::string> lines;
-        for (const HairCut& c : h.cuts) lines.push_back(join({c.azimuthFrom, c.azimuthTo, c.zenithMax, c.height}));
+        for (const HairCut& c : h.cuts)
+          lines.push_back(join({c.azimuthFrom, c.azimuthTo, c.zenithMax, c.height}));
         return lines;
       }));
 }
@@ -242,12 +253,13 @@ Section<Hairstyle> makeHairstyle() {
   const Range aboveZeroToOne{0.0, 1.0, true, false};
   return makeSection<H>(
       "Hairstyle", "Hairstyle Info", "HairstyleInfo",
-      {realKey<H>({"VisualityStep", "m", "arc length between output vertices"}, &H::visualityStep, aboveZeroToOne),
+      {realKey<H>({"VisualityStep", "m", "arc length between output vertices"}, &H::visualityStep,
+                  aboveZeroToOne),
        realKey<H>({"CollisionStep", "m", "arc length between collision samples"}, &H::collisionStep,
                   aboveZeroToOne),
        integerKey<H>({"MaxIter", "", "Rosenbrock stages at most"}, &H::maxIter, 1, 1000000),
-       realKey<H>({"Epsilon", "", "relative energy change between stages that ends minimisation"}, &H::epsilon,
-                  Range::positive()),
+       realKey<H>({"Epsilon", "", "relative energy change between stages that ends minimisation"},
+                  &H::epsilon, Range::positive()),
        hairLengthsKey(),
        realKey<H>({"HairDensity", "strands/cm²", "strands per square centimetre of wick"}, &H::hairDensity,
                   Range::nonNegative()),
@@ -261,29 +273,34 @@ Section<Hairstyle> makeHairstyle() {
                   Range::closed(-1000.0, 1000.0)),
        realKey<H>({"Poisson", "", "Poisson's ratio σ"}, &H::poisson, {-1.0, 0.5, true, false}),
        realKey<H>({"Young", "Pa", "Young's modulus E"}, &H::young, Range::positive()),
-       realKey<H>({"Density", "kg/m³", "mass density ρ of the hair fibre"}, &H::massDensity, Range::nonNegative()),
+       realKey<H>({"Density", "kg/m³", "mass density ρ of the hair fibre"}, &H::massDensity,
+                  Range::nonNegative()),
        realKey<H>({"Gravity", "N/kg", "gravitational acceleration g, pulling along -y"}, &H::gravity,
                   Range::closed(0.0, 1000.0)),
-       choiceKey<H, StylingModel>({"Model", "", "the styling model: Super-Helix guides or Anjyo's cantilever"},
-                                  &H::model, {StylingModel::kSuperHelix, StylingModel::kCantilever}),
-       realKey<H>({"Clump", "", "tip weights drawn in [0, Clump): 0 gathers tips at the nearest guide"}, &H::clump,
-                  Range::closed(0.0, 1.0)),
+       choiceKey<H, StylingModel>(
+           {"Model", "", "the styling model: Super-Helix guides or Anjyo's cantilever"}, &H::model,
+           {StylingModel::kSuperHelix, StylingModel::kCantilever}),
+       realKey<H>({"Clump", "", "tip weights drawn in [0, Clump): 0 gathers tips at the nearest guide"},
+                  &H::clump, Range::closed(0.0, 1.0)),
        boolKey<H>({"StrayHairs", "", "true = the thesis' barycentric assignment (§4.1.4.4)"}, &H::strayHairs),
        unsignedKey<H>({"Seed", "", "keys every random number; --seed overrides it"}, &H::seed),
        integerKey<H>({"Segments", "", "cantilever: equal segments per hair"}, &H::segments, 1, 100000),
        realKey<H>({"FlexuralRigidity", "N·m²", "cantilever: E·I; 0 = Young × π a b³/4"}, &H::flexuralRigidity,
                   Range::nonNegative()),
-       jointLimitKey(), forceKey(), cutKey()});
+       jointLimitKey(),
+       forceKey(),
+       cutKey()});
 }
 
 // ------------------------------------------------------------------------------------------ Collision
 
 Key<Collision> shapeKey(const char* name, ShapeKind kind, std::vector<std::string> aliases) {
   return repeatable(customKey<Collision>(
-      {name, "m", kind == ShapeKind::kSphere
-                      ? "a sphere: envelope growth, penalty k >= 0, centre, radius > 0"
-                      : std::string(kind == ShapeKind::kEllipsoid ? "an ellipsoid" : "a box") +
-                            ": envelope growth, penalty k >= 0, centre, half-extents > 0 along three axes",
+      {name, "m",
+       kind == ShapeKind::kSphere
+           ? "a sphere: envelope growth, penalty k >= 0, centre, radius > 0"
+           : std::string(kind == ShapeKind::kEllipsoid ? "an ellipsoid" : "a box") +
+                 ": envelope growth, penalty k >= 0, centre, half-extents > 0 along three axes",
        std::move(aliases)},
       kind == ShapeKind::kSphere ? "volume penalty cx cy cz r"
                                  : "volume penalty cx cy cz a b c ux uy uz vx vy vz wx wy wz",
@@ -307,14 +324,16 @@ Section<Collision> makeCollision() {
       [](SectionReader&, Collision& c) {
         // The shapes keep their file order whatever their kind (it is part of the output's identity):
         // the file's lines in order, then those of --set.
-        std::stable_sort(c.shapes.begin(), c.shapes.end(), [](const CollisionShape& a, const CollisionShape& b) {
-          if (a.where.file != b.where.file) return a.where.line > 0 && b.where.line == 0;
-          return a.where.line < b.where.line;
-        });
+        std::stable_sort(c.shapes.begin(), c.shapes.end(),
+                         [](const CollisionShape& a, const CollisionShape& b) {
+                           if (a.where.file != b.where.file) return a.where.line > 0 && b.where.line == 0;
+                           return a.where.line < b.where.line;
+                         });
       },
       [](const Collision& c) {
         std::vector<std::string> lines;
-        for (const CollisionShape& s : c.shapes) lines.push_back(std::string(name(s.kind)) + " " + shapeText(s));
+        for (const CollisionShape& s : c.shapes)
+          lines.push_back(std::string(name(s.kind)) + " " + shapeText(s));
         return lines;
       });
 }
@@ -326,8 +345,10 @@ Section<Visuality> makeVisuality() {
   const Range colour = Range::closed(0.0, 1000.0);
   return makeSection<V>(
       "Visuality", "Visuality Info", "VisualityInfo",
-      {vectorKey<V, 3>({"AmbientColor", "", "ambient reflectance of the hair"}, &V::ambientColor, "r g b", colour),
-       vectorKey<V, 3>({"DiffuseColor", "", "diffuse reflectance of the hair"}, &V::diffuseColor, "r g b", colour),
+      {vectorKey<V, 3>({"AmbientColor", "", "ambient reflectance of the hair"}, &V::ambientColor, "r g b",
+                       colour),
+       vectorKey<V, 3>({"DiffuseColor", "", "diffuse reflectance of the hair"}, &V::diffuseColor, "r g b",
+                       colour),
        vectorKey<V, 3>({"SpecularColor", "", "specular reflectance of the hair"}, &V::specularColor, "r g b",
                        colour),
        realKey<V>({"Glossiness", "", "specular exponent p"}, &V::glossiness, Range::closed(0.0, 100000.0)),
@@ -351,7 +372,8 @@ Key<RenderSettings> resolutionKey() {
         s.resolution = glm::ivec2(static_cast<int>(res[0]), static_cast<int>(res[1]));
       },
       [](const RenderSettings& s) {
-        return std::vector<std::string>{std::to_string(s.resolution.x) + " " + std::to_string(s.resolution.y)};
+        return std::vector<std::string>{std::to_string(s.resolution.x) + " " +
+                                        std::to_string(s.resolution.y)};
       });
 }
 
@@ -364,32 +386,41 @@ Section<RenderSettings> makeRender() {
        vectorKey<R, 3>({"CameraPosition", "m", "where the camera is"}, &R::cameraPosition, "x y z"),
        vectorKey<R, 3>({"CameraTarget", "m", "the point the camera looks at"}, &R::cameraTarget, "x y z"),
        vectorKey<R, 3>({"CameraUp", "", "the camera's up direction"}, &R::cameraUp, "x y z"),
-       realKey<R>({"FieldOfView", "degrees", "vertical field of view"}, &R::fieldOfView, {0.0, 180.0, true, true}),
+       realKey<R>({"FieldOfView", "degrees", "vertical field of view"}, &R::fieldOfView,
+                  {0.0, 180.0, true, true}),
        vectorKey<R, 3>({"LightPosition", "m", "the point light"}, &R::lightPosition, "x y z"),
-       vectorKey<R, 3>({"LightColor", "", "the light's colour and intensity"}, &R::lightColor, "r g b", colour),
+       vectorKey<R, 3>({"LightColor", "", "the light's colour and intensity"}, &R::lightColor, "r g b",
+                       colour),
        realKey<R>({"AmbientIntensity", "", "ambient light"}, &R::ambientIntensity, colour),
-       integerKey<R>({"Samples", "", "antialiasing samples per pixel (k² for k×k sub-pixels)"}, &R::samples, 1, 64),
+       integerKey<R>({"Samples", "", "antialiasing samples per pixel (k² for k×k sub-pixels)"}, &R::samples,
+                     1, 64),
        vectorKey<R, 4>({"LayerSizes", "m", "the depths of the four deep-opacity layers"}, &R::layerSizes,
                        "d1 d2 d3 d4", Range::positive()),
        realKey<R>({"StrandOpacity", "", "opacity of one strand"}, &R::strandOpacity, Range::closed(0.0, 1.0)),
-       realKey<R>({"StrandWidth", "m", "on-screen diameter of a strand"}, &R::strandWidth, {0.0, 1.0, true, false}),
-       choiceKey<R, ShadingModel>({"ShadingModel", "", "how strands are lit (README, Rendering)"}, &R::shadingModel,
+       realKey<R>({"StrandWidth", "m", "on-screen diameter of a strand"}, &R::strandWidth,
+                  {0.0, 1.0, true, false}),
+       choiceKey<R, ShadingModel>({"ShadingModel", "", "how strands are lit (README, Rendering)"},
+                                  &R::shadingModel,
                                   {ShadingModel::kKajiyaKay, ShadingModel::kThesis, ShadingModel::kAnjyo,
                                    ShadingModel::kVolumetric}),
-       vectorKey<R, 3>({"Background", "", "the preview's background colour"}, &R::background, "r g b", colour),
+       vectorKey<R, 3>({"Background", "", "the preview's background colour"}, &R::background, "r g b",
+                       colour),
        vectorKey<R, 3>({"HeadColor", "", "Lambert albedo of the head"}, &R::headColor, "r g b",
                        Range::closed(0.0, 1.0)),
-       realKey<R>({"VoxelSize", "m", "hairgen shade: spacing of the density grid (large for caches in cm or mm)"},
-                  &R::voxelSize, {0.0, 1000.0, true, false}),
-       integerKey<R>({"VolumePadding", "voxels", "hairgen shade: empty voxels around the hair"}, &R::volumePadding,
-                     1, 64),
-       realKey<R>({"ShellDensity", "", "hairgen shade: the shell's density as a fraction of a typical hair point's"},
-                  &R::shellDensity, {0.0, 100.0, true, false}),
+       realKey<R>(
+           {"VoxelSize", "m", "hairgen shade: spacing of the density grid (large for caches in cm or mm)"},
+           &R::voxelSize, {0.0, 1000.0, true, false}),
+       integerKey<R>({"VolumePadding", "voxels", "hairgen shade: empty voxels around the hair"},
+                     &R::volumePadding, 1, 64),
+       realKey<R>(
+           {"ShellDensity", "", "hairgen shade: the shell's density as a fraction of a typical hair point's"},
+           &R::shellDensity, {0.0, 100.0, true, false}),
        realKey<R>({"VolumetricBlend", "", "0 = Kajiya-Kay, 1 = volumetric"}, &R::volumetricBlend,
                   Range::closed(0.0, 1.0))},
       [](SectionReader& r, R& s) {
         if (glm::length(s.cameraTarget - s.cameraPosition) < 1e-9)
-          throw InputError(r.where("CameraTarget"), "CameraTarget equals CameraPosition; the camera needs a direction");
+          throw InputError(r.where("CameraTarget"),
+                           "CameraTarget equals CameraPosition; the camera needs a direction");
         if (glm::length(glm::cross(s.cameraUp, s.cameraTarget - s.cameraPosition)) < 1e-9)
           throw InputError(r.where("CameraUp"), "CameraUp is zero or parallel to the view direction");
       });

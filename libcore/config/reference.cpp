@@ -20,20 +20,26 @@ std::string keyReference(const SectionList& sections) {
       "# Config keys\n\n"
       "Every key hairgen reads, generated from its declaration (`libcore/config/keys.cpp`) by `hairgen check "
       "--keys`;\n`scripts/config-keys.sh` rewrites this file, and the build fails when it is stale. Keys are "
-      "case-insensitive,\n`#` starts a comment, paths are relative to the file that names them, and any value "
-      "can be overridden\nwith `--set Section.Key=VALUE`. A default is what the canonical text behind the config "
+      "case-insensitive,\n`#` starts a comment, paths are relative to the file that names them, and any "
+      "value "
+      "can be overridden\nwith `--set Section.Key=VALUE`. A default is what the canonical text behind the "
+      "config "
       "digest writes\nfor a file that leaves the key out.\n";
   for (const SectionSpec* section : sections) {
     out += "\n## " + section->title + "\n\n";
     if (section->file.empty())
       out += "The file named on the command line; `--set " + section->name + ".KEY=VALUE`.\n\n";
     else
-      out += "The file the Setup's `" + section->file + "` names; `--set " + section->name + ".KEY=VALUE`.\n\n";
+      out +=
+          "The file the Setup's `" + section->file + "` names; `--set " + section->name + ".KEY=VALUE`.\n\n";
     out += "| key | value | unit | default | meaning |\n|---|---|---|---|---|\n";
     for (const KeySpec& key : section->keys) {
       std::string value = key.value;
-      if (!key.range.empty()) value += (key.range[0] == '>' || key.range[0] == '<' ? " " : " in ") + key.range;
-      std::string defaultText = key.required ? "required" : key.defaultText.empty() ? "none" : key.defaultText;
+      if (!key.range.empty())
+        value += (key.range[0] == '>' || key.range[0] == '<' ? " " : " in ") + key.range;
+      std::string defaultText = key.required              ? "required"
+                                : key.defaultText.empty() ? "none"
+                                                          : key.defaultText;
       std::string notes;
       if (key.repeatable) notes += " Repeatable.";
       if (!notes.empty() || !key.aliases.empty() || !key.inDigest) notes = "." + notes;
@@ -43,8 +49,8 @@ std::string keyReference(const SectionList& sections) {
         notes += ".";
       }
       if (!key.inDigest) notes += " Not in the config digest.";
-      out += "| `" + key.name + "` | " + cell(value) + " | " + cell(key.unit) + " | " + cell(defaultText) + " | " +
-             cell(key.help + notes) + " |\n";
+      out += "| `" + key.name + "` | " + cell(value) + " | " + cell(key.unit) + " | " + cell(defaultText) +
+             " | " + cell(key.help + notes) + " |\n";
     }
   }
   return out;

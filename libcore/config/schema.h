@@ -88,7 +88,8 @@ std::string Section<S>::canonicalText(const S& value) const {
   }
   for (const Key<S>& key : keys) {
     if (!key.spec.inDigest) continue;
-    for (const std::string& line : key.write(value)) out += spec.name + "." + key.spec.name + " " + line + "\n";
+    for (const std::string& line : key.write(value))
+      out += spec.name + "." + key.spec.name + " " + line + "\n";
   }
   return out;
 }
