@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <iterator>
 
 #include "libcore/util/text.h"
 
@@ -400,9 +401,7 @@ Section<RenderSettings> makeRender() {
        realKey<R>({"StrandWidth", "m", "on-screen diameter of a strand"}, &R::strandWidth,
                   {0.0, 1.0, true, false}),
        choiceKey<R, ShadingModel>({"ShadingModel", "", "how strands are lit (README, Rendering)"},
-                                  &R::shadingModel,
-                                  {ShadingModel::kKajiyaKay, ShadingModel::kThesis, ShadingModel::kAnjyo,
-                                   ShadingModel::kVolumetric}),
+                                  &R::shadingModel, {std::begin(kShadingModels), std::end(kShadingModels)}),
        vectorKey<R, 3>({"Background", "", "the preview's background colour"}, &R::background, "r g b",
                        colour),
        vectorKey<R, 3>({"HeadColor", "", "Lambert albedo of the head"}, &R::headColor, "r g b",

@@ -21,7 +21,9 @@
 #include <glm/gtc/matrix_transform.hpp>
 #include <glm/gtc/type_ptr.hpp>
 
+#include "glsl/embedded_glsl.h"
 #include "libcore/render/gl_context.h"
+#include "libcore/render/shader_interface.h"
 #include "libcore/util/error.h"
 #include "libcore/util/stopwatch.h"
 
@@ -41,262 +43,6 @@ void checkGl(const char* where) {
     fail(std::string("OpenGL error ") + code + " in " + where);
   }
 }
-
-// ---------------------------------------------------------------------------------------------- GLSL
-
-// Hair points and tangents arrive as vertex attributes for lines (one vertex per point), or from
-// storage buffers for ribbons (two vertices per point; RIBBON defined).
-constexpr const char* kHairVertex = R"(
-#ifdef RIBBON
-layout(std430, binding = 0) readonly buffer Points { float pointData[]; };
-layout(std430, binding = 1) readonly buffer Tangents { float tangentData[]; };
-layout(std430, binding = 2) readonly buffer Colours { float colourData[]; };
-layout(std430, binding = 3) readonly buffer Normals { float normalData[]; };
-uniform int uHasColour;
-uniform int uHasNormal;
-#else
-layout(location = 0) in vec3 aPosition;
-layout(location = 1) in vec3 aTangent;
-layout(location = 2) in vec3 aColour;  // (1, 1, 1) when the cache has no colours
-layout(location = 3) in vec3 aNormal;  // (0, 0, 0) when the cache has no normals
-#endif
-uniform mat4 uView;
-uniform mat4 uProj;
-uniform vec2 uViewport;   // pixels
-uniform float uFocalPx;   // pixels per metre at one metre of depth
-uniform float uWidth;     // strand diameter, metres
-uniform float uOpacity;
-uniform float uMinWidth;  // pixels: the narrowest ribbon
-out vec3 vWorld;
-out vec3 vTangent;
-out vec3 vColour;
-out vec3 vNormal;
-out float vAlpha;
-out float vDepth;         // metres along the view axis
-void main() {
-#ifdef RIBBON
-  int i = gl_VertexID >> 1;
-  vec3 p = vec3(pointData[3 * i], pointData[3 * i + 1], pointData[3 * i + 2]);
-  vec3 t = vec3(tangentData[3 * i], tangentData[3 * i + 1], tangentData[3 * i + 2]);
-  vColour = uHasColour != 0 ? vec3(colourData[3 * i], colourData[3 * i + 1], colourData[3 * i + 2]) : vec3(1.0);
-  vNormal = uHasNormal != 0 ? vec3(normalData[3 * i], normalData[3 * i + 1], normalData[3 * i + 2]) : vec3(0.0);
-#else
-  vec3 p = aPosition;
-  vec3 t = aTangent;
-  vColour = aColour;
-  vNormal = aNormal;
-#endif
-  vec4 view = uView * vec4(p, 1.0);
-  vec4 clip = uProj * view;
-  float depth = -view.z;
-#ifdef RIBBON
-  float side = (gl_VertexID & 1) == 0 ? -1.0 : 1.0;
-  vec4 ahead = uProj * (view + uView * vec4(1e-3 * t, 0.0));
-  vec2 d = (ahead.xy / ahead.w - clip.xy / clip.w) * uViewport;
-  float len = length(d);
-  vec2 across = len > 1e-9 ? vec2(-d.y, d.x) / len : vec2(1.0, 0.0);
-  float widthPx = uWidth * uFocalPx / max(depth, 1e-6);
-  clip.xy += across * (side * 0.5 * max(widthPx, uMinWidth)) * 2.0 / uViewport * clip.w;
-#endif
-  gl_Position = clip;
-  vWorld = p;
-  vTangent = t;
-  vAlpha = uOpacity;
-  vDepth = depth;
-}
-)";
-
-constexpr const char* kHeadVertex = R"(#version 450 core
-layout(location = 0) in vec3 aPosition;
-layout(location = 1) in vec3 aNormal;
-uniform mat4 uView;
-uniform mat4 uProj;
-out vec3 vWorld;
-out vec3 vNormal;
-out float vDepth;
-void main() {
-  vec4 view = uView * vec4(aPosition, 1.0);
-  gl_Position = uProj * view;
-  vWorld = aPosition;
-  vNormal = aNormal;
-  vDepth = -view.z;
-}
-)";
-
-// Distance along the light's axis, for both depth maps.
-constexpr const char* kDepthFragment = R"(#version 450 core
-in float vDepth;
-layout(location = 0) out float oDepth;
-void main() { oDepth = vDepth; }
-)";
-
-// The deep opacity map: a fragment adds its opacity to its layer and every layer behind it; one past
-// the last layer counts in the last.
-constexpr const char* kOpacityFragment = R"(#version 450 core
-in float vDepth;
-in float vAlpha;
-uniform sampler2D uStart;
-uniform vec4 uLayers;
-layout(location = 0) out vec4 oOpacity;
-void main() {
-  float z0 = texelFetch(uStart, ivec2(gl_FragCoord.xy), 0).r;
-  vec4 ends = z0 + vec4(uLayers.x, uLayers.x + uLayers.y, uLayers.x + uLayers.y + uLayers.z,
-                        uLayers.x + uLayers.y + uLayers.z + uLayers.w);
-  float a = vAlpha;
-  oOpacity = vec4(vDepth < ends.x ? a : 0.0, vDepth < ends.y ? a : 0.0, vDepth < ends.z ? a : 0.0, a);
-}
-)";
-
-// Shared by the hair and head shading fragments: the light that reaches a world point.
-constexpr const char* kShadowFunction = R"(
-uniform mat4 uLightView;
-uniform mat4 uLightProj;
-uniform sampler2D uStart;
-uniform sampler2D uHeadDepth;
-uniform sampler2D uOpacityMap;
-uniform vec4 uLayers;
-uniform float uHeadBias;
-// `bias`: metres toward the light, so a surface does not shadow itself through the maps' resolution.
-float lightArriving(vec3 world, float bias) {
-  vec4 lv = uLightView * vec4(world, 1.0);
-  float z = -lv.z - bias;
-  vec4 c = uLightProj * lv;
-  vec2 uv = c.xy / c.w * 0.5 + 0.5;
-  if (any(lessThan(uv, vec2(0.0))) || any(greaterThan(uv, vec2(1.0)))) return 1.0;
-  if (z > texture(uHeadDepth, uv).r + uHeadBias) return 0.25;  // the head is in the way: opaque
-  // Over the 2×2 texels around the point: where the hair begins nearest, and each layer's largest
-  // opacity, so a strand one texel wide still shadows what lies behind it.
-  vec4 starts = textureGather(uStart, uv, 0);
-  float z0 = min(min(starts.x, starts.y), min(starts.z, starts.w));
-  vec4 g0 = textureGather(uOpacityMap, uv, 0), g1 = textureGather(uOpacityMap, uv, 1);
-  vec4 g2 = textureGather(uOpacityMap, uv, 2), g3 = textureGather(uOpacityMap, uv, 3);
-  vec4 op = vec4(max(max(g0.x, g0.y), max(g0.z, g0.w)), max(max(g1.x, g1.y), max(g1.z, g1.w)),
-                 max(max(g2.x, g2.y), max(g2.z, g2.w)), max(max(g3.x, g3.y), max(g3.z, g3.w)));
-  vec4 ends = z0 + vec4(uLayers.x, uLayers.x + uLayers.y, uLayers.x + uLayers.y + uLayers.z,
-                        uLayers.x + uLayers.y + uLayers.z + uLayers.w);
-  float s;
-  if (z <= z0) s = 0.0;
-  else if (z < ends.x) s = mix(0.0, op.r, (z - z0) / uLayers.x);
-  else if (z < ends.y) s = mix(op.r, op.g, (z - ends.x) / uLayers.y);
-  else if (z < ends.z) s = mix(op.g, op.b, (z - ends.y) / uLayers.z);
-  else if (z < ends.w) s = mix(op.b, op.a, (z - ends.z) / uLayers.w);
-  else s = op.a;
-  return 1.0 - 0.75 * clamp(s, 0.0, 1.0);
-}
-)";
-
-constexpr const char* kHairFragment = R"(
-in vec3 vWorld;
-in vec3 vTangent;
-in vec3 vColour;
-in vec3 vNormal;
-in float vAlpha;
-in float vDepth;
-uniform vec3 uEye;
-uniform vec3 uLightPosition;
-uniform vec3 uLightColor;
-uniform float uAmbient;
-uniform vec3 uAmbientColor;
-uniform vec3 uDiffuseColor;
-uniform vec3 uSpecularColor;
-uniform float uGlossiness;
-uniform int uModel;       // 0 Kajiya-Kay, 1 the thesis' variant, 2 Anjyo, 3 volumetric
-uniform float uBlend;     // volumetric: its share against Kajiya-Kay
-uniform int uBlock;       // k: sub-pixels per pixel side
-uniform int uOrder[64];   // the screen door's threshold rank of each sub-pixel of a block, row by row
-layout(location = 0) out vec4 oColor;
-layout(location = 1) out vec4 oData;  // Z, hair opacity, shadow
-void main() {
-  if (uBlock > 1) {
-    // Screen door: the sub-pixel of rank j in its k×k block keeps the fragment when alpha > (j + 0.5)/k²,
-    // so a block's coverage is alpha to within 1/k².
-    ivec2 q = ivec2(gl_FragCoord.xy) % uBlock;
-    int j = uOrder[q.y * uBlock + q.x];
-    if (vAlpha <= (float(j) + 0.5) / float(uBlock * uBlock)) discard;
-  }
-  vec3 t = normalize(vTangent);
-  vec3 l = normalize(uLightPosition - vWorld);
-  vec3 e = normalize(uEye - vWorld);
-  float tl = dot(t, l), te = dot(t, e);
-  float sinTL = sqrt(max(0.0, 1.0 - tl * tl)), sinTE = sqrt(max(0.0, 1.0 - te * te));
-  float diffuse = sinTL, specular;
-  if (uModel == 2) {
-    float th = dot(t, normalize(l + e));
-    specular = pow(max(1.0 - th * th, 0.0), 0.5 * uGlossiness);
-    diffuse = 0.0;
-  } else {
-    float cone = uModel == 1 ? abs(tl) * abs(te) + sinTL * sinTE : -tl * te + sinTL * sinTE;
-    specular = pow(max(cone, 0.0), uGlossiness);
-  }
-  float shadow = lightArriving(vWorld, 0.001);
-  vec3 colour = uAmbient * uAmbientColor * vColour +
-                shadow * uLightColor * (uDiffuseColor * vColour * diffuse + uSpecularColor * specular);
-  if (uModel == 3) {
-    // The strand as a point of the hair's surface, lit about the volume normal.
-    vec3 n = dot(vNormal, vNormal) > 0.0 ? normalize(vNormal) : vec3(0.0);
-    float surfaceDiffuse = max(dot(n, l), 0.0);
-    float phong = pow(max(dot(reflect(-l, n), e), 0.0), uGlossiness);
-    vec3 volumetric = uAmbient * uAmbientColor * vColour +
-                      shadow * uLightColor * (uDiffuseColor * vColour * surfaceDiffuse + uSpecularColor * phong);
-    colour = mix(colour, volumetric, uBlend);
-  }
-  oColor = vec4(colour, vAlpha);
-  oData = vec4(vDepth, 1.0, shadow, 0.0);
-}
-)";
-
-constexpr const char* kHeadFragment = R"(
-in vec3 vWorld;
-in vec3 vNormal;
-in float vDepth;
-uniform vec3 uLightPosition;
-uniform vec3 uLightColor;
-uniform float uAmbient;
-uniform vec3 uHeadColor;
-layout(location = 0) out vec4 oColor;
-layout(location = 1) out vec4 oData;  // Z, hair opacity, shadow
-void main() {
-  vec3 n = normalize(vNormal);
-  vec3 l = normalize(uLightPosition - vWorld);
-  // Looked up a little off the surface, so the head does not shadow itself where it faces the light.
-  float shadow = lightArriving(vWorld + 0.002 * n, 0.0);
-  vec3 colour = uAmbient * uHeadColor + shadow * uLightColor * uHeadColor * max(dot(n, l), 0.0);
-  oColor = vec4(colour, 1.0);
-  oData = vec4(vDepth, 0.0, shadow, 0.0);
-}
-)";
-
-constexpr const char* kFullscreenVertex = R"(#version 450 core
-void main() {
-  vec2 p = vec2((gl_VertexID << 1) & 2, gl_VertexID & 2);
-  gl_Position = vec4(p * 2.0 - 1.0, 0.0, 1.0);
-}
-)";
-
-// Box-filters each k×k block of sub-pixels: colour, hair opacity and shadow averaged, Z the nearest.
-constexpr const char* kResolveFragment = R"(#version 450 core
-uniform sampler2D uColor;
-uniform sampler2D uData;
-uniform int uBlock;
-layout(location = 0) out vec4 oColor;
-layout(location = 1) out vec4 oData;
-void main() {
-  ivec2 p = ivec2(gl_FragCoord.xy) * uBlock;
-  vec4 colour = vec4(0.0);
-  float z = 3.0e38, opacity = 0.0, shadow = 0.0;
-  for (int y = 0; y < uBlock; ++y)
-    for (int x = 0; x < uBlock; ++x) {
-      colour += texelFetch(uColor, p + ivec2(x, y), 0);
-      vec4 data = texelFetch(uData, p + ivec2(x, y), 0);
-      z = min(z, data.x);
-      opacity += data.y;
-      shadow += data.z;
-    }
-  float n = float(uBlock * uBlock);
-  oColor = colour / n;
-  oData = vec4(z, opacity / n, shadow / n, 0.0);
-}
-)";
 
 // ------------------------------------------------------------------------------------ GL resources
 
@@ -365,11 +111,11 @@ struct Texture {
 
 struct Framebuffer {
   GLuint id = 0, depth = 0;
-  Framebuffer(std::initializer_list<const Texture*> colours, int w, int h, bool withDepth) {
+  Framebuffer(std::initializer_list<const Texture*> colors, int w, int h, bool withDepth) {
     glCreateFramebuffers(1, &id);
     std::vector<GLenum> buffers;
     GLenum i = 0;
-    for (const Texture* t : colours) {
+    for (const Texture* t : colors) {
       glNamedFramebufferTexture(id, GL_COLOR_ATTACHMENT0 + i, t->id, 0);
       buffers.push_back(GL_COLOR_ATTACHMENT0 + i++);
     }
@@ -408,17 +154,17 @@ struct Buffer {
 // Hair on the GPU: points and tangents in storage buffers; per strand a line strip (one vertex per
 // point) or a triangle strip (two).
 struct HairGeometry {
-  Buffer points, tangents, colours, normals;
-  bool hasColours, hasNormals;
+  Buffer points, tangents, colors, normals;
+  bool hasColors, hasNormals;
   std::vector<GLint> lineFirsts, ribbonFirsts;
   std::vector<GLsizei> lineCounts, ribbonCounts;
   GLuint vao = 0;
   HairGeometry(const Strands& s, const std::vector<glm::vec3>& tangentData)
       : points(s.points.data(), s.points.size() * sizeof(glm::vec3)),
         tangents(tangentData.data(), tangentData.size() * sizeof(glm::vec3)),
-        colours(s.colors.data(), s.colors.size() * sizeof(glm::vec3)),
+        colors(s.colors.data(), s.colors.size() * sizeof(glm::vec3)),
         normals(s.normals.data(), s.normals.size() * sizeof(glm::vec3)),
-        hasColours(!s.colors.empty()),
+        hasColors(!s.colors.empty()),
         hasNormals(!s.normals.empty()) {
     for (size_t i = 0; i < s.strandCount(); ++i) {
       if (s.pointsOf(i) < 2) continue;
@@ -430,10 +176,10 @@ struct HairGeometry {
     glCreateVertexArrays(1, &vao);
     glVertexArrayVertexBuffer(vao, 0, points.id, 0, sizeof(glm::vec3));
     glVertexArrayVertexBuffer(vao, 1, tangents.id, 0, sizeof(glm::vec3));
-    glVertexArrayVertexBuffer(vao, 2, colours.id, 0, sizeof(glm::vec3));
+    glVertexArrayVertexBuffer(vao, 2, colors.id, 0, sizeof(glm::vec3));
     glVertexArrayVertexBuffer(vao, 3, normals.id, 0, sizeof(glm::vec3));
     for (GLuint a = 0; a < 4; ++a) {
-      if ((a == 2 && !hasColours) || (a == 3 && !hasNormals)) continue;  // constant attributes, set in draw()
+      if ((a == 2 && !hasColors) || (a == 3 && !hasNormals)) continue;  // constant attributes, set in draw()
       glEnableVertexArrayAttrib(vao, a);
       glVertexArrayAttribFormat(vao, a, 3, GL_FLOAT, GL_FALSE, 0);
       glVertexArrayAttribBinding(vao, a, a);
@@ -486,9 +232,9 @@ void HairGeometry::draw(bool ribbon) const {
   glBindVertexArray(vao);
   glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, points.id);
   glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, tangents.id);
-  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 2, colours.id);
+  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 2, colors.id);
   glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 3, normals.id);
-  if (!hasColours) glVertexAttrib3f(2, 1.0f, 1.0f, 1.0f);
+  if (!hasColors) glVertexAttrib3f(2, 1.0f, 1.0f, 1.0f);
   if (!hasNormals) glVertexAttrib3f(3, 0.0f, 0.0f, 0.0f);
   if (lineFirsts.empty()) return;
   if (ribbon)
@@ -648,18 +394,21 @@ RenderOutput renderHair(GlContext&, const RenderInput& in) {
   const HairGeometry hairGeometry(hair, tangentsOf(hair));
   std::unique_ptr<HeadGeometry> headGeometry;
   if (in.head && !in.head->triangles.empty()) headGeometry = std::make_unique<HeadGeometry>(*in.head);
-  const std::string v450 = "#version 450 core\n";
-  Shader hairDepth(v450 + kHairVertex, kDepthFragment, "hair depth");
-  Shader headDepth(kHeadVertex, kDepthFragment, "head depth");
-  Shader opacity(v450 + kHairVertex, kOpacityFragment, "deep opacity");
+  auto stage = [](const char* body, StagePrelude prelude = {}) { return assembleStage(prelude, body); };
+  Shader hairDepth(stage(glsl::kHairVertex), stage(glsl::kDepthFragment), "hair depth");
+  Shader headDepth(stage(glsl::kHeadVertex), stage(glsl::kDepthFragment), "head depth");
+  Shader opacity(stage(glsl::kHairVertex), stage(glsl::kOpacityFragment), "deep opacity");
   // Lines where every strand is at most a pixel and a half wide (at the scene's nearest point) and
   // there are no sub-pixels; ribbons otherwise.
   const double nearest = std::max(glm::length(scene.centre - r.cameraPosition) - scene.radius, 1e-3);
   const bool ribbons = block > 1 || r.strandWidth * camera.focalPx / nearest > 1.5;
-  Shader hairShade(v450 + (ribbons ? "#define RIBBON\n" : "") + kHairVertex,
-                   v450 + kShadowFunction + kHairFragment, "hair shading");
-  Shader headShade(kHeadVertex, v450 + kShadowFunction + kHeadFragment, "head shading");
-  Shader resolve(kFullscreenVertex, kResolveFragment, "resolve");
+  Shader hairShade(
+      stage(glsl::kHairVertex, {.ribbon = ribbons}),
+      stage(glsl::kHairFragment, {.ribbon = ribbons, .shadowFunction = true, .screenDoor = true}),
+      "hair shading");
+  Shader headShade(stage(glsl::kHeadVertex), stage(glsl::kHeadFragment, {.shadowFunction = true}),
+                   "head shading");
+  Shader resolve(stage(glsl::kFullscreenVertex), stage(glsl::kResolveFragment), "resolve");
   checkGl("setting up");
   out.timings.upload = seconds(clock);
 
@@ -709,8 +458,7 @@ RenderOutput renderHair(GlContext&, const RenderInput& in) {
     setView(opacity, light);
     setHairWidth(opacity, light, r);
     opacity.set("uLayers", glm::vec4(r.layerSizes));
-    opacity.set("uStart", 0);
-    glBindTextureUnit(0, startZ.id);
+    glBindTextureUnit(kUnitHairStart, startZ.id);
     hairGeometry.draw(false);
     glDisable(GL_BLEND);
   }
@@ -723,9 +471,9 @@ RenderOutput renderHair(GlContext&, const RenderInput& in) {
   fine.width = sw;
   fine.height = sh;
   fine.focalPx = camera.focalPx * block;
-  Texture colour(GL_RGBA16F, sw, sh), data(GL_RGBA32F, sw, sh);
+  Texture color(GL_RGBA16F, sw, sh), data(GL_RGBA32F, sw, sh);
   {
-    Framebuffer fb({&colour, &data}, sw, sh, true);
+    Framebuffer fb({&color, &data}, sw, sh, true);
     fb.bind(sw, sh);
     const float background[4] = {float(r.background.x), float(r.background.y), float(r.background.z), 0.0f};
     const float nothing[4] = {kBackgroundZ, 0.0f, 1.0f, 0.0f};
@@ -737,17 +485,13 @@ RenderOutput renderHair(GlContext&, const RenderInput& in) {
       s.set("uLightView", glm::mat4(light.view));
       s.set("uLightProj", glm::mat4(light.proj));
       s.set("uLayers", glm::vec4(r.layerSizes));
-      s.set("uHeadBias", 0.003f);
-      s.set("uStart", 0);
-      s.set("uHeadDepth", 1);
-      s.set("uOpacityMap", 2);
       s.set("uLightPosition", glm::vec3(r.lightPosition));
       s.set("uLightColor", glm::vec3(r.lightColor));
       s.set("uAmbient", float(r.ambientIntensity));
     };
-    glBindTextureUnit(0, startZ.id);
-    glBindTextureUnit(1, headZ.id);
-    glBindTextureUnit(2, opacityMap.id);
+    glBindTextureUnit(kUnitHairStart, startZ.id);
+    glBindTextureUnit(kUnitHeadDepth, headZ.id);
+    glBindTextureUnit(kUnitOpacityMap, opacityMap.id);
     if (headGeometry) {
       headShade.use();
       setView(headShade, fine);
@@ -768,26 +512,21 @@ RenderOutput renderHair(GlContext&, const RenderInput& in) {
     hairShade.set("uDiffuseColor", glm::vec3(in.visuality.diffuseColor));
     hairShade.set("uSpecularColor", glm::vec3(in.visuality.specularColor));
     hairShade.set("uGlossiness", float(in.visuality.glossiness));
-    hairShade.set("uModel", r.shadingModel == ShadingModel::kThesis       ? 1
-                            : r.shadingModel == ShadingModel::kAnjyo      ? 2
-                            : r.shadingModel == ShadingModel::kVolumetric ? 3
-                                                                          : 0);
+    hairShade.set("uModel", static_cast<int>(r.shadingModel));
     hairShade.set("uBlend", float(r.volumetricBlend));
-    hairShade.set("uHasColour", hair.colors.empty() ? 0 : 1);
+    hairShade.set("uHasColor", hair.colors.empty() ? 0 : 1);
     hairShade.set("uHasNormal", hair.normals.empty() ? 0 : 1);
     hairGeometry.draw(ribbons);
   }
-  Texture resolvedColour(GL_RGBA32F, w, h), resolvedData(GL_RGBA32F, w, h);
+  Texture resolvedColor(GL_RGBA32F, w, h), resolvedData(GL_RGBA32F, w, h);
   {
-    Framebuffer fb({&resolvedColour, &resolvedData}, w, h, false);
+    Framebuffer fb({&resolvedColor, &resolvedData}, w, h, false);
     fb.bind(w, h);
     glDisable(GL_DEPTH_TEST);
     resolve.use();
     resolve.set("uBlock", block);
-    resolve.set("uColor", 0);
-    resolve.set("uData", 1);
-    glBindTextureUnit(0, colour.id);
-    glBindTextureUnit(1, data.id);
+    glBindTextureUnit(kUnitSubpixelColor, color.id);
+    glBindTextureUnit(kUnitSubpixelData, data.id);
     glBindVertexArray(hairGeometry.vao);
     glDrawArrays(GL_TRIANGLES, 0, 3);
   }
@@ -799,7 +538,7 @@ RenderOutput renderHair(GlContext&, const RenderInput& in) {
   b.height = h;
   b.channels = {"R", "G", "B", "A", "Z", "opacity", "shadow"};
   b.planes.resize(b.channels.size());
-  readPlanes(resolvedColour.id, w, h, {&b.planes[0], &b.planes[1], &b.planes[2], &b.planes[3]});
+  readPlanes(resolvedColor.id, w, h, {&b.planes[0], &b.planes[1], &b.planes[2], &b.planes[3]});
   readPlanes(resolvedData.id, w, h, {&b.planes[4], &b.planes[5], &b.planes[6]});
   if (in.keepDom) {
     Image& d = out.dom;
