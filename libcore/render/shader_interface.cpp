@@ -57,7 +57,8 @@ std::string glslFloat(float value) {
 std::string glslConstants() {
   std::string out;
   for (ShadingModel model : kShadingModels)
-    out += "const int kShading" + camelCase(name(model)) + " = " + std::to_string(static_cast<int>(model)) + ";\n";
+    out += "const int kShading" + camelCase(name(model)) + " = " + std::to_string(static_cast<int>(model)) +
+           ";\n";
   for (int unit = 0; unit < kTextureUnitCount; ++unit)
     out += std::string("const int ") + name(TextureUnit(unit)) + " = " + std::to_string(unit) + ";\n";
   out += "const float kShadowBiasHair = " + glslFloat(kShadowBiasHair) + ";\n";
