@@ -6,6 +6,8 @@
 
 #include <glm/gtc/type_ptr.hpp>
 
+#include "libcore/render/custom_shaders.h"
+#include "libcore/render/shader_interface.h"
 #include "libcore/util/error.h"
 
 namespace hairgen {
@@ -30,23 +32,55 @@ void clearGlErrors() {
 
 // ------------------------------------------------------------------------------------------ Program
 
-Program::Program(const std::string& vertex, const std::string& fragment, const char* name) {
-  auto compile = [&](GLenum type, const std::string& text) {
-    GLuint s = glCreateShader(type);
-    const char* src = text.c_str();
-    glShaderSource(s, 1, &src, nullptr);
-    glCompileShader(s);
-    GLint ok = 0;
-    glGetShaderiv(s, GL_COMPILE_STATUS, &ok);
-    if (!ok) {
-      char log[4096];
-      glGetShaderInfoLog(s, sizeof log, nullptr, log);
-      glDeleteShader(s);
-      renderFailure(std::string("compiling the ") + name + " shader: " + log);
-    }
-    return s;
-  };
-  GLuint v = compile(GL_VERTEX_SHADER, vertex), f = compile(GL_FRAGMENT_SHADER, fragment);
+namespace {
+
+std::string infoLog(GLuint object, bool program) {
+  GLint length = 0;
+  program ? glGetProgramiv(object, GL_INFO_LOG_LENGTH, &length)
+          : glGetShaderiv(object, GL_INFO_LOG_LENGTH, &length);
+  std::string log(size_t(std::max(length, 1)), '\0');
+  program ? glGetProgramInfoLog(object, length, nullptr, log.data())
+          : glGetShaderInfoLog(object, length, nullptr, log.data());
+  return log.c_str();
+}
+
+// "HairFrag, named at setup.txt:9"
+std::string origin(const StageSource& s) {
+  std::string text = s.key;
+  if (*s.variant) text += std::string(" ") + s.variant;
+  if (!s.custom->namedAt.empty()) text += ", named at " + s.custom->namedAt;
+  return text;
+}
+
+GLuint compileStage(GLenum type, const StageSource& source, const char* program) {
+  GLuint s = glCreateShader(type);
+  const char* text = source.text.c_str();
+  glShaderSource(s, 1, &text, nullptr);
+  glCompileShader(s);
+  GLint ok = 0;
+  glGetShaderiv(s, GL_COMPILE_STATUS, &ok);
+  if (ok) return s;
+  const std::string log = infoLog(s, false);
+  glDeleteShader(s);
+  const CompilerMessage error = firstCompilerError(log);
+  if (source.custom)
+    throw InputError({source.custom->file, error.line}, error.text + " (compiling " + origin(source) + ")");
+  renderFailure(std::string("compiling the ") + program + " program's " +
+                (type == GL_VERTEX_SHADER ? "vertex" : "fragment") + " stage: line " +
+                std::to_string(error.line) + ": " + error.text);
+}
+
+}  // namespace
+
+Program::Program(const StageSource& vertex, const StageSource& fragment, const char* name) {
+  const GLuint v = compileStage(GL_VERTEX_SHADER, vertex, name);
+  GLuint f = 0;
+  try {
+    f = compileStage(GL_FRAGMENT_SHADER, fragment, name);
+  } catch (...) {
+    glDeleteShader(v);
+    throw;
+  }
   id = glCreateProgram();
   glAttachShader(id, v);
   glAttachShader(id, f);
@@ -55,28 +89,51 @@ Program::Program(const std::string& vertex, const std::string& fragment, const c
   glDeleteShader(f);
   GLint ok = 0;
   glGetProgramiv(id, GL_LINK_STATUS, &ok);
-  if (!ok) {
-    char log[4096];
-    glGetProgramInfoLog(id, sizeof log, nullptr, log);
-    glDeleteProgram(id);
-    renderFailure(std::string("linking the ") + name + " shader: " + log);
-  }
+  if (ok) return;
+  const CompilerMessage error = firstCompilerError(infoLog(id, true));
+  glDeleteProgram(id);
+  // A link error is about the two stages together: it names the custom one (the fragment stage's file
+  // when both are), and the other.
+  const StageSource* blamed = fragment.custom ? &fragment : vertex.custom ? &vertex : nullptr;
+  if (!blamed) renderFailure(std::string("linking the ") + name + " program: " + error.text);
+  const StageSource& other = blamed == &fragment ? vertex : fragment;
+  const std::string otherStage =
+      other.custom ? other.custom->file + " (" + origin(other) + ")"
+                   : std::string("hairgen's ") + (&other == &vertex ? "vertex" : "fragment") + " stage";
+  throw InputError({blamed->custom->file, 0}, error.text + " (linking " + origin(*blamed) + ", with " +
+                                                  otherStage + ", into the " + name + " program)");
 }
 
-Program::~Program() { glDeleteProgram(id); }
+Program::~Program() {
+  glDeleteProgram(id);
+}
 
-void Program::use() const { glUseProgram(id); }
+void Program::use() const {
+  glUseProgram(id);
+}
 
-GLint Program::loc(const char* name) const { return glGetUniformLocation(id, name); }
+GLint Program::loc(const char* name) const {
+  return glGetUniformLocation(id, name);
+}
 
 void Program::set(const char* name, const glm::mat4& m) const {
   glUniformMatrix4fv(loc(name), 1, GL_FALSE, glm::value_ptr(m));
 }
-void Program::set(const char* name, const glm::vec4& v) const { glUniform4fv(loc(name), 1, glm::value_ptr(v)); }
-void Program::set(const char* name, const glm::vec3& v) const { glUniform3fv(loc(name), 1, glm::value_ptr(v)); }
-void Program::set(const char* name, const glm::vec2& v) const { glUniform2fv(loc(name), 1, glm::value_ptr(v)); }
-void Program::set(const char* name, float v) const { glUniform1f(loc(name), v); }
-void Program::set(const char* name, int v) const { glUniform1i(loc(name), v); }
+void Program::set(const char* name, const glm::vec4& v) const {
+  glUniform4fv(loc(name), 1, glm::value_ptr(v));
+}
+void Program::set(const char* name, const glm::vec3& v) const {
+  glUniform3fv(loc(name), 1, glm::value_ptr(v));
+}
+void Program::set(const char* name, const glm::vec2& v) const {
+  glUniform2fv(loc(name), 1, glm::value_ptr(v));
+}
+void Program::set(const char* name, float v) const {
+  glUniform1f(loc(name), v);
+}
+void Program::set(const char* name, int v) const {
+  glUniform1i(loc(name), v);
+}
 void Program::set(const char* name, const std::vector<int>& v) const {
   glUniform1iv(loc(name), static_cast<GLsizei>(v.size()), v.data());
 }
@@ -133,7 +190,9 @@ Buffer::Buffer(const void* data, size_t bytes) {
   glNamedBufferStorage(id, static_cast<GLsizeiptr>(std::max<size_t>(bytes, 4)), bytes ? data : nullptr, 0);
 }
 
-Buffer::~Buffer() { glDeleteBuffers(1, &id); }
+Buffer::~Buffer() {
+  glDeleteBuffers(1, &id);
+}
 
 // ------------------------------------------------------------------------------------------ geometry
 
@@ -164,7 +223,9 @@ HairGeometry::HairGeometry(const Strands& s, const std::vector<glm::vec3>& tange
   }
 }
 
-HairGeometry::~HairGeometry() { glDeleteVertexArrays(1, &vao); }
+HairGeometry::~HairGeometry() {
+  glDeleteVertexArrays(1, &vao);
+}
 
 void HairGeometry::draw(bool ribbon) const {
   glBindVertexArray(vao);
@@ -188,7 +249,8 @@ HeadGeometry::HeadGeometry(const Mesh& m) {
   interleaved.reserve(m.positions.size() * 6);
   for (size_t i = 0; i < m.positions.size(); ++i) {
     const glm::vec3 n = i < m.normals.size() ? m.normals[i] : glm::vec3(0, 1, 0);
-    interleaved.insert(interleaved.end(), {m.positions[i].x, m.positions[i].y, m.positions[i].z, n.x, n.y, n.z});
+    interleaved.insert(interleaved.end(),
+                       {m.positions[i].x, m.positions[i].y, m.positions[i].z, n.x, n.y, n.z});
   }
   glCreateBuffers(1, &vbo);
   glNamedBufferStorage(vbo, static_cast<GLsizeiptr>(std::max<size_t>(interleaved.size() * 4, 4)),

@@ -24,10 +24,23 @@ void checkGl(const char* where);
 // Forgets the errors recorded before the renderer started.
 void clearGlErrors();
 
-// A linked program of a vertex and a fragment stage, each a complete GLSL text (assembleStage's).
+struct CustomStage;
+
+// One stage of a program: its complete GLSL (assembleStage's), and for a Setup's file, the file and
+// the Setup key that named it, so a compiler error can name them.
+struct StageSource {
+  std::string text;
+  const CustomStage* custom = nullptr;  // null: hairgen's own stage
+  const char* key = "";                 // "HairFrag"
+  const char* variant = "";             // what the prelude made of it, e.g. "for ribbons"; may be empty
+};
+
+// A linked program of a vertex and a fragment stage. `name` ("hair shading") is for messages. A custom
+// stage that fails to compile, or a program with one that fails to link, throws InputError at the
+// custom file and the line the compiler names, on one line; hairgen's own stages failing throw Error.
 class Program {
  public:
-  Program(const std::string& vertex, const std::string& fragment, const char* name);
+  Program(const StageSource& vertex, const StageSource& fragment, const char* name);
   ~Program();
   Program(const Program&) = delete;
   Program& operator=(const Program&) = delete;

@@ -64,18 +64,34 @@ void readPlanes(const Texture& texture, std::vector<std::vector<float>*> planes)
   }
 }
 
-std::string stage(const char* body, StagePrelude prelude = {}) { return assembleStage(prelude, body); }
+// A program's stage: `custom` in place of hairgen's `own` when the Setup names one, with the same
+// prelude either way.
+StageSource stage(const char* own, const std::optional<CustomStage>& custom = std::nullopt,
+                  const char* key = "", StagePrelude prelude = {}) {
+  StageSource s;
+  s.text = assembleStage(prelude, custom ? custom->text : std::string(own));
+  s.custom = custom ? &*custom : nullptr;
+  s.key = key;
+  s.variant = prelude.ribbon ? "for ribbons" : "";
+  return s;
+}
 
 }  // namespace
 
-Programs::Programs(bool ribbons)
-    : hairDepth(stage(glsl::kHairVertex), stage(glsl::kDepthFragment), "hair depth"),
-      headDepth(stage(glsl::kHeadVertex), stage(glsl::kDepthFragment), "head depth"),
-      opacity(stage(glsl::kHairVertex), stage(glsl::kOpacityFragment), "deep opacity"),
-      hairShade(stage(glsl::kHairVertex, {.ribbon = ribbons}),
-                stage(glsl::kHairFragment, {.ribbon = ribbons, .shadowFunction = true, .screenDoor = true}),
+Programs::Programs(bool ribbons, const CustomShaders& custom)
+    : hairDepth(stage(glsl::kHairVertex, custom.hairVert, "HairVert"), stage(glsl::kDepthFragment),
+                "hair depth"),
+      headDepth(stage(glsl::kHeadVertex, custom.headVert, "HeadVert"), stage(glsl::kDepthFragment),
+                "head depth"),
+      opacity(stage(glsl::kHairVertex, custom.hairVert, "HairVert"), stage(glsl::kOpacityFragment),
+              "deep opacity"),
+      hairShade(stage(glsl::kHairVertex, custom.hairVert, "HairVert", {.ribbon = ribbons}),
+                stage(glsl::kHairFragment, custom.hairFrag, "HairFrag",
+                      {.ribbon = ribbons, .shadowFunction = true, .screenDoor = true}),
                 "hair shading"),
-      headShade(stage(glsl::kHeadVertex), stage(glsl::kHeadFragment, {.shadowFunction = true}), "head shading"),
+      headShade(stage(glsl::kHeadVertex, custom.headVert, "HeadVert"),
+                stage(glsl::kHeadFragment, custom.headFrag, "HeadFrag", {.shadowFunction = true}),
+                "head shading"),
       resolve(stage(glsl::kFullscreenVertex), stage(glsl::kResolveFragment), "resolve") {}
 
 Scene::Scene(const RenderInput& in)
@@ -89,7 +105,7 @@ Scene::Scene(const RenderInput& in)
       ribbons(drawsRibbons(in.settings, bounds, camera, block)),
       hair(*in.hair, tangentsOf(*in.hair)),
       head(in.head && !in.head->triangles.empty() ? std::make_unique<HeadGeometry>(*in.head) : nullptr),
-      programs(ribbons) {
+      programs(ribbons, in.shaders) {
   checkGl("setting up");
 }
 

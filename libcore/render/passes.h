@@ -19,9 +19,10 @@
 
 namespace hairgen {
 
-// The programs of one render, from hairgen's stages (libcore/render/glsl/).
+// The programs of one render: hairgen's stages (libcore/render/glsl/), or the Setup's custom ones in
+// their place (HairVert in every program that draws hair, HeadVert in every one that draws the head).
 struct Programs {
-  explicit Programs(bool ribbons);
+  Programs(bool ribbons, const CustomShaders& custom);
   Program hairDepth, headDepth, opacity, hairShade, headShade, resolve;
 };
 
@@ -33,10 +34,10 @@ struct Scene {
   const RenderSettings& settings;
   const Visuality& visuality;
   BoundingSphere bounds;  // of the hair and the head
-  int block;             // k: sub-pixels per pixel side (Samples = k², as far as the device allows)
+  int block;              // k: sub-pixels per pixel side (Samples = k², as far as the device allows)
   View camera, subpixel;  // the camera on pixels and on sub-pixels
-  View light;            // domResolution texels per side
-  bool ribbons;          // the shading pass draws ribbons, not lines
+  View light;             // domResolution texels per side
+  bool ribbons;           // the shading pass draws ribbons, not lines
   HairGeometry hair;
   std::unique_ptr<HeadGeometry> head;  // null when there is no head to draw
   Programs programs;

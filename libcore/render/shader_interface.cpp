@@ -2,6 +2,8 @@
 
 #include <cctype>
 #include <charconv>
+#include <regex>
+#include <sstream>
 
 #include "glsl/embedded_glsl.h"
 #include "libcore/config/params.h"
@@ -74,6 +76,36 @@ std::string assembleStage(const StagePrelude& prelude, const std::string& body) 
   if (prelude.shadowFunction) text += glsl::kShadow;
   if (prelude.screenDoor) text += glsl::kScreenDoor;
   return text + "#line 1\n" + body;
+}
+
+CompilerMessage firstCompilerError(const std::string& log) {
+  std::istringstream lines(log);
+  std::string line, first, firstError;
+  while (std::getline(lines, line)) {
+    line.erase(0, line.find_first_not_of(" \t\r"));
+    line.erase(line.find_last_not_of(" \t\r") + 1);
+    if (line.empty()) continue;
+    if (first.empty()) first = line;
+    std::string lower = line;
+    for (char& c : lower) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+    if (lower.find("error") != std::string::npos) {
+      firstError = line;
+      break;
+    }
+  }
+  const std::string& chosen = firstError.empty() ? first : firstError;
+  // string:line(column): / string(line) : / ERROR: string:line:
+  static const std::regex mesa(R"(^\d+:(\d+)\(\d+\):\s*(.*)$)"), nvidia(R"(^\d+\((\d+)\)\s*:\s*(.*)$)"),
+      glslang(R"(^ERROR:\s*\d+:(\d+):\s*(.*)$)", std::regex::icase),
+      errorWord(R"(^error:\s*)", std::regex::icase);
+  CompilerMessage out{0, chosen};
+  std::smatch m;
+  if (std::regex_match(chosen, m, mesa) || std::regex_match(chosen, m, nvidia) ||
+      std::regex_match(chosen, m, glslang))
+    out = {std::stoi(m[1].str()), m[2].str()};
+  out.text = std::regex_replace(out.text, errorWord, "");
+  if (out.text.empty()) out.text = "the GLSL compiler gave no reason";
+  return out;
 }
 
 }  // namespace hairgen

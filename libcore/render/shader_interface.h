@@ -48,4 +48,14 @@ std::string glslConstants();
 // the compiler numbers the stage's own lines from 1; `body` follows.
 std::string assembleStage(const StagePrelude& prelude, const std::string& body);
 
+// The first error of a GLSL compiler's or linker's log, on one line: its line number (0 when the log
+// names none) and what it says, without the log's own location prefix and "error:". Reads the logs of
+// Mesa ("0:12(5): error: ..."), NVIDIA ("0(12) : error C1008: ...") and glslang-style drivers
+// ("ERROR: 0:12: ..."); another line shape comes back whole, at line 0.
+struct CompilerMessage {
+  int line = 0;
+  std::string text;
+};
+CompilerMessage firstCompilerError(const std::string& log);
+
 }  // namespace hairgen
