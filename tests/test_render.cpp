@@ -186,42 +186,71 @@ TEST(Render, AStrandBetweenTheLightAndAnotherDarkensOnlyThatOne) {
   EXPECT_GT(bPixels, 50);
 }
 
-TEST(Render, TheHeadIsDarkerUnderTheHairThanBesideIt) {
-  // A flat "head" facing up, a patch of hair 5 cm above its middle, the light above and to the +x
-  // side (so the hair's shadow falls toward −x), the camera straight above.
+// A flat "head" facing up, a patch of hair 5 cm above its middle (x from −2 to 2 cm), the light above
+// and to the +x side (so the hair's shadow falls 2.5 cm toward −x), the camera straight above.
+struct HairOverAPlane {
   Mesh head;
-  head.positions = {{-0.1f, 0, -0.1f}, {0.1f, 0, -0.1f}, {0.1f, 0, 0.1f}, {-0.1f, 0, 0.1f}};
-  head.normals.assign(4, glm::vec3(0, 1, 0));
-  head.triangles = {{0, 2, 1}, {0, 3, 2}};
   Strands hair;
-  for (int i = 0; i < 40; ++i) {
-    float x = -0.02f + 0.04f * i / 39.0f;
-    addStraight(hair, {x, 0.05f, -0.03f}, {x, 0.05f, 0.03f});
-  }
-  RenderSettings r;
-  r.resolution = {128, 128};
-  r.samples = 1;
-  r.cameraPosition = {0.0, 0.5, 0.0};
-  r.cameraTarget = {0.0, 0.0, 0.0};
-  r.cameraUp = {0.0, 0.0, -1.0};
-  r.fieldOfView = 30.0;
-  r.lightPosition = {0.5, 1.0, 0.0};
-  r.strandWidth = 0.002;
-  r.strandOpacity = 0.9;
-  RenderOutput out = renderStrands(hair, r, &head);
-  const double focal = 0.5 * 128 / std::tan(glm::radians(15.0));
-  double under = 0.0, beside = 0.0;
-  int nUnder = 0, nBeside = 0;
-  for (int y = 54; y < 74; ++y)
-    for (int x = 0; x < 128; ++x) {
-      if (out.beauty.at("opacity", x, y) != 0.0f || out.beauty.at("A", x, y) != 1.0f) continue;
-      double wx = (x + 0.5 - 64) / focal * 0.5;
-      if (wx > -0.033 && wx < -0.024) under += out.beauty.at("R", x, y), ++nUnder;
-      if (wx > 0.04 && wx < 0.06) beside += out.beauty.at("R", x, y), ++nBeside;
+  RenderSettings settings;
+  HairOverAPlane() {
+    head.positions = {{-0.1f, 0, -0.1f}, {0.1f, 0, -0.1f}, {0.1f, 0, 0.1f}, {-0.1f, 0, 0.1f}};
+    head.normals.assign(4, glm::vec3(0, 1, 0));
+    head.triangles = {{0, 2, 1}, {0, 3, 2}};
+    for (int i = 0; i < 40; ++i) {
+      float x = -0.02f + 0.04f * i / 39.0f;
+      addStraight(hair, {x, 0.05f, -0.03f}, {x, 0.05f, 0.03f});
     }
-  ASSERT_GT(nUnder, 20);
-  ASSERT_GT(nBeside, 20);
-  EXPECT_LT(under / nUnder, 0.75 * beside / nBeside);
+    settings.resolution = {128, 128};
+    settings.samples = 1;
+    settings.cameraPosition = {0.0, 0.5, 0.0};
+    settings.cameraTarget = {0.0, 0.0, 0.0};
+    settings.cameraUp = {0.0, 0.0, -1.0};
+    settings.fieldOfView = 30.0;
+    settings.lightPosition = {0.5, 1.0, 0.0};
+    settings.strandWidth = 0.002;
+    settings.strandOpacity = 0.9;
+  }
+  // The mean red of the head where no hair covers it, over x in (fromX, toX) metres of the middle rows.
+  double headRed(const RenderOutput& out, double fromX, double toX) const {
+    const double focal = 0.5 * 128 / std::tan(glm::radians(15.0));
+    double sum = 0.0;
+    int n = 0;
+    for (int y = 54; y < 74; ++y)
+      for (int x = 0; x < 128; ++x) {
+        if (out.beauty.at("opacity", x, y) != 0.0f || out.beauty.at("A", x, y) != 1.0f) continue;
+        double wx = (x + 0.5 - 64) / focal * 0.5;
+        if (wx > fromX && wx < toX) sum += out.beauty.at("R", x, y), ++n;
+      }
+    EXPECT_GT(n, 20) << "head pixels in (" << fromX << ", " << toX << ")";
+    return sum / std::max(n, 1);
+  }
+};
+
+TEST(Render, TheHeadIsDarkerUnderTheHairThanBesideIt) {
+  HairOverAPlane scene;
+  RenderOutput out = renderStrands(scene.hair, scene.settings, &scene.head);
+  EXPECT_LT(scene.headRed(out, -0.033, -0.024), 0.75 * scene.headRed(out, 0.04, 0.06));
+}
+
+// hairgen's own hair vertex stage with one line added that moves every strand 5 cm along +x: the
+// hair's shadow on the head moves with it, as the light's passes draw the moved hair too.
+TEST(Render, ACustomHairVertexMovesTheHairAndItsShadow) {
+  std::string glsl = readFileText(test::sourceDir() / "libcore/render/glsl/hair_vertex.glsl");
+  const std::string anchor = "  vec4 view = uView * vec4(p, 1.0);\n";
+  ASSERT_NE(glsl.find(anchor), std::string::npos);
+  glsl.insert(glsl.find(anchor), "  p.x += 0.05;\n");
+  test::TempDir dir("hairvert");
+  writeFileAtomic(dir / "hairvert.glsl", glsl);
+  hairgen::Setup setup;
+  setup.hairVert = {dir / "hairvert.glsl", {"setup.txt", 8}};
+  HairOverAPlane scene;
+  for (int samples : {1, 4}) {  // lines, then ribbons in the shading pass
+    scene.settings.samples = samples;
+    RenderOutput out =
+        renderStrands(scene.hair, scene.settings, &scene.head, Visuality{}, readCustomShaders(setup));
+    EXPECT_LT(scene.headRed(out, 0.017, 0.026), 0.75 * scene.headRed(out, -0.033, -0.024))
+        << samples << " samples";
+  }
 }
 
 TEST(Render, SupersamplingChangesOnlyStrandEdges) {
@@ -259,7 +288,7 @@ TEST(Render, SupersamplingChangesOnlyStrandEdges) {
 // hairgen render and run read it.
 CustomShaders customHairFrag(const test::TempDir& dir, const std::string& glsl) {
   writeFileAtomic(dir / "hairfrag.glsl", glsl);
-  Setup setup;
+  hairgen::Setup setup;
   setup.hairFrag = {dir / "hairfrag.glsl", {"setup.txt", 9}};
   return readCustomShaders(setup);
 }
