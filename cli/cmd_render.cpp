@@ -1,6 +1,5 @@
 // hairgen render SETUP --hair FILE -o image.exr: Kajiya-Kay hair with deep opacity map shadows,
 // headless through EGL, to an EXR with AOVs; --dom and --preview write the light's maps and a PNG.
-#include <cmath>
 #include <iostream>
 
 #include "cli/commands.h"
@@ -128,7 +127,7 @@ void registerRender(CLI::App& app, int& exitCode) {
       Stats stats("render");
       Stopwatch clock;
       Config config = loadStageConfig(options->setup, options->common, SetupUse::kRender, stats);
-      Strands hair = readStrands(options->hair);
+      const Strands hair = readStrands(options->hair);
       if (config.render.shadingModel == ShadingModel::kVolumetric && config.render.volumetricBlend > 0.0 &&
           hair.normals.empty())
         throw InputError({options->hair, 0},
@@ -138,12 +137,13 @@ void registerRender(CLI::App& app, int& exitCode) {
       std::optional<Mesh> head;
       if (config.setup.headModel.given()) head = readObj(config.setup.headModel.path);
       stats.time("read", clock.lap());
-      RenderOptions render;
-      render.frame = options->frame;
-      render.zUp = options->upAxis == "z";
-      render.scale = options->scale;
-      render.keepDom = !options->dom.empty();
-      RenderOutput out = renderStage(options->common, config, hair, head ? &*head : nullptr, render, stats);
+      RenderOptions renderOptions;
+      renderOptions.frame = options->frame;
+      renderOptions.zUp = options->upAxis == "z";
+      renderOptions.scale = options->scale;
+      renderOptions.keepDom = !options->dom.empty();
+      RenderOutput out =
+          renderStage(options->common, config, hair, head ? &*head : nullptr, renderOptions, stats);
       clock.lap();
       writeRenderOutputs(config, out, options->output, options->dom, options->preview);
       stats.time("write", clock.lap());
