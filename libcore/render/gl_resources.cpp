@@ -36,15 +36,19 @@ namespace {
 
 std::string infoLog(GLuint object, bool program) {
   GLint length = 0;
-  program ? glGetProgramiv(object, GL_INFO_LOG_LENGTH, &length)
-          : glGetShaderiv(object, GL_INFO_LOG_LENGTH, &length);
+  if (program)
+    glGetProgramiv(object, GL_INFO_LOG_LENGTH, &length);
+  else
+    glGetShaderiv(object, GL_INFO_LOG_LENGTH, &length);
   std::string log(size_t(std::max(length, 1)), '\0');
-  program ? glGetProgramInfoLog(object, length, nullptr, log.data())
-          : glGetShaderInfoLog(object, length, nullptr, log.data());
+  if (program)
+    glGetProgramInfoLog(object, length, nullptr, log.data());
+  else
+    glGetShaderInfoLog(object, length, nullptr, log.data());
   return log.c_str();
 }
 
-// "HairFrag, named at setup.txt:9"
+// "HairFrag for ribbons, named at setup.txt:9"
 std::string origin(const StageSource& s) {
   std::string text = s.key;
   if (*s.variant) text += std::string(" ") + s.variant;

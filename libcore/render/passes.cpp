@@ -97,12 +97,12 @@ Programs::Programs(bool ribbons, const CustomShaders& custom)
 Scene::Scene(const RenderInput& in)
     : settings(in.settings),
       visuality(in.visuality),
-      bounds(boundingSphere(*in.hair, in.head)),
+      sphere(boundingSphere(*in.hair, in.head)),
       block(subpixelBlock(in.settings)),
-      camera(cameraView(in.settings, bounds)),
+      camera(cameraView(in.settings, sphere)),
       subpixel(subpixelView(camera, block)),
-      light(lightView(in.settings, bounds, in.domResolution)),
-      ribbons(drawsRibbons(in.settings, bounds, camera, block)),
+      light(lightView(in.settings, sphere, in.domResolution)),
+      ribbons(drawsRibbons(in.settings, sphere, camera, block)),
       hair(*in.hair, tangentsOf(*in.hair)),
       head(in.head && !in.head->triangles.empty() ? std::make_unique<HeadGeometry>(*in.head) : nullptr),
       programs(ribbons, in.shaders) {

@@ -33,7 +33,7 @@ struct Scene {
 
   const RenderSettings& settings;
   const Visuality& visuality;
-  BoundingSphere bounds;  // of the hair and the head
+  BoundingSphere sphere;  // around the hair and the head
   int block;              // k: sub-pixels per pixel side (Samples = k², as far as the device allows)
   View camera, subpixel;  // the camera on pixels and on sub-pixels
   View light;             // domResolution texels per side
