@@ -145,6 +145,8 @@ void registerRender(CLI::App& app, int& exitCode) {
       RenderOutput out =
           renderStage(options->common, config, hair, head ? &*head : nullptr, renderOptions, stats);
       clock.lap();
+      // The image's config digest is that of the camera and light it was rendered with (--frame aims them).
+      config.render = out.settings;
       writeRenderOutputs(config, out, options->output, options->dom, options->preview);
       stats.time("write", clock.lap());
       note(options->common,

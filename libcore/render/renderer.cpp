@@ -36,6 +36,7 @@ RenderOutput renderHair(GlContext&, const RenderInput& in) {
   clearGlErrors();
   const Scene scene(in);
   out.samples = scene.block * scene.block;
+  out.settings = in.settings;
   out.worldToCamera = scene.camera.view;
   out.worldToNdc = scene.camera.proj * scene.camera.view;
   out.worldToLight = scene.light.proj * scene.light.view;

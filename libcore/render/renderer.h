@@ -33,7 +33,9 @@ struct RenderOutput {
   glm::dmat4 worldToCamera{1.0}, worldToNdc{1.0};
   glm::dmat4 worldToLight{1.0};
   RenderTimings timings;
-  int samples = 1;  // the samples used (Samples, clamped to what the device offers)
+  int samples = 1;          // the samples used (Samples, clamped to what the device offers)
+  RenderSettings settings;  // what was rendered: the input's, with the camera and light the render stage
+                            // aimed when asked to frame the hair
 };
 
 struct RenderInput {
