@@ -1,6 +1,5 @@
 // hairgen render SETUP --hair FILE -o image.exr: Kajiya-Kay hair with deep opacity map shadows,
 // headless through EGL, to an EXR with AOVs; --dom and --preview write the light's maps and a PNG.
-#include <cmath>
 #include <iostream>
 
 #include "cli/commands.h"
@@ -12,6 +11,7 @@
 #include "libcore/render/gl_context.h"
 #include "libcore/util/error.h"
 #include "libcore/util/text.h"
+#include "stages/render.h"
 
 namespace hairgen::cli {
 namespace {
@@ -23,55 +23,20 @@ void requireExtension(const std::string& file, const char* extension, const char
     throw InputError(std::string(flag) + " " + file + ": expected a " + extension + " file");
 }
 
-// Hair made elsewhere: z-up to y-up, and a scale to metres.
-void conform(Strands& hair, const std::string& upAxis, double scale) {
-  auto fix = [&](glm::vec3 v, bool position) {
-    if (upAxis == "z") v = glm::vec3(v.x, v.z, -v.y);
-    return position ? v * static_cast<float>(scale) : v;
-  };
-  for (glm::vec3& p : hair.points) p = fix(p, true);
-  for (glm::vec3& t : hair.tangents) t = fix(t, false);
-  for (glm::vec3& n : hair.normals) n = fix(n, false);
-  for (float& t : hair.thickness) t *= static_cast<float>(scale);
-  hair.defaultThickness *= static_cast<float>(scale);
-}
-
-// Keeps the camera's and the light's directions and distances in proportion, but aims them at the
-// hair and backs the camera off until the bounding sphere fits the view.
-void frameHair(RenderSettings& r, const Strands& hair) {
-  if (hair.points.empty()) return;
-  const Bounds box = bounds(hair.points);
-  const glm::dvec3 lo(box.min), hi(box.max);
-  const glm::dvec3 centre = (lo + hi) * 0.5;
-  const double radius = std::max(glm::length(hi - lo) * 0.5, 1e-3);
-  const double fov = glm::radians(r.fieldOfView) * std::min(1.0, double(r.resolution.x) / r.resolution.y);
-  const double distance = radius / std::sin(0.5 * fov) * 1.05;
-  glm::dvec3 view = r.cameraPosition - r.cameraTarget, toLight = r.lightPosition - r.cameraTarget;
-  double lightRatio = glm::length(toLight) / std::max(glm::length(view), 1e-9);
-  r.cameraTarget = centre;
-  r.cameraPosition = centre + glm::normalize(view) * distance;
-  r.lightPosition = centre + glm::normalize(toLight) * distance * lightRatio;
-}
-
 }  // namespace
 
 RenderOutput renderStage(const CommonOptions& common, const Config& config, const Strands& hair,
-                         const Mesh* head, bool keepDom, Stats& stats) {
+                         const Mesh* head, const RenderOptions& options, Stats& stats) {
   Stopwatch clock;
+  const CustomShaders shaders = readCustomShaders(config.setup);
+  stats.add("read", clock.lap());
   GlContext gl;
   stats.time("device", clock.lap());
   note(common, "render: " + gl.renderer() + " through EGL " + gl.platform() + ", " +
                    std::to_string(hair.strandCount()) + " strands at " +
                    std::to_string(config.render.resolution.x) + "x" +
                    std::to_string(config.render.resolution.y));
-  RenderInput input;
-  input.hair = &hair;
-  input.head = head;
-  input.visuality = config.visuality;
-  input.settings = config.render;
-  input.domResolution = domResolutionFor(config.render.resolution);
-  input.keepDom = keepDom;
-  RenderOutput out = renderHair(gl, input);
+  RenderOutput out = render(gl, hair, head, config.visuality, config.render, shaders, options);
   stats.time("upload", out.timings.upload);
   stats.time("lightDepth", out.timings.lightDepth);
   stats.time("opacity", out.timings.opacity);
@@ -162,21 +127,26 @@ void registerRender(CLI::App& app, int& exitCode) {
       Stats stats("render");
       Stopwatch clock;
       Config config = loadStageConfig(options->setup, options->common, SetupUse::kRender, stats);
-      Strands hair = readStrands(options->hair);
+      const Strands hair = readStrands(options->hair);
       if (config.render.shadingModel == ShadingModel::kVolumetric && config.render.volumetricBlend > 0.0 &&
           hair.normals.empty())
         throw InputError({options->hair, 0},
                          "ShadingModel volumetric needs the coupe's volume normals, and this one has "
                          "none; run `hairgen shade SETUP --hair " +
                              options->hair + " -o shaded.hair` and render that");
-      conform(hair, options->upAxis, options->scale);
       std::optional<Mesh> head;
       if (config.setup.headModel.given()) head = readObj(config.setup.headModel.path);
-      if (options->frame) frameHair(config.render, hair);
       stats.time("read", clock.lap());
+      RenderOptions renderOptions;
+      renderOptions.frame = options->frame;
+      renderOptions.zUp = options->upAxis == "z";
+      renderOptions.scale = options->scale;
+      renderOptions.keepDom = !options->dom.empty();
       RenderOutput out =
-          renderStage(options->common, config, hair, head ? &*head : nullptr, !options->dom.empty(), stats);
+          renderStage(options->common, config, hair, head ? &*head : nullptr, renderOptions, stats);
       clock.lap();
+      // The image's config digest is that of the camera and light it was rendered with (--frame aims them).
+      config.render = out.settings;
       writeRenderOutputs(config, out, options->output, options->dom, options->preview);
       stats.time("write", clock.lap());
       note(options->common,

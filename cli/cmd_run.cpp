@@ -107,8 +107,7 @@ void registerRun(CLI::App& app, int& exitCode) {
       if (!options->noRender) {
         std::optional<Mesh> head;
         if (config.setup.headModel.given()) head = readObj(config.setup.headModel.path);
-        RenderOutput image =
-            renderStage(options->common, config, coupe, head ? &*head : nullptr, false, stats);
+        RenderOutput image = renderStage(options->common, config, coupe, head ? &*head : nullptr, {}, stats);
         clock.lap();
         writeRenderOutputs(config, image, (out / "beauty.exr").string(), "", (out / "beauty.png").string());
         stats.add("write", clock.lap());

@@ -11,8 +11,8 @@
 #include "libcore/config/params.h"
 #include "libcore/model/mesh.h"
 #include "libcore/model/strands.h"
-#include "libcore/render/renderer.h"
 #include "stages/grow.h"
+#include "stages/render.h"
 #include "stages/shade.h"
 
 namespace hairgen::cli {
@@ -32,8 +32,10 @@ GrowResult growStage(const CommonOptions& common, const Config& config, const Me
 Strands interpolateStage(const CommonOptions& common, const Config& config, const Mesh& wick,
                          const Strands& guides, const std::string& guidesName, Stats& stats);
 ShadeResult shadeStage(const CommonOptions& common, const Config& config, Strands coupe, Stats& stats);
+// Opens the device, reads the Setup's custom shader files and calls the render stage; records the
+// device and the passes' times in `stats`.
 RenderOutput renderStage(const CommonOptions& common, const Config& config, const Strands& hair,
-                         const Mesh* head, bool keepDom, Stats& stats);
+                         const Mesh* head, const RenderOptions& options, Stats& stats);
 // Writes the EXR, and the light's maps and the preview where named (empty: not wanted).
 void writeRenderOutputs(const Config& config, const RenderOutput& out, const std::string& exr,
                         const std::string& dom, const std::string& preview);

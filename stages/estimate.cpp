@@ -16,7 +16,9 @@ namespace {
 // Rosenbrock sweeps over the directions per stage: each stage goes on until every direction has had a
 // success and a failure, which takes longer the more directions there are (measured on the default
 // coupe: 2.6 sweeps at 4 elements; about 60 at 64 and 300 at 256).
-double sweepsPerStage(double elements) { return 5.0 * std::max(1.0, elements / 4.0); }
+double sweepsPerStage(double elements) {
+  return 5.0 * std::max(1.0, elements / 4.0);
+}
 // One energy evaluation: per Super-Helix element (frame, closed forms) and per collision sample and
 // shape (GrowCoupe3 benchmark: 1 µs for 4 elements, 32 samples and 2 shapes).
 constexpr double kSecondsPerElement = 60e-9, kSecondsPerSample = 12e-9;
@@ -28,7 +30,9 @@ constexpr double kSecondsPerNode = 500e-9, kSecondsPerSplat = 60e-9;
 // llvmpipe: per vertex pushed through a pass, and per fragment shaded (render benchmarks).
 constexpr double kSecondsPerVertex = 150e-9, kSecondsPerFragment = 8e-9;
 
-double cores(size_t threads) { return double(std::max<size_t>(threads, 1)); }
+double cores(size_t threads) {
+  return double(std::max<size_t>(threads, 1));
+}
 
 std::string seconds(double s) {
   char text[32];
@@ -44,7 +48,9 @@ std::string seconds(double s) {
 }
 
 // Saturating conversions: an estimate of 1e30 bytes is still a refusal, not a wrapped small number.
-uint64_t bytesOf(double b) { return b >= 1.8e19 ? UINT64_MAX : uint64_t(std::max(b, 0.0)); }
+uint64_t bytesOf(double b) {
+  return b >= 1.8e19 ? UINT64_MAX : uint64_t(std::max(b, 0.0));
+}
 
 }  // namespace
 
@@ -52,20 +58,22 @@ void requireFits(const WorkEstimate& e, bool force) {
   const uint64_t budget = memoryBudget();
   if (e.bytes > budget)
     throw InputError(e.stage + " would need about " + formatBytes(e.bytes) + " of memory (" + e.detail +
-                     "), more than the " + formatBytes(budget) + " free on this machine; change " + e.memoryKey);
+                     "), more than the " + formatBytes(budget) + " free on this machine; change " +
+                     e.memoryKey);
   if (e.seconds > kTimeLimitSeconds && !force)
     throw InputError(e.stage + " would take about " + seconds(e.seconds) + " (" + e.detail + "); change " +
                      e.timeKey + ", or pass --force to run it anyway");
 }
 
-WorkEstimate estimateGrow(const Hairstyle& style, const Collision& collision, size_t follicles, size_t threads) {
+WorkEstimate estimateGrow(const Hairstyle& style, const Collision& collision, size_t follicles,
+                          size_t threads) {
   WorkEstimate e;
   e.stage = "grow";
   const double length = style.totalLength();
   const double guides = double(follicles);
   if (style.model == StylingModel::kCantilever) {
     const double nodes = double(style.segments) + 1.0;
-    e.bytes = bytesOf(guides * nodes * (24.0 + 48.0));  // the guides, and each hair's nodes in doubles
+    e.bytes = bytesOf(guides * nodes * (24.0 + 48.0));     // the guides, and each hair's nodes in doubles
     e.seconds = guides * nodes * 200e-9 / cores(threads);  // a bend and a collision bisection per node
     e.memoryKey = e.timeKey = "Hairstyle.Segments";
     e.detail = formatReal(guides) + " hairs x " + formatReal(nodes) + " nodes";
@@ -106,7 +114,8 @@ WorkEstimate estimateInterpolate(const Hairstyle& style, double wickAreaCm2, siz
   return e;
 }
 
-WorkEstimate estimateShade(const RenderSettings& render, size_t strands, size_t points, const glm::dvec3& span) {
+WorkEstimate estimateShade(const RenderSettings& render, size_t strands, size_t points,
+                           const glm::dvec3& span) {
   WorkEstimate e;
   e.stage = "shade";
   const glm::dvec3 nodes = glm::ceil(span / render.voxelSize) + 1.0 + 2.0 * double(render.volumePadding);
@@ -131,7 +140,8 @@ WorkEstimate estimateRender(const RenderSettings& r, size_t strands, size_t poin
   const int dom = std::clamp(std::max(r.resolution.x, r.resolution.y) / 2, 1024, 4096);
   // The shading targets (RGBA16F colour, RGBA32F data, 24-bit depth) at the sub-pixel resolution, the
   // resolved pair and the planes read back, the light's maps, and the hair and head on the device.
-  const double framebuffers = fine * (8.0 + 16.0 + 4.0) + pixels * (32.0 + 7 * 4.0) + double(dom) * dom * 28.0;
+  const double framebuffers =
+      fine * (8.0 + 16.0 + 4.0) + pixels * (32.0 + 7 * 4.0) + double(dom) * dom * 28.0;
   const double geometry = double(points) * 48.0 * 2.0 + double(strands) * 16.0 + double(headTriangles) * 36.0;
   e.bytes = bytesOf(framebuffers + geometry);
   e.memoryKey = framebuffers >= geometry ? "Render.Resolution or Render.Samples" : "the coupe's size";

@@ -33,12 +33,14 @@ inline constexpr double kTimeLimitSeconds = 3600.0;
 void requireFits(const WorkEstimate& estimate, bool force);
 
 // `threads`: the worker threads the stage may use (each holds its own scratch).
-WorkEstimate estimateGrow(const Hairstyle& style, const Collision& collision, size_t follicles, size_t threads);
+WorkEstimate estimateGrow(const Hairstyle& style, const Collision& collision, size_t follicles,
+                          size_t threads);
 // `wickAreaCm2`: the wick's area; `pointsPerGuide`: the guides' largest vertex count.
 WorkEstimate estimateInterpolate(const Hairstyle& style, double wickAreaCm2, size_t triangles,
                                  size_t pointsPerGuide);
 // `span`: the coupe's bounding box size, metres.
-WorkEstimate estimateShade(const RenderSettings& render, size_t strands, size_t points, const glm::dvec3& span);
+WorkEstimate estimateShade(const RenderSettings& render, size_t strands, size_t points,
+                           const glm::dvec3& span);
 // `nearest`: the distance from the camera to the nearest point of the scene, metres; `hairLength`: the
 // longest strand, metres.
 WorkEstimate estimateRender(const RenderSettings& render, size_t strands, size_t points, size_t headTriangles,

@@ -132,6 +132,38 @@ render_errors)
   expect_rc 0 "$hairgen" render --list-devices
   grep -q "opens" "$tmp/out" || fail "no device opens: $(cat "$tmp/out")"
   ;;
+render_shader_errors)
+  # A Setup's HairFrag that does not compile: exit 2 at the file's line, naming the Setup line, and no
+  # image; fixed, the same commands render with it.
+  c2="$src/configs/thesis/coupe2"
+  printf 'HairstyleInfo %s\nCollisionInfo %s\nVisualityInfo %s\nRenderInfo %s\nHeadModel %s\nWickModel %s\nHairFrag hairfrag.glsl\n' \
+    "$c2/hairstyle.txt" "$c2/collision.txt" "$c2/visuality.txt" "$c2/render.txt" \
+    "$src/configs/assets/head.obj" "$src/configs/assets/wick.obj" > "$tmp/setup.txt"
+  printf 'layout(location = 0) out vec4 oColor;\nlayout(location = 1) out vec4 oData;\nvoid main() {\n  oColor = vec4(foo);\n  oData = vec4(0.0);\n}\n' \
+    > "$tmp/hairfrag.glsl"
+  small=(--set "Render.Resolution=48 48" --set Hairstyle.HairDensity=5 --quiet)
+  expect_rc 0 "$hairgen" run "$tmp/setup.txt" -o "$tmp/coupe" --no-render "${small[@]}"
+  expect_rc 2 "$hairgen" run "$tmp/setup.txt" -o "$tmp/run" "${small[@]}"
+  [ "$(wc -l < "$tmp/err")" -eq 1 ] || fail "not one line: $(cat "$tmp/err")"
+  grep -q "^hairgen run: error: $tmp/hairfrag.glsl:4: .*foo.*(compiling HairFrag.*, named at $tmp/setup.txt:7)$" "$tmp/err" \
+    || fail "file and line not named: $(cat "$tmp/err")"
+  [ -z "$(ls -A "$tmp/run")" ] || fail "a failed run left outputs: $(ls "$tmp/run")"
+  expect_rc 2 "$hairgen" render "$tmp/setup.txt" --hair "$tmp/coupe/coupe.hair" -o "$tmp/i.exr" "${small[@]}"
+  grep -q "^hairgen render: error: $tmp/hairfrag.glsl:4: " "$tmp/err" || fail "render: $(cat "$tmp/err")"
+  [ ! -e "$tmp/i.exr" ] || fail "render wrote an image after a shader error"
+  [ -z "$(ls "$tmp" "$tmp/run" | grep tmp-)" ] || fail "a temporary file was left behind"
+  printf 'in float vAlpha;\nin float vDepth;\nlayout(location = 0) out vec4 oColor;\nlayout(location = 1) out vec4 oData;\nvoid main() {\n  screenDoor(vAlpha);\n  oColor = vec4(1.0, 0.0, 0.0, vAlpha);\n  oData = vec4(vDepth, 1.0, lightArriving(vec3(0.0), kShadowBiasHair), 0.0);\n}\n' \
+    > "$tmp/hairfrag.glsl"
+  expect_rc 0 "$hairgen" render "$tmp/setup.txt" --hair "$tmp/coupe/coupe.hair" -o "$tmp/i.exr" "${small[@]}"
+  [ -s "$tmp/i.exr" ] || fail "no image from a working HairFrag"
+  # A shader file that is not there is reported before anything runs, as `check` does for the thesis'
+  # Appendix B Setup.
+  sed -i 's/^HairFrag .*/HairFrag missing.glsl/' "$tmp/setup.txt"
+  expect_rc 2 "$hairgen" check "$tmp/setup.txt"
+  grep -q "setup.txt:7: HairFrag names '.*missing.glsl', which does not exist" "$tmp/err" || fail "missing: $(cat "$tmp/err")"
+  expect_rc 2 "$hairgen" check "$src/configs/thesis/appendix-b/setup.txt"
+  grep -q "which does not exist" "$tmp/err" || fail "appendix-b: $(cat "$tmp/err")"
+  ;;
 render_diff)
   expect_rc 0 "$hairgen" grow "$src/configs/thesis/coupe2/setup.txt" -o "$tmp/g.hair" --quiet
   small=(--set "Render.Resolution=96 96" --quiet)

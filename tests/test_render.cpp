@@ -1,10 +1,14 @@
 // The renderer on llvmpipe (or a GPU): each shading model against the CPU formula, deep-opacity shadows
-// between strands and onto the head, the background's AOVs, and what supersampling changes.
+// between strands and onto the head, the background's AOVs, what supersampling changes, a Setup's
+// custom shaders, and the stage's framing and conforming of foreign hair.
 #include <gtest/gtest.h>
 
 #include "libcore/render/gl_context.h"
-#include "libcore/render/renderer.h"
+#include "libcore/render/shader_interface.h"
 #include "libcore/render/shading.h"
+#include "libcore/util/file_util.h"
+#include "stages/render.h"
+#include "tests/test_util.h"
 
 namespace hairgen {
 namespace {
@@ -34,15 +38,12 @@ RenderSettings frontCamera(int size, int samples) {
   return r;
 }
 
-RenderOutput render(const Strands& hair, const RenderSettings& r, const Mesh* head = nullptr,
-                    const Visuality& v = Visuality{}) {
-  RenderInput in;
-  in.hair = &hair;
-  in.head = head;
-  in.settings = r;
-  in.visuality = v;
-  in.domResolution = 512;
-  return renderHair(gl(), in);
+// Through the render stage, as hairgen render and run call it, with light maps of 512 texels.
+RenderOutput renderStrands(const Strands& hair, const RenderSettings& r, const Mesh* head = nullptr,
+                           const Visuality& v = Visuality{}, const CustomShaders& shaders = {}) {
+  RenderOptions options;
+  options.domResolution = 512;
+  return render(gl(), hair, head, v, r, shaders, options);
 }
 
 // The world point on the plane z = 0 seen through the centre of pixel (x, y) by frontCamera.
@@ -64,7 +65,7 @@ int compareStrandWithCpu(RenderSettings r, const glm::dvec3& normal) {
   Visuality v;
   v.glossiness = 20.0;
   v.specularColor = {0.6, 0.6, 0.6};
-  RenderOutput out = render(s, r, nullptr, v);
+  RenderOutput out = renderStrands(s, r, nullptr, v);
   int checked = 0;
   for (int y = 0; y < r.resolution.y; ++y)
     for (int x = 0; x < r.resolution.x; ++x) {
@@ -122,12 +123,12 @@ TEST(Render, VolumetricWithBlendZeroIsKajiyaKay) {
     RenderSettings r = frontCamera(96, samples);
     r.strandWidth = 0.0002;
     r.lightPosition = {0.2, 0.3, 0.2};
-    RenderOutput kajiyaKay = render(s, r);
+    RenderOutput kajiyaKay = renderStrands(s, r);
     r.shadingModel = ShadingModel::kVolumetric;
     r.volumetricBlend = 0.0;
-    RenderOutput volumetric = render(s, r);
+    RenderOutput volumetric = renderStrands(s, r);
     r.volumetricBlend = 1.0;
-    RenderOutput full = render(s, r);
+    RenderOutput full = renderStrands(s, r);
     double worst = 0.0, fullDiffers = 0.0;
     for (int y = 0; y < 96; ++y)
       for (int x = 0; x < 96; ++x)
@@ -147,7 +148,7 @@ TEST(Render, BackgroundPixelsHaveNoOpacityAndTheBackgroundZ) {
   Strands s;
   addStraight(s, {-0.02f, 0, 0}, {0.02f, 0, 0});
   RenderSettings r = frontCamera(64, 4);
-  RenderOutput out = render(s, r);
+  RenderOutput out = renderStrands(s, r);
   EXPECT_EQ(out.beauty.at("opacity", 0, 0), 0.0f);
   EXPECT_EQ(out.beauty.at("A", 0, 0), 0.0f);
   EXPECT_EQ(out.beauty.at("Z", 0, 0), kBackgroundZ);
@@ -167,7 +168,7 @@ TEST(Render, AStrandBetweenTheLightAndAnotherDarkensOnlyThatOne) {
   addStraight(both, {-0.04f, 0.0f, 0}, {0.04f, 0.0f, 0});
   addStraight(aAlone, {-0.04f, 0.02f, 0}, {0.04f, 0.02f, 0});
   addStraight(bAlone, {-0.04f, 0.0f, 0}, {0.04f, 0.0f, 0});
-  RenderOutput all = render(both, r), a = render(aAlone, r), b = render(bAlone, r);
+  RenderOutput all = renderStrands(both, r), a = renderStrands(aAlone, r), b = renderStrands(bAlone, r);
   int aPixels = 0, bPixels = 0;
   for (int y = 0; y < 96; ++y)
     for (int x = 20; x < 76; ++x) {
@@ -185,42 +186,71 @@ TEST(Render, AStrandBetweenTheLightAndAnotherDarkensOnlyThatOne) {
   EXPECT_GT(bPixels, 50);
 }
 
-TEST(Render, TheHeadIsDarkerUnderTheHairThanBesideIt) {
-  // A flat "head" facing up, a patch of hair 5 cm above its middle, the light above and to the +x
-  // side (so the hair's shadow falls toward −x), the camera straight above.
+// A flat "head" facing up, a patch of hair 5 cm above its middle (x from −2 to 2 cm), the light above
+// and to the +x side (so the hair's shadow falls 2.5 cm toward −x), the camera straight above.
+struct HairOverAPlane {
   Mesh head;
-  head.positions = {{-0.1f, 0, -0.1f}, {0.1f, 0, -0.1f}, {0.1f, 0, 0.1f}, {-0.1f, 0, 0.1f}};
-  head.normals.assign(4, glm::vec3(0, 1, 0));
-  head.triangles = {{0, 2, 1}, {0, 3, 2}};
   Strands hair;
-  for (int i = 0; i < 40; ++i) {
-    float x = -0.02f + 0.04f * i / 39.0f;
-    addStraight(hair, {x, 0.05f, -0.03f}, {x, 0.05f, 0.03f});
-  }
-  RenderSettings r;
-  r.resolution = {128, 128};
-  r.samples = 1;
-  r.cameraPosition = {0.0, 0.5, 0.0};
-  r.cameraTarget = {0.0, 0.0, 0.0};
-  r.cameraUp = {0.0, 0.0, -1.0};
-  r.fieldOfView = 30.0;
-  r.lightPosition = {0.5, 1.0, 0.0};
-  r.strandWidth = 0.002;
-  r.strandOpacity = 0.9;
-  RenderOutput out = render(hair, r, &head);
-  const double focal = 0.5 * 128 / std::tan(glm::radians(15.0));
-  double under = 0.0, beside = 0.0;
-  int nUnder = 0, nBeside = 0;
-  for (int y = 54; y < 74; ++y)
-    for (int x = 0; x < 128; ++x) {
-      if (out.beauty.at("opacity", x, y) != 0.0f || out.beauty.at("A", x, y) != 1.0f) continue;
-      double wx = (x + 0.5 - 64) / focal * 0.5;
-      if (wx > -0.033 && wx < -0.024) under += out.beauty.at("R", x, y), ++nUnder;
-      if (wx > 0.04 && wx < 0.06) beside += out.beauty.at("R", x, y), ++nBeside;
+  RenderSettings settings;
+  HairOverAPlane() {
+    head.positions = {{-0.1f, 0, -0.1f}, {0.1f, 0, -0.1f}, {0.1f, 0, 0.1f}, {-0.1f, 0, 0.1f}};
+    head.normals.assign(4, glm::vec3(0, 1, 0));
+    head.triangles = {{0, 2, 1}, {0, 3, 2}};
+    for (int i = 0; i < 40; ++i) {
+      float x = -0.02f + 0.04f * i / 39.0f;
+      addStraight(hair, {x, 0.05f, -0.03f}, {x, 0.05f, 0.03f});
     }
-  ASSERT_GT(nUnder, 20);
-  ASSERT_GT(nBeside, 20);
-  EXPECT_LT(under / nUnder, 0.75 * beside / nBeside);
+    settings.resolution = {128, 128};
+    settings.samples = 1;
+    settings.cameraPosition = {0.0, 0.5, 0.0};
+    settings.cameraTarget = {0.0, 0.0, 0.0};
+    settings.cameraUp = {0.0, 0.0, -1.0};
+    settings.fieldOfView = 30.0;
+    settings.lightPosition = {0.5, 1.0, 0.0};
+    settings.strandWidth = 0.002;
+    settings.strandOpacity = 0.9;
+  }
+  // The mean red of the head where no hair covers it, over x in (fromX, toX) metres of the middle rows.
+  double headRed(const RenderOutput& out, double fromX, double toX) const {
+    const double focal = 0.5 * 128 / std::tan(glm::radians(15.0));
+    double sum = 0.0;
+    int n = 0;
+    for (int y = 54; y < 74; ++y)
+      for (int x = 0; x < 128; ++x) {
+        if (out.beauty.at("opacity", x, y) != 0.0f || out.beauty.at("A", x, y) != 1.0f) continue;
+        double wx = (x + 0.5 - 64) / focal * 0.5;
+        if (wx > fromX && wx < toX) sum += out.beauty.at("R", x, y), ++n;
+      }
+    EXPECT_GT(n, 20) << "head pixels in (" << fromX << ", " << toX << ")";
+    return sum / std::max(n, 1);
+  }
+};
+
+TEST(Render, TheHeadIsDarkerUnderTheHairThanBesideIt) {
+  HairOverAPlane scene;
+  RenderOutput out = renderStrands(scene.hair, scene.settings, &scene.head);
+  EXPECT_LT(scene.headRed(out, -0.033, -0.024), 0.75 * scene.headRed(out, 0.04, 0.06));
+}
+
+// hairgen's own hair vertex stage with one line added that moves every strand 5 cm along +x: the
+// hair's shadow on the head moves with it, as the light's passes draw the moved hair too.
+TEST(Render, ACustomHairVertexMovesTheHairAndItsShadow) {
+  std::string glsl = readFileText(test::sourceDir() / "libcore/render/glsl/hair_vertex.glsl");
+  const std::string anchor = "  vec4 view = uView * vec4(p, 1.0);\n";
+  ASSERT_NE(glsl.find(anchor), std::string::npos);
+  glsl.insert(glsl.find(anchor), "  p.x += 0.05;\n");
+  test::TempDir dir("hairvert");
+  writeFileAtomic(dir / "hairvert.glsl", glsl);
+  hairgen::Setup setup;
+  setup.hairVert = {dir / "hairvert.glsl", {"setup.txt", 8}};
+  HairOverAPlane scene;
+  for (int samples : {1, 4}) {  // lines, then ribbons in the shading pass
+    scene.settings.samples = samples;
+    RenderOutput out =
+        renderStrands(scene.hair, scene.settings, &scene.head, Visuality{}, readCustomShaders(setup));
+    EXPECT_LT(scene.headRed(out, 0.017, 0.026), 0.75 * scene.headRed(out, -0.033, -0.024))
+        << samples << " samples";
+  }
 }
 
 TEST(Render, SupersamplingChangesOnlyStrandEdges) {
@@ -229,9 +259,9 @@ TEST(Render, SupersamplingChangesOnlyStrandEdges) {
   RenderSettings r = frontCamera(80, 1);
   r.strandWidth = 0.01;
   r.lightPosition = {0.1, 0.3, 0.3};
-  RenderOutput one = render(s, r);
+  RenderOutput one = renderStrands(s, r);
   r.samples = 9;
-  RenderOutput nine = render(s, r);
+  RenderOutput nine = renderStrands(s, r);
   int edges = 0, changedEdges = 0;
   for (int y = 1; y < 79; ++y)
     for (int x = 1; x < 79; ++x) {
@@ -252,6 +282,120 @@ TEST(Render, SupersamplingChangesOnlyStrandEdges) {
     }
   EXPECT_GT(edges, 100);
   EXPECT_GT(changedEdges, edges / 4) << "supersampling should soften the edges";
+}
+
+// A Setup naming `glsl` as its HairFrag at setup.txt:9, the file written to `dir` and read back as
+// hairgen render and run read it.
+CustomShaders customHairFrag(const test::TempDir& dir, const std::string& glsl) {
+  writeFileAtomic(dir / "hairfrag.glsl", glsl);
+  hairgen::Setup setup;
+  setup.hairFrag = {dir / "hairfrag.glsl", {"setup.txt", 9}};
+  return readCustomShaders(setup);
+}
+
+TEST(Render, ACustomHairFragmentGivesItsColorWhereTheHairIs) {
+  test::TempDir dir("hairfrag");
+  const CustomShaders shaders =
+      customHairFrag(dir,
+                     "in float vAlpha;\n"
+                     "in float vDepth;\n"
+                     "layout(location = 0) out vec4 oColor;\n"
+                     "layout(location = 1) out vec4 oData;\n"
+                     "void main() {\n"
+                     "  screenDoor(vAlpha);\n"
+                     "  oColor = vec4(0.25, 0.75, 0.5, vAlpha);\n"
+                     "  oData = vec4(vDepth, 1.0, lightArriving(vec3(0.0), 0.0), 0.0);\n"
+                     "}\n");
+  Strands s;
+  addStraight(s, {-0.04f, 0, 0}, {0.04f, 0, 0});
+  RenderSettings r = frontCamera(64, 1);
+  r.strandWidth = 0.006;
+  RenderOutput out = renderStrands(s, r, nullptr, Visuality{}, shaders);
+  int hair = 0;
+  for (int y = 0; y < 64; ++y)
+    for (int x = 0; x < 64; ++x) {
+      if (out.beauty.at("opacity", x, y) < 1.0f) continue;
+      EXPECT_EQ(out.beauty.at("R", x, y), 0.25f) << x << "," << y;
+      EXPECT_EQ(out.beauty.at("G", x, y), 0.75f) << x << "," << y;
+      EXPECT_EQ(out.beauty.at("B", x, y), 0.5f) << x << "," << y;
+      ++hair;
+    }
+  EXPECT_GT(hair, 40);
+  EXPECT_EQ(out.beauty.at("opacity", 0, 0), 0.0f);
+  EXPECT_NEAR(out.beauty.at("R", 0, 0), r.background.x, 1e-3) << "the background is not the shader's";
+}
+
+TEST(Render, ABrokenCustomHairFragmentIsAnInputErrorAtItsFileAndLine) {
+  test::TempDir dir("hairfrag");
+  const CustomShaders shaders = customHairFrag(dir,
+                                               "layout(location = 0) out vec4 oColor;\n"
+                                               "layout(location = 1) out vec4 oData;\n"
+                                               "void main() {\n"
+                                               "  oColor = vec4(foo);\n"
+                                               "  oData = vec4(0.0);\n"
+                                               "}\n");
+  Strands s;
+  addStraight(s, {-0.04f, 0, 0}, {0.04f, 0, 0});
+  try {
+    renderStrands(s, frontCamera(32, 1), nullptr, Visuality{}, shaders);
+    FAIL() << "a HairFrag that does not compile rendered";
+  } catch (const InputError& e) {
+    const std::string what = e.what();
+    EXPECT_EQ(e.code(), ExitCode::kBadInput);
+    EXPECT_EQ(e.where().line, 4) << what;
+    EXPECT_EQ(what.rfind((dir / "hairfrag.glsl").string() + ":4: ", 0), 0u) << what;
+    EXPECT_NE(what.find("foo"), std::string::npos) << what;
+    EXPECT_NE(what.find("HairFrag, named at setup.txt:9"), std::string::npos) << what;
+    EXPECT_EQ(what.find('\n'), std::string::npos) << "one line: " << what;
+  }
+}
+
+TEST(Render, CompilerLogsFoldToTheirFirstErrorAndItsLine) {
+  CompilerMessage mesa = firstCompilerError(
+      "0:3(10): warning: `x' unused\n0:12(5): error: `foo' undeclared\n0:13(2): error: syntax error\n");
+  EXPECT_EQ(mesa.line, 12);
+  EXPECT_EQ(mesa.text, "`foo' undeclared");
+  CompilerMessage nvidia = firstCompilerError("0(12) : error C1008: undefined variable \"foo\"\n");
+  EXPECT_EQ(nvidia.line, 12);
+  EXPECT_EQ(nvidia.text, "error C1008: undefined variable \"foo\"");
+  CompilerMessage glslang =
+      firstCompilerError("ERROR: 0:12: 'foo' : undeclared identifier\nERROR: 1 compilation errors.\n");
+  EXPECT_EQ(glslang.line, 12);
+  EXPECT_EQ(glslang.text, "'foo' : undeclared identifier");
+  CompilerMessage link = firstCompilerError("error: vertex shader lacks `main'\n");
+  EXPECT_EQ(link.line, 0);
+  EXPECT_EQ(link.text, "vertex shader lacks `main'");
+}
+
+// Hair made in centimetres with z up: after conform, y is up and lengths are metres.
+TEST(Render, ConformTurnsZUpCentimetresIntoYUpMetres) {
+  Strands s;
+  s.addStrand({{0, 0, 0}, {1, 2, 30}});
+  s.tangents = {{0, 0, 1}, {0, 0, 1}};
+  s.thickness = {0.008f, 0.008f};
+  conform(s, true, 0.01);
+  EXPECT_NEAR(s.points[1].x, 0.01f, 1e-7f);
+  EXPECT_NEAR(s.points[1].y, 0.30f, 1e-7f);
+  EXPECT_NEAR(s.points[1].z, -0.02f, 1e-7f);
+  EXPECT_EQ(s.tangents[0], glm::vec3(0, 1, 0));
+  EXPECT_NEAR(s.thickness[0], 8e-5f, 1e-10f);
+}
+
+// After framing, the camera looks at the hair's centre from the same direction, and the hair's
+// bounding sphere lies inside the narrower field of view.
+TEST(Render, FrameHairAimsAtTheHairAndFitsItInTheView) {
+  Strands s;
+  addStraight(s, {1.0f, 2.0f, 3.0f}, {1.5f, 2.2f, 3.1f});
+  RenderSettings r;
+  r.resolution = {200, 100};
+  const glm::dvec3 from = glm::normalize(r.cameraPosition - r.cameraTarget);
+  frameHair(r, s);
+  const glm::dvec3 centre(1.25, 2.1, 3.05);
+  EXPECT_NEAR(glm::length(r.cameraTarget - centre), 0.0, 1e-6);
+  EXPECT_NEAR(glm::dot(glm::normalize(r.cameraPosition - r.cameraTarget), from), 1.0, 1e-9);
+  const double radius = 0.5 * glm::length(glm::dvec3(0.5, 0.2, 0.1));
+  const double halfAngle = std::asin(radius / glm::length(r.cameraPosition - centre));
+  EXPECT_LT(halfAngle, 0.5 * glm::radians(r.fieldOfView) * 0.99);
 }
 
 }  // namespace

@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <iterator>
 
 #include "libcore/util/text.h"
 
@@ -141,14 +142,21 @@ Section<Setup> makeSetup() {
                       &Setup::wickModel),
        pathKey<Setup>({"HeadModel", "", "the head OBJ: rendered, and shadows the hair"}, &Setup::headModel),
        pathKey<Setup>(
-           {"HairVert", "", "GLSL vertex stage for the hair, in place of hairgen's (README, Shaders)"},
+           {"HairVert", "",
+            "GLSL hair vertex stage of every pass, in place of hairgen's (README, Custom shaders)"},
            &Setup::hairVert),
-       pathKey<Setup>({"HairFrag", "", "GLSL fragment stage shading the hair, in place of hairgen's"},
-                      &Setup::hairFrag),
-       pathKey<Setup>({"HeadVert", "", "GLSL vertex stage for the head, in place of hairgen's"},
-                      &Setup::headVert),
-       pathKey<Setup>({"HeadFrag", "", "GLSL fragment stage shading the head, in place of hairgen's"},
-                      &Setup::headFrag)},
+       pathKey<Setup>(
+           {"HairFrag", "",
+            "GLSL fragment stage shading the hair, in place of hairgen's (README, Custom shaders)"},
+           &Setup::hairFrag),
+       pathKey<Setup>(
+           {"HeadVert", "",
+            "GLSL head vertex stage of every pass, in place of hairgen's (README, Custom shaders)"},
+           &Setup::headVert),
+       pathKey<Setup>(
+           {"HeadFrag", "",
+            "GLSL fragment stage shading the head, in place of hairgen's (README, Custom shaders)"},
+           &Setup::headFrag)},
       [](SectionReader& r, Setup& s) {
         if (s.load && !s.loadFile.given())
           throw InputError(r.where("Load"),
@@ -400,9 +408,7 @@ Section<RenderSettings> makeRender() {
        realKey<R>({"StrandWidth", "m", "on-screen diameter of a strand"}, &R::strandWidth,
                   {0.0, 1.0, true, false}),
        choiceKey<R, ShadingModel>({"ShadingModel", "", "how strands are lit (README, Rendering)"},
-                                  &R::shadingModel,
-                                  {ShadingModel::kKajiyaKay, ShadingModel::kThesis, ShadingModel::kAnjyo,
-                                   ShadingModel::kVolumetric}),
+                                  &R::shadingModel, {std::begin(kShadingModels), std::end(kShadingModels)}),
        vectorKey<R, 3>({"Background", "", "the preview's background colour"}, &R::background, "r g b",
                        colorRange),
        vectorKey<R, 3>({"HeadColor", "", "Lambert albedo of the head"}, &R::headColor, "r g b",

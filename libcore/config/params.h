@@ -16,6 +16,9 @@ namespace hairgen {
 
 enum class StylingModel { kSuperHelix, kCantilever };
 enum class ShadingModel { kKajiyaKay, kThesis, kAnjyo, kVolumetric };
+// Every shading model, in the enum's order: the config's choices and the renderer's GLSL constants.
+inline constexpr ShadingModel kShadingModels[] = {ShadingModel::kKajiyaKay, ShadingModel::kThesis,
+                                                  ShadingModel::kAnjyo, ShadingModel::kVolumetric};
 
 const char* name(StylingModel model);
 const char* name(ShadingModel model);

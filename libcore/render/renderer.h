@@ -14,6 +14,7 @@
 #include "libcore/model/image.h"
 #include "libcore/model/mesh.h"
 #include "libcore/model/strands.h"
+#include "libcore/render/custom_shaders.h"
 
 namespace hairgen {
 
@@ -32,7 +33,9 @@ struct RenderOutput {
   glm::dmat4 worldToCamera{1.0}, worldToNdc{1.0};
   glm::dmat4 worldToLight{1.0};
   RenderTimings timings;
-  int samples = 1;  // the samples used (Samples, clamped to what the device offers)
+  int samples = 1;          // the samples used (Samples, clamped to what the device offers)
+  RenderSettings settings;  // what was rendered: the input's, with the camera and light the render stage
+                            // aimed when asked to frame the hair
 };
 
 struct RenderInput {
@@ -40,6 +43,7 @@ struct RenderInput {
   const Mesh* head = nullptr;  // may be null
   Visuality visuality;
   RenderSettings settings;
+  CustomShaders shaders;
   int domResolution = 1024;  // texels per side of the light's maps
   bool keepDom = false;
 };
@@ -50,7 +54,9 @@ inline int domResolutionFor(const glm::ivec2& resolution) {
   return std::clamp(std::max(resolution.x, resolution.y) / 2, 1024, 4096);
 }
 
-// Renders with the current context of `gl`. Deterministic for a given device and driver.
+// Renders with the current context of `gl`. Deterministic for a given device and driver. A custom
+// stage that does not compile or link throws InputError at the file and line the GLSL compiler names;
+// anything else that fails throws Error (exit code 1).
 RenderOutput renderHair(GlContext& gl, const RenderInput& input);
 
 }  // namespace hairgen

@@ -24,7 +24,8 @@ inline std::optional<uint64_t> checkedAdd(uint64_t a, uint64_t b) {
 // Whether `count` elements of `elementSize` bytes, `stride` bytes apart, starting `offset` bytes in,
 // lie within `available` bytes: offset + stride·(count − 1) + elementSize <= available, in exact
 // arithmetic. Zero elements always fit.
-inline bool extentFits(uint64_t offset, uint64_t count, uint64_t stride, uint64_t elementSize, uint64_t available) {
+inline bool extentFits(uint64_t offset, uint64_t count, uint64_t stride, uint64_t elementSize,
+                       uint64_t available) {
   if (count == 0) return true;
   std::optional<uint64_t> span = checkedMul(stride, count - 1);
   if (!span) return false;

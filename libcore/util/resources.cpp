@@ -37,7 +37,9 @@ uint64_t memoryBudget() {
   return available > kReserve ? available - kReserve : 0;
 }
 
-uint64_t peakResidentBytes() { return procValue("/proc/self/status", "VmHWM"); }
+uint64_t peakResidentBytes() {
+  return procValue("/proc/self/status", "VmHWM");
+}
 
 std::string formatBytes(uint64_t bytes) {
   char buffer[32];

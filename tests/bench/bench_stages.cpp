@@ -7,8 +7,8 @@
 //                       distance, normals), every core; counters give the grid's size and each part's
 //                       seconds.
 //   CantileverStyling:  Anjyo's figures, 20,000 hairs of 20 segments bent around the head ellipsoid.
-//   Render/strands/width/height/samples: coupe 3 with the head and shadows, through whatever EGL opens
-//                       (llvmpipe here); counters give each pass's seconds.
+//   Render/strands/width/height/samples: the render stage on coupe 3 with the head and shadows,
+//                       through whatever EGL opens (llvmpipe here); counters give each pass's seconds.
 #include <benchmark/benchmark.h>
 
 #include <map>
@@ -19,10 +19,10 @@
 #include "libcore/config/setup.h"
 #include "libcore/io/obj_io.h"
 #include "libcore/render/gl_context.h"
-#include "libcore/render/renderer.h"
 #include "stages/cantilever.h"
 #include "stages/grow.h"
 #include "stages/interpolate.h"
+#include "stages/render.h"
 #include "stages/shade.h"
 
 namespace hairgen {
@@ -177,17 +177,12 @@ void Render(benchmark::State& state) {
   static GlContext gl;
   static const Mesh head = readObj(std::filesystem::path(HAIRGEN_SOURCE_DIR) / "configs/assets/head.obj");
   const Strands& hair = coupe3Strands(int(state.range(0)));
-  RenderInput in;
-  in.hair = &hair;
-  in.head = &head;
-  in.visuality = coupe3().config.visuality;
-  in.settings = coupe3().config.render;
-  in.settings.resolution = {int(state.range(1)), int(state.range(2))};
-  in.settings.samples = int(state.range(3));
-  in.domResolution = domResolutionFor(in.settings.resolution);
+  RenderSettings settings = coupe3().config.render;
+  settings.resolution = {int(state.range(1)), int(state.range(2))};
+  settings.samples = int(state.range(3));
   RenderTimings sum;
   for (auto _ : state) {
-    RenderOutput out = renderHair(gl, in);
+    RenderOutput out = render(gl, hair, &head, coupe3().config.visuality, settings, {}, {});
     sum.upload += out.timings.upload;
     sum.lightDepth += out.timings.lightDepth;
     sum.opacity += out.timings.opacity;

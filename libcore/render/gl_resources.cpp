@@ -1,0 +1,288 @@
+#include "libcore/render/gl_resources.h"
+
+#include <algorithm>
+#include <cstdio>
+#include <utility>
+
+#include <glm/gtc/type_ptr.hpp>
+
+#include "libcore/render/custom_shaders.h"
+#include "libcore/render/shader_interface.h"
+#include "libcore/util/error.h"
+
+namespace hairgen {
+
+void renderFailure(const std::string& what) {
+  throw Error(ExitCode::kWorkFailed, {}, "rendering: " + what);
+}
+
+void checkGl(const char* where) {
+  GLenum e = glGetError();
+  if (e != GL_NO_ERROR) {
+    char code[16];
+    std::snprintf(code, sizeof code, "0x%04x", e);
+    renderFailure(std::string("OpenGL error ") + code + " in " + where);
+  }
+}
+
+void clearGlErrors() {
+  while (glGetError() != GL_NO_ERROR) {
+  }
+}
+
+// ------------------------------------------------------------------------------------------ Program
+
+namespace {
+
+std::string infoLog(GLuint object, bool program) {
+  GLint length = 0;
+  if (program)
+    glGetProgramiv(object, GL_INFO_LOG_LENGTH, &length);
+  else
+    glGetShaderiv(object, GL_INFO_LOG_LENGTH, &length);
+  std::string log(size_t(std::max(length, 1)), '\0');
+  if (program)
+    glGetProgramInfoLog(object, length, nullptr, log.data());
+  else
+    glGetShaderInfoLog(object, length, nullptr, log.data());
+  return log.c_str();
+}
+
+// "HairFrag for ribbons, named at setup.txt:9"
+std::string origin(const StageSource& s) {
+  std::string text = s.key;
+  if (*s.variant) text += std::string(" ") + s.variant;
+  if (!s.custom->namedAt.empty()) text += ", named at " + s.custom->namedAt;
+  return text;
+}
+
+GLuint compileStage(GLenum type, const StageSource& source, const char* program) {
+  GLuint s = glCreateShader(type);
+  const char* text = source.text.c_str();
+  glShaderSource(s, 1, &text, nullptr);
+  glCompileShader(s);
+  GLint ok = 0;
+  glGetShaderiv(s, GL_COMPILE_STATUS, &ok);
+  if (ok) return s;
+  const std::string log = infoLog(s, false);
+  glDeleteShader(s);
+  const CompilerMessage error = firstCompilerError(log);
+  if (source.custom)
+    throw InputError({source.custom->file, error.line}, error.text + " (compiling " + origin(source) + ")");
+  renderFailure(std::string("compiling the ") + program + " program's " +
+                (type == GL_VERTEX_SHADER ? "vertex" : "fragment") + " stage: line " +
+                std::to_string(error.line) + ": " + error.text);
+}
+
+}  // namespace
+
+Program::Program(const StageSource& vertex, const StageSource& fragment, const char* name) {
+  const GLuint v = compileStage(GL_VERTEX_SHADER, vertex, name);
+  GLuint f = 0;
+  try {
+    f = compileStage(GL_FRAGMENT_SHADER, fragment, name);
+  } catch (...) {
+    glDeleteShader(v);
+    throw;
+  }
+  id = glCreateProgram();
+  glAttachShader(id, v);
+  glAttachShader(id, f);
+  glLinkProgram(id);
+  glDeleteShader(v);
+  glDeleteShader(f);
+  GLint ok = 0;
+  glGetProgramiv(id, GL_LINK_STATUS, &ok);
+  if (ok) return;
+  const CompilerMessage error = firstCompilerError(infoLog(id, true));
+  glDeleteProgram(id);
+  // A link error is about the two stages together: it names the custom one (the fragment stage's file
+  // when both are), and the other.
+  const StageSource* blamed = fragment.custom ? &fragment : vertex.custom ? &vertex : nullptr;
+  if (!blamed) renderFailure(std::string("linking the ") + name + " program: " + error.text);
+  const StageSource& other = blamed == &fragment ? vertex : fragment;
+  const std::string otherStage =
+      other.custom ? other.custom->file + " (" + origin(other) + ")"
+                   : std::string("hairgen's ") + (&other == &vertex ? "vertex" : "fragment") + " stage";
+  throw InputError({blamed->custom->file, 0}, error.text + " (linking " + origin(*blamed) + ", with " +
+                                                  otherStage + ", into the " + name + " program)");
+}
+
+Program::~Program() {
+  glDeleteProgram(id);
+}
+
+void Program::use() const {
+  glUseProgram(id);
+}
+
+GLint Program::loc(const char* name) const {
+  return glGetUniformLocation(id, name);
+}
+
+void Program::set(const char* name, const glm::mat4& m) const {
+  glUniformMatrix4fv(loc(name), 1, GL_FALSE, glm::value_ptr(m));
+}
+void Program::set(const char* name, const glm::vec4& v) const {
+  glUniform4fv(loc(name), 1, glm::value_ptr(v));
+}
+void Program::set(const char* name, const glm::vec3& v) const {
+  glUniform3fv(loc(name), 1, glm::value_ptr(v));
+}
+void Program::set(const char* name, const glm::vec2& v) const {
+  glUniform2fv(loc(name), 1, glm::value_ptr(v));
+}
+void Program::set(const char* name, float v) const {
+  glUniform1f(loc(name), v);
+}
+void Program::set(const char* name, int v) const {
+  glUniform1i(loc(name), v);
+}
+void Program::set(const char* name, const std::vector<int>& v) const {
+  glUniform1iv(loc(name), static_cast<GLsizei>(v.size()), v.data());
+}
+
+// ------------------------------------------------------------------------- Texture, Framebuffer, Buffer
+
+Texture::Texture(GLenum internalFormat, int w, int h, GLenum filter) : width(w), height(h) {
+  glCreateTextures(GL_TEXTURE_2D, 1, &id);
+  glTextureStorage2D(id, 1, internalFormat, w, h);
+  glTextureParameteri(id, GL_TEXTURE_MIN_FILTER, filter);
+  glTextureParameteri(id, GL_TEXTURE_MAG_FILTER, filter);
+  glTextureParameteri(id, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+  glTextureParameteri(id, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+}
+
+Texture::Texture(Texture&& other) noexcept
+    : id(std::exchange(other.id, 0)), width(other.width), height(other.height) {}
+
+Texture::~Texture() {
+  if (id) glDeleteTextures(1, &id);
+}
+
+Framebuffer::Framebuffer(std::initializer_list<const Texture*> colors, int w, int h, bool withDepth)
+    : width(w), height(h) {
+  glCreateFramebuffers(1, &id);
+  std::vector<GLenum> buffers;
+  GLenum i = 0;
+  for (const Texture* t : colors) {
+    glNamedFramebufferTexture(id, GL_COLOR_ATTACHMENT0 + i, t->id, 0);
+    buffers.push_back(GL_COLOR_ATTACHMENT0 + i++);
+  }
+  glNamedFramebufferDrawBuffers(id, static_cast<GLsizei>(buffers.size()), buffers.data());
+  if (withDepth) {
+    glCreateRenderbuffers(1, &depth);
+    glNamedRenderbufferStorage(depth, GL_DEPTH_COMPONENT24, w, h);
+    glNamedFramebufferRenderbuffer(id, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, depth);
+  }
+  if (glCheckNamedFramebufferStatus(id, GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE)
+    renderFailure("framebuffer incomplete");
+}
+
+Framebuffer::~Framebuffer() {
+  glDeleteFramebuffers(1, &id);
+  if (depth) glDeleteRenderbuffers(1, &depth);
+}
+
+void Framebuffer::bind() const {
+  glBindFramebuffer(GL_FRAMEBUFFER, id);
+  glViewport(0, 0, width, height);
+}
+
+Buffer::Buffer(const void* data, size_t bytes) {
+  glCreateBuffers(1, &id);
+  glNamedBufferStorage(id, static_cast<GLsizeiptr>(std::max<size_t>(bytes, 4)), bytes ? data : nullptr, 0);
+}
+
+Buffer::~Buffer() {
+  glDeleteBuffers(1, &id);
+}
+
+// ------------------------------------------------------------------------------------------ geometry
+
+HairGeometry::HairGeometry(const Strands& s, const std::vector<glm::vec3>& tangentData)
+    : points(s.points.data(), s.points.size() * sizeof(glm::vec3)),
+      tangents(tangentData.data(), tangentData.size() * sizeof(glm::vec3)),
+      colors(s.colors.data(), s.colors.size() * sizeof(glm::vec3)),
+      normals(s.normals.data(), s.normals.size() * sizeof(glm::vec3)),
+      hasColors(!s.colors.empty()),
+      hasNormals(!s.normals.empty()) {
+  for (size_t i = 0; i < s.strandCount(); ++i) {
+    if (s.pointsOf(i) < 2) continue;
+    lineFirsts.push_back(static_cast<GLint>(s.firstPoint[i]));
+    lineCounts.push_back(static_cast<GLsizei>(s.pointsOf(i)));
+    ribbonFirsts.push_back(static_cast<GLint>(2 * s.firstPoint[i]));
+    ribbonCounts.push_back(static_cast<GLsizei>(2 * s.pointsOf(i)));
+  }
+  glCreateVertexArrays(1, &vao);
+  glVertexArrayVertexBuffer(vao, 0, points.id, 0, sizeof(glm::vec3));
+  glVertexArrayVertexBuffer(vao, 1, tangents.id, 0, sizeof(glm::vec3));
+  glVertexArrayVertexBuffer(vao, 2, colors.id, 0, sizeof(glm::vec3));
+  glVertexArrayVertexBuffer(vao, 3, normals.id, 0, sizeof(glm::vec3));
+  for (GLuint a = 0; a < 4; ++a) {
+    if ((a == 2 && !hasColors) || (a == 3 && !hasNormals)) continue;  // constant attributes, set in draw()
+    glEnableVertexArrayAttrib(vao, a);
+    glVertexArrayAttribFormat(vao, a, 3, GL_FLOAT, GL_FALSE, 0);
+    glVertexArrayAttribBinding(vao, a, a);
+  }
+}
+
+HairGeometry::~HairGeometry() {
+  glDeleteVertexArrays(1, &vao);
+}
+
+void HairGeometry::draw(bool ribbon) const {
+  glBindVertexArray(vao);
+  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, points.id);
+  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, tangents.id);
+  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 2, colors.id);
+  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 3, normals.id);
+  if (!hasColors) glVertexAttrib3f(2, 1.0f, 1.0f, 1.0f);
+  if (!hasNormals) glVertexAttrib3f(3, 0.0f, 0.0f, 0.0f);
+  if (lineFirsts.empty()) return;
+  if (ribbon)
+    glMultiDrawArrays(GL_TRIANGLE_STRIP, ribbonFirsts.data(), ribbonCounts.data(),
+                      static_cast<GLsizei>(ribbonFirsts.size()));
+  else
+    glMultiDrawArrays(GL_LINE_STRIP, lineFirsts.data(), lineCounts.data(),
+                      static_cast<GLsizei>(lineFirsts.size()));
+}
+
+HeadGeometry::HeadGeometry(const Mesh& m) {
+  std::vector<float> interleaved;
+  interleaved.reserve(m.positions.size() * 6);
+  for (size_t i = 0; i < m.positions.size(); ++i) {
+    const glm::vec3 n = i < m.normals.size() ? m.normals[i] : glm::vec3(0, 1, 0);
+    interleaved.insert(interleaved.end(),
+                       {m.positions[i].x, m.positions[i].y, m.positions[i].z, n.x, n.y, n.z});
+  }
+  glCreateBuffers(1, &vbo);
+  glNamedBufferStorage(vbo, static_cast<GLsizeiptr>(std::max<size_t>(interleaved.size() * 4, 4)),
+                       interleaved.data(), 0);
+  glCreateBuffers(1, &ebo);
+  glNamedBufferStorage(ebo, static_cast<GLsizeiptr>(std::max<size_t>(m.triangles.size() * 12, 4)),
+                       m.triangles.data(), 0);
+  indexCount = static_cast<GLsizei>(m.triangles.size() * 3);
+  glCreateVertexArrays(1, &vao);
+  glVertexArrayVertexBuffer(vao, 0, vbo, 0, 6 * sizeof(float));
+  glVertexArrayElementBuffer(vao, ebo);
+  glEnableVertexArrayAttrib(vao, 0);
+  glEnableVertexArrayAttrib(vao, 1);
+  glVertexArrayAttribFormat(vao, 0, 3, GL_FLOAT, GL_FALSE, 0);
+  glVertexArrayAttribFormat(vao, 1, 3, GL_FLOAT, GL_FALSE, 3 * sizeof(float));
+  glVertexArrayAttribBinding(vao, 0, 0);
+  glVertexArrayAttribBinding(vao, 1, 0);
+}
+
+HeadGeometry::~HeadGeometry() {
+  glDeleteVertexArrays(1, &vao);
+  glDeleteBuffers(1, &vbo);
+  glDeleteBuffers(1, &ebo);
+}
+
+void HeadGeometry::draw() const {
+  glBindVertexArray(vao);
+  glDrawElements(GL_TRIANGLES, indexCount, GL_UNSIGNED_INT, nullptr);
+}
+
+}  // namespace hairgen

@@ -1,0 +1,131 @@
+// The OpenGL objects the renderer draws with. Each owns its GL name and deletes it with itself, so a
+// failing pass leaves nothing behind; all need a current OpenGL 4.5 core context (GlContext). Failures
+// that are hairgen's own throw Error with exit code 1 ("rendering: ...").
+#pragma once
+
+#include <initializer_list>
+#include <string>
+#include <vector>
+
+#define GL_GLEXT_PROTOTYPES 1
+#include <GL/glcorearb.h>
+#include <glm/glm.hpp>
+
+#include "libcore/model/mesh.h"
+#include "libcore/model/strands.h"
+
+namespace hairgen {
+
+[[noreturn]] void renderFailure(const std::string& what);
+
+// Throws renderFailure naming `where` when OpenGL has recorded an error.
+void checkGl(const char* where);
+
+// Forgets the errors recorded before the renderer started.
+void clearGlErrors();
+
+struct CustomStage;
+
+// One stage of a program: its complete GLSL (assembleStage's), and for a Setup's file, the file and
+// the Setup key that named it, so a compiler error can name them.
+struct StageSource {
+  std::string text;
+  const CustomStage* custom = nullptr;  // null: hairgen's own stage
+  const char* key = "";                 // "HairFrag"
+  const char* variant = "";             // what the prelude made of it, e.g. "for ribbons"; may be empty
+};
+
+// A linked program of a vertex and a fragment stage. `name` ("hair shading") is for messages. A custom
+// stage that fails to compile, or a program with one that fails to link, throws InputError at the
+// custom file and the line the compiler names, on one line; hairgen's own stages failing throw Error.
+class Program {
+ public:
+  Program(const StageSource& vertex, const StageSource& fragment, const char* name);
+  ~Program();
+  Program(const Program&) = delete;
+  Program& operator=(const Program&) = delete;
+
+  void use() const;
+  // A uniform's location; −1 when the program has no such uniform (setting it then does nothing).
+  GLint loc(const char* name) const;
+  void set(const char* name, const glm::mat4& m) const;
+  void set(const char* name, const glm::vec4& v) const;
+  void set(const char* name, const glm::vec3& v) const;
+  void set(const char* name, const glm::vec2& v) const;
+  void set(const char* name, float v) const;
+  void set(const char* name, int v) const;
+  void set(const char* name, const std::vector<int>& v) const;
+
+  GLuint id = 0;
+};
+
+// A 2D texture of one level, clamped at its edges.
+struct Texture {
+  Texture(GLenum internalFormat, int width, int height, GLenum filter = GL_NEAREST);
+  ~Texture();
+  Texture(Texture&& other) noexcept;
+  Texture(const Texture&) = delete;
+  Texture& operator=(const Texture&) = delete;
+  Texture& operator=(Texture&&) = delete;
+
+  GLuint id = 0;
+  int width = 0, height = 0;  // texels
+};
+
+// Draws into `colors` (attachments 0, 1, ...), with a 24-bit depth buffer when asked.
+struct Framebuffer {
+  Framebuffer(std::initializer_list<const Texture*> colors, int width, int height, bool withDepth);
+  ~Framebuffer();
+  Framebuffer(const Framebuffer&) = delete;
+  Framebuffer& operator=(const Framebuffer&) = delete;
+  // Binds it for drawing, the viewport its whole size.
+  void bind() const;
+
+  GLuint id = 0, depth = 0;
+  int width = 0, height = 0;
+};
+
+// An immutable buffer holding `bytes` of `data` (at least 4 bytes, so an empty array still binds).
+struct Buffer {
+  Buffer(const void* data, size_t bytes);
+  ~Buffer();
+  Buffer(const Buffer&) = delete;
+  Buffer& operator=(const Buffer&) = delete;
+
+  GLuint id = 0;
+};
+
+// Hair on the GPU: points, tangents, colors and normals (where the strands have them) both as vertex
+// attributes 0-3 and as storage buffers 0-3 (glsl/hair_vertex.glsl reads one or the other); per strand
+// a line strip (one vertex per point) or a triangle strip (two). Strands of fewer than 2 points are
+// not drawn.
+struct HairGeometry {
+  // `tangents`: one per point.
+  HairGeometry(const Strands& strands, const std::vector<glm::vec3>& tangents);
+  ~HairGeometry();
+  HairGeometry(const HairGeometry&) = delete;
+  HairGeometry& operator=(const HairGeometry&) = delete;
+  // Binds the buffers and draws every strand as lines, or as ribbons.
+  void draw(bool ribbon) const;
+
+  Buffer points, tangents, colors, normals;
+  bool hasColors, hasNormals;
+  std::vector<GLint> lineFirsts, ribbonFirsts;
+  std::vector<GLsizei> lineCounts, ribbonCounts;
+  GLuint vao = 0;
+};
+
+// The head on the GPU: positions as attribute 0, normals as attribute 1 ((0, 1, 0) where the mesh has
+// none), triangles indexed.
+struct HeadGeometry {
+  explicit HeadGeometry(const Mesh& mesh);
+  ~HeadGeometry();
+  HeadGeometry(const HeadGeometry&) = delete;
+  HeadGeometry& operator=(const HeadGeometry&) = delete;
+  void draw() const;
+
+  GLuint vao = 0, vbo = 0, ebo = 0;
+  GLsizei indexCount = 0;
+};
+
+}  // namespace hairgen

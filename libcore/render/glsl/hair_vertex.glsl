@@ -1,0 +1,64 @@
+// hairgen's hair vertex stage, used by every pass that draws hair: the light's depth and deep opacity
+// passes (lines) and the shading pass (lines, or ribbons when RIBBON is defined). The reference for a
+// custom HairVert (README, Custom shaders).
+//
+// Lines: one vertex per point, the point's data as vertex attributes. Ribbons: two vertices per point
+// (gl_VertexID 2i and 2i + 1 for point i), the data read from storage buffers, the pair pushed apart
+// across the strand on screen.
+#ifdef RIBBON
+layout(std430, binding = 0) readonly buffer Points { float pointData[]; };
+layout(std430, binding = 1) readonly buffer Tangents { float tangentData[]; };
+layout(std430, binding = 2) readonly buffer Colors { float colorData[]; };
+layout(std430, binding = 3) readonly buffer Normals { float normalData[]; };
+uniform int uHasColor;
+uniform int uHasNormal;
+#else
+layout(location = 0) in vec3 aPosition;
+layout(location = 1) in vec3 aTangent;
+layout(location = 2) in vec3 aColor;   // (1, 1, 1) when the cache has no colors
+layout(location = 3) in vec3 aNormal;  // (0, 0, 0) when the cache has no normals
+#endif
+uniform mat4 uView;       // world to view (the camera's or the light's)
+uniform mat4 uProj;       // view to clip
+uniform vec2 uViewport;   // pixels
+uniform float uFocalPx;   // pixels per metre at one metre of depth
+uniform float uWidth;     // strand diameter, metres
+uniform float uOpacity;
+uniform float uMinWidth;  // pixels: the narrowest ribbon
+out vec3 vWorld;          // world position, metres
+out vec3 vTangent;        // world tangent (not normalised)
+out vec3 vColor;          // the strand's per-vertex color, (1, 1, 1) when it has none
+out vec3 vNormal;         // the stored volume normal, (0, 0, 0) when there is none
+out float vAlpha;         // the strand's opacity
+out float vDepth;         // metres along the view axis
+void main() {
+#ifdef RIBBON
+  int i = gl_VertexID >> 1;
+  vec3 p = vec3(pointData[3 * i], pointData[3 * i + 1], pointData[3 * i + 2]);
+  vec3 t = vec3(tangentData[3 * i], tangentData[3 * i + 1], tangentData[3 * i + 2]);
+  vColor = uHasColor != 0 ? vec3(colorData[3 * i], colorData[3 * i + 1], colorData[3 * i + 2]) : vec3(1.0);
+  vNormal = uHasNormal != 0 ? vec3(normalData[3 * i], normalData[3 * i + 1], normalData[3 * i + 2]) : vec3(0.0);
+#else
+  vec3 p = aPosition;
+  vec3 t = aTangent;
+  vColor = aColor;
+  vNormal = aNormal;
+#endif
+  vec4 view = uView * vec4(p, 1.0);
+  vec4 clip = uProj * view;
+  float depth = -view.z;
+#ifdef RIBBON
+  float side = (gl_VertexID & 1) == 0 ? -1.0 : 1.0;
+  vec4 ahead = uProj * (view + uView * vec4(1e-3 * t, 0.0));
+  vec2 d = (ahead.xy / ahead.w - clip.xy / clip.w) * uViewport;
+  float len = length(d);
+  vec2 across = len > 1e-9 ? vec2(-d.y, d.x) / len : vec2(1.0, 0.0);
+  float widthPx = uWidth * uFocalPx / max(depth, 1e-6);
+  clip.xy += across * (side * 0.5 * max(widthPx, uMinWidth)) * 2.0 / uViewport * clip.w;
+#endif
+  gl_Position = clip;
+  vWorld = p;
+  vTangent = t;
+  vAlpha = uOpacity;
+  vDepth = depth;
+}

@@ -1,0 +1,282 @@
+#include "libcore/render/passes.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "glsl/embedded_glsl.h"
+#include "libcore/render/shader_interface.h"
+
+namespace hairgen {
+
+namespace {
+
+// k for Samples = k² (k ≤ 8), lowered until the sub-pixel image fits the device's largest texture.
+int subpixelBlock(const RenderSettings& r) {
+  GLint maxSize = 4096;
+  glGetIntegerv(GL_MAX_TEXTURE_SIZE, &maxSize);
+  int block = std::min(std::max(1, int(std::lround(std::sqrt(double(r.samples))))), 8);
+  while (block > 1 && std::max(r.resolution.x, r.resolution.y) * block > maxSize) --block;
+  return block;
+}
+
+// Lines where every strand is at most a pixel and a half wide (at the scene's nearest point) and
+// there are no sub-pixels; ribbons otherwise.
+bool drawsRibbons(const RenderSettings& r, const BoundingSphere& sphere, const View& camera, int block) {
+  const double nearest = std::max(glm::length(sphere.centre - r.cameraPosition) - sphere.radius, 1e-3);
+  return block > 1 || r.strandWidth * camera.focalPx / nearest > 1.5;
+}
+
+void setView(const Program& p, const View& v) {
+  p.set("uView", glm::mat4(v.view));
+  p.set("uProj", glm::mat4(v.proj));
+}
+
+void setHairWidth(const Program& p, const View& v, const RenderSettings& r) {
+  p.set("uViewport", glm::vec2(v.width, v.height));
+  p.set("uFocalPx", float(v.focalPx));
+  p.set("uWidth", float(r.strandWidth));
+  p.set("uOpacity", float(r.strandOpacity));
+}
+
+// The light's maps and the light, for the shadow function (glsl/shadow.glsl) of a shading program.
+void setShadowUniforms(const Program& p, const Scene& scene) {
+  const RenderSettings& r = scene.settings;
+  p.set("uLightView", glm::mat4(scene.light.view));
+  p.set("uLightProj", glm::mat4(scene.light.proj));
+  p.set("uLayers", glm::vec4(r.layerSizes));
+  p.set("uLightPosition", glm::vec3(r.lightPosition));
+  p.set("uLightColor", glm::vec3(r.lightColor));
+  p.set("uAmbient", float(r.ambientIntensity));
+}
+
+// Reads the first planes.size() float channels of a single-sample RGBA texture into planes (a null
+// plane is skipped), rows top to bottom.
+void readPlanes(const Texture& texture, std::vector<std::vector<float>*> planes) {
+  const int w = texture.width, h = texture.height;
+  std::vector<float> rgba(size_t(w) * h * 4);
+  glGetTextureImage(texture.id, 0, GL_RGBA, GL_FLOAT, static_cast<GLsizei>(rgba.size() * sizeof(float)),
+                    rgba.data());
+  for (size_t c = 0; c < planes.size(); ++c) {
+    if (!planes[c]) continue;
+    planes[c]->resize(size_t(w) * h);
+    for (int y = 0; y < h; ++y)
+      for (int x = 0; x < w; ++x) (*planes[c])[size_t(h - 1 - y) * w + x] = rgba[(size_t(y) * w + x) * 4 + c];
+  }
+}
+
+// A program's stage: `custom` in place of hairgen's `own` when the Setup names one, with the same
+// prelude either way.
+StageSource stage(const char* own, const std::optional<CustomStage>& custom = std::nullopt,
+                  const char* key = "", StagePrelude prelude = {}) {
+  StageSource s;
+  s.text = assembleStage(prelude, custom ? custom->text : std::string(own));
+  s.custom = custom ? &*custom : nullptr;
+  s.key = key;
+  s.variant = prelude.ribbon ? "for ribbons" : "";
+  return s;
+}
+
+}  // namespace
+
+Programs::Programs(bool ribbons, const CustomShaders& custom)
+    : hairDepth(stage(glsl::kHairVertex, custom.hairVert, "HairVert"), stage(glsl::kDepthFragment),
+                "hair depth"),
+      headDepth(stage(glsl::kHeadVertex, custom.headVert, "HeadVert"), stage(glsl::kDepthFragment),
+                "head depth"),
+      opacity(stage(glsl::kHairVertex, custom.hairVert, "HairVert"), stage(glsl::kOpacityFragment),
+              "deep opacity"),
+      hairShade(stage(glsl::kHairVertex, custom.hairVert, "HairVert", {.ribbon = ribbons}),
+                stage(glsl::kHairFragment, custom.hairFrag, "HairFrag",
+                      {.ribbon = ribbons, .shadowFunction = true, .screenDoor = true}),
+                "hair shading"),
+      headShade(stage(glsl::kHeadVertex, custom.headVert, "HeadVert"),
+                stage(glsl::kHeadFragment, custom.headFrag, "HeadFrag", {.shadowFunction = true}),
+                "head shading"),
+      resolve(stage(glsl::kFullscreenVertex), stage(glsl::kResolveFragment), "resolve") {}
+
+Scene::Scene(const RenderInput& in)
+    : settings(in.settings),
+      visuality(in.visuality),
+      sphere(boundingSphere(*in.hair, in.head)),
+      block(subpixelBlock(in.settings)),
+      camera(cameraView(in.settings, sphere)),
+      subpixel(subpixelView(camera, block)),
+      light(lightView(in.settings, sphere, in.domResolution)),
+      ribbons(drawsRibbons(in.settings, sphere, camera, block)),
+      hair(*in.hair, tangentsOf(*in.hair)),
+      head(in.head && !in.head->triangles.empty() ? std::make_unique<HeadGeometry>(*in.head) : nullptr),
+      programs(ribbons, in.shaders) {
+  checkGl("setting up");
+}
+
+LightDepth lightDepthPass(const Scene& scene) {
+  const int n = scene.light.width;
+  const float far[4] = {kBackgroundZ, kBackgroundZ, kBackgroundZ, kBackgroundZ};
+  const float one = 1.0f;
+  LightDepth depth{Texture(GL_R32F, n, n), Texture(GL_R32F, n, n)};
+  glEnable(GL_DEPTH_TEST);
+  glDepthFunc(GL_LESS);
+  glDisable(GL_CULL_FACE);
+  {
+    Framebuffer fb({&depth.head}, n, n, true);
+    fb.bind();
+    glClearBufferfv(GL_COLOR, 0, far);
+    glClearBufferfv(GL_DEPTH, 0, &one);
+    if (scene.head) {
+      scene.programs.headDepth.use();
+      setView(scene.programs.headDepth, scene.light);
+      scene.head->draw();
+    }
+  }
+  {
+    Framebuffer fb({&depth.hairStart}, n, n, true);
+    fb.bind();
+    glClearBufferfv(GL_COLOR, 0, far);
+    glClearBufferfv(GL_DEPTH, 0, &one);
+    const Program& p = scene.programs.hairDepth;
+    p.use();
+    setView(p, scene.light);
+    setHairWidth(p, scene.light, scene.settings);
+    scene.hair.draw(false);
+  }
+  checkGl("the light's depth pass");
+  return depth;
+}
+
+Texture deepOpacityPass(const Scene& scene, const LightDepth& depth) {
+  const int n = scene.light.width;
+  Texture opacity(GL_RGBA32F, n, n, GL_LINEAR);
+  Framebuffer fb({&opacity}, n, n, false);
+  fb.bind();
+  const float zero[4] = {0, 0, 0, 0};
+  glClearBufferfv(GL_COLOR, 0, zero);
+  glDisable(GL_DEPTH_TEST);
+  glEnable(GL_BLEND);
+  glBlendFunc(GL_ONE, GL_ONE);
+  const Program& p = scene.programs.opacity;
+  p.use();
+  setView(p, scene.light);
+  setHairWidth(p, scene.light, scene.settings);
+  p.set("uLayers", glm::vec4(scene.settings.layerSizes));
+  glBindTextureUnit(kUnitHairStart, depth.hairStart.id);
+  scene.hair.draw(false);
+  glDisable(GL_BLEND);
+  checkGl("the deep opacity pass");
+  return opacity;
+}
+
+ShadedImage shadingPass(const Scene& scene, const LightDepth& depth, const Texture& opacity) {
+  const RenderSettings& r = scene.settings;
+  const int w = scene.subpixel.width, h = scene.subpixel.height;
+  ShadedImage image{Texture(GL_RGBA16F, w, h), Texture(GL_RGBA32F, w, h)};
+  Framebuffer fb({&image.color, &image.data}, w, h, true);
+  fb.bind();
+  const float background[4] = {float(r.background.x), float(r.background.y), float(r.background.z), 0.0f};
+  const float nothing[4] = {kBackgroundZ, 0.0f, 1.0f, 0.0f};
+  const float one = 1.0f;
+  glClearBufferfv(GL_COLOR, 0, background);
+  glClearBufferfv(GL_COLOR, 1, nothing);
+  glClearBufferfv(GL_DEPTH, 0, &one);
+  glEnable(GL_DEPTH_TEST);
+  glBindTextureUnit(kUnitHairStart, depth.hairStart.id);
+  glBindTextureUnit(kUnitHeadDepth, depth.head.id);
+  glBindTextureUnit(kUnitOpacityMap, opacity.id);
+  if (scene.head) {
+    const Program& p = scene.programs.headShade;
+    p.use();
+    setView(p, scene.subpixel);
+    setShadowUniforms(p, scene);
+    p.set("uHeadColor", glm::vec3(r.headColor));
+    scene.head->draw();
+  }
+  const Program& p = scene.programs.hairShade;
+  p.use();
+  setView(p, scene.subpixel);
+  setHairWidth(p, scene.subpixel, r);
+  p.set("uMinWidth", float(scene.block));
+  p.set("uBlock", scene.block);
+  p.set("uOrder", ditherOrder(scene.block));
+  setShadowUniforms(p, scene);
+  p.set("uEye", glm::vec3(r.cameraPosition));
+  p.set("uAmbientColor", glm::vec3(scene.visuality.ambientColor));
+  p.set("uDiffuseColor", glm::vec3(scene.visuality.diffuseColor));
+  p.set("uSpecularColor", glm::vec3(scene.visuality.specularColor));
+  p.set("uGlossiness", float(scene.visuality.glossiness));
+  p.set("uModel", static_cast<int>(r.shadingModel));
+  p.set("uBlend", float(r.volumetricBlend));
+  p.set("uHasColor", scene.hair.hasColors ? 1 : 0);
+  p.set("uHasNormal", scene.hair.hasNormals ? 1 : 0);
+  scene.hair.draw(scene.ribbons);
+  checkGl("the shading pass");
+  return image;
+}
+
+ShadedImage resolvePass(const Scene& scene, const ShadedImage& subpixels) {
+  const int w = scene.camera.width, h = scene.camera.height;
+  ShadedImage image{Texture(GL_RGBA32F, w, h), Texture(GL_RGBA32F, w, h)};
+  Framebuffer fb({&image.color, &image.data}, w, h, false);
+  fb.bind();
+  glDisable(GL_DEPTH_TEST);
+  const Program& p = scene.programs.resolve;
+  p.use();
+  p.set("uBlock", scene.block);
+  glBindTextureUnit(kUnitSubpixelColor, subpixels.color.id);
+  glBindTextureUnit(kUnitSubpixelData, subpixels.data.id);
+  glBindVertexArray(scene.hair.vao);  // core profile draws need a vertex array; the triangle reads none
+  glDrawArrays(GL_TRIANGLES, 0, 3);
+  checkGl("the resolve");
+  return image;
+}
+
+void readBack(const ShadedImage& image, const LightDepth* depth, const Texture* opacity, RenderOutput& out) {
+  Image& b = out.beauty;
+  b.width = image.color.width;
+  b.height = image.color.height;
+  b.channels = {"R", "G", "B", "A", "Z", "opacity", "shadow"};
+  b.planes.resize(b.channels.size());
+  readPlanes(image.color, {&b.planes[0], &b.planes[1], &b.planes[2], &b.planes[3]});
+  readPlanes(image.data, {&b.planes[4], &b.planes[5], &b.planes[6]});
+  if (depth && opacity) {
+    Image& d = out.dom;
+    d.width = d.height = depth->hairStart.width;
+    d.channels = {"Z", "layer1", "layer2", "layer3", "layer4"};
+    d.planes.resize(5);
+    readPlanes(depth->hairStart, {&d.planes[0]});
+    readPlanes(*opacity, {&d.planes[1], &d.planes[2], &d.planes[3], &d.planes[4]});
+  }
+  checkGl("reading the images back");
+  glBindFramebuffer(GL_FRAMEBUFFER, 0);
+}
+
+// Threshold ranks that spread each coverage level evenly: Bayer's matrices for powers of two, a
+// magic-square order for 3, a sheared order otherwise.
+std::vector<int> ditherOrder(int k) {
+  std::vector<int> order(size_t(k) * k);
+  if ((k & (k - 1)) == 0) {
+    for (int y = 0; y < k; ++y)
+      for (int x = 0; x < k; ++x) {
+        int v = 0;
+        for (int bit = k >> 1, weight = 1; bit > 0; bit >>= 1, weight <<= 2) {
+          bool bx = x & bit, by = y & bit;
+          v += weight * ((bx != by ? 2 : 0) + (by ? 1 : 0));
+        }
+        order[size_t(y) * k + x] = v;
+      }
+    // v was built least-significant level last; reverse the base-4 digits so the coarsest level leads.
+    int levels = 0;
+    for (int t = k; t > 1; t >>= 1) ++levels;
+    for (int& v : order) {
+      int r = 0;
+      for (int l = 0; l < levels; ++l) r = r * 4 + ((v >> (2 * l)) & 3);
+      v = r;
+    }
+  } else if (k == 3) {
+    order = {0, 7, 3, 6, 5, 2, 4, 1, 8};
+  } else {
+    for (int y = 0; y < k; ++y)
+      for (int x = 0; x < k; ++x) order[size_t(y) * k + x] = ((x + y * k) * (k + 1)) % (k * k);
+  }
+  return order;
+}
+
+}  // namespace hairgen

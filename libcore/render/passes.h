@@ -1,0 +1,71 @@
+// The passes of one render (deep opacity maps, Yuksel & Keyser 2008, as the thesis uses them in
+// §4.1.6), each a function over the GPU objects of a Scene, called in turn by renderHair:
+//   1. lightDepthPass:  from the light, the distance to the head (an opaque occluder) and to where the
+//                       hair begins;
+//   2. deepOpacityPass: 4 layers from where the hair begins, each strand fragment adding its opacity to
+//                       its layer and every layer behind it;
+//   3. shadingPass:     from the camera on the sub-pixel grid, the head and the hair lit and shadowed
+//                       through both maps;
+//   4. resolvePass:     each block of sub-pixels box-filtered to a pixel;
+//   5. readBack:        the images into RenderOutput's planes, rows top to bottom.
+// Each pass sets the GL state it needs and throws renderFailure when OpenGL reports an error.
+#pragma once
+
+#include <memory>
+
+#include "libcore/render/gl_resources.h"
+#include "libcore/render/renderer.h"
+#include "libcore/render/views.h"
+
+namespace hairgen {
+
+// The programs of one render: hairgen's stages (libcore/render/glsl/), or the Setup's custom ones in
+// their place (HairVert in every program that draws hair, HeadVert in every one that draws the head).
+struct Programs {
+  Programs(bool ribbons, const CustomShaders& custom);
+  Program hairDepth, headDepth, opacity, hairShade, headShade, resolve;
+};
+
+// What every pass reads: the settings, the views, the geometry on the GPU and the programs. Building
+// it uploads the geometry and compiles the programs.
+struct Scene {
+  explicit Scene(const RenderInput& input);
+
+  const RenderSettings& settings;
+  const Visuality& visuality;
+  BoundingSphere sphere;  // around the hair and the head
+  int block;              // k: sub-pixels per pixel side (Samples = k², as far as the device allows)
+  View camera, subpixel;  // the camera on pixels and on sub-pixels
+  View light;             // domResolution texels per side
+  bool ribbons;           // the shading pass draws ribbons, not lines
+  HairGeometry hair;
+  std::unique_ptr<HeadGeometry> head;  // null when there is no head to draw
+  Programs programs;
+};
+
+// The light's depth maps, metres along its axis (kBackgroundZ where nothing was drawn).
+struct LightDepth {
+  Texture head;       // R32F: to the head
+  Texture hairStart;  // R32F: to where the hair begins
+};
+
+// An image the shading pass draws and the resolve averages.
+struct ShadedImage {
+  Texture color;  // R G B over the background, A coverage
+  Texture data;   // Z (metres along the camera's axis), hair opacity, shadow (the light arriving)
+};
+
+LightDepth lightDepthPass(const Scene& scene);
+// RGBA32F, one layer per channel, the light's map size.
+Texture deepOpacityPass(const Scene& scene, const LightDepth& depth);
+// At sub-pixel resolution.
+ShadedImage shadingPass(const Scene& scene, const LightDepth& depth, const Texture& opacity);
+// At the image's resolution.
+ShadedImage resolvePass(const Scene& scene, const ShadedImage& subpixels);
+// Into `out.beauty`, and `out.dom` when the light's maps are passed.
+void readBack(const ShadedImage& image, const LightDepth* depth, const Texture* opacity, RenderOutput& out);
+
+// Threshold ranks for a k×k block of the screen door (k ≤ 8), row by row.
+std::vector<int> ditherOrder(int k);
+
+}  // namespace hairgen

@@ -1,0 +1,61 @@
+// What the renderer's C++ and its GLSL share, declared once here: the texture units of the light's maps
+// and the sub-pixel images, the shadow biases, the shading models' numbers, and the text put in front of
+// every shader stage (hairgen's own, from libcore/render/glsl/, and a Setup's custom ones). GLSL sees
+// the names below as constants of the same spelling.
+#pragma once
+
+#include <string>
+
+namespace hairgen {
+
+// The texture units the passes bind their maps to; GLSL declares each sampler with
+// `layout(binding = kUnit...)`, so no unit is set by hand.
+enum TextureUnit : int {
+  kUnitHairStart = 0,      // R32F, the light's view: distance along its axis to where the hair begins, metres
+  kUnitHeadDepth = 1,      // R32F, the light's view: distance along its axis to the head, metres
+  kUnitOpacityMap = 2,     // RGBA32F, the light's view: the 4 deep opacity layers
+  kUnitSubpixelColor = 3,  // RGBA16F, the shading pass's sub-pixels: color and opacity
+  kUnitSubpixelData = 4,   // RGBA32F, the shading pass's sub-pixels: Z, hair opacity, shadow
+};
+inline constexpr int kTextureUnitCount = 5;
+
+// The unit's name as C++ and GLSL spell it ("kUnitHairStart").
+const char* name(TextureUnit unit);
+
+// Shadow biases, metres. The light's maps have texels a few millimetres wide at the head, so a surface
+// compared with the map it drew itself into would shadow itself.
+// A strand must not shadow itself: hair looks its shadow up 1 mm nearer the light.
+inline constexpr float kShadowBiasHair = 0.001f;
+// The head must not shadow itself where it faces the light: it looks its shadow up 2 mm off its
+// surface, along its normal.
+inline constexpr float kShadowOffsetHead = 0.002f;
+// A point is behind the head only when 3 mm farther from the light than the head's depth map says, so
+// the scalp and the roots on it are not cut off by the map's resolution.
+inline constexpr float kShadowBiasHeadDepth = 0.003f;
+
+// What goes in front of one shader stage's text.
+struct StagePrelude {
+  bool ribbon = false;          // `#define RIBBON`: the hair is drawn as ribbons in this program
+  bool shadowFunction = false;  // lightArriving() (glsl/shadow.glsl): the shading fragment stages
+  bool screenDoor = false;      // screenDoor() (glsl/screen_door.glsl): the hair shading fragment stage
+};
+
+// The GLSL constants: `const int kShading<Name> = <value>;` for every ShadingModel (the name from
+// name(ShadingModel) in camel case, e.g. kShadingKajiyaKay), every TextureUnit, and the shadow biases.
+std::string glslConstants();
+
+// `#version 450 core`, RIBBON where asked, glslConstants(), the functions asked for, then `#line 1`, so
+// the compiler numbers the stage's own lines from 1; `body` follows.
+std::string assembleStage(const StagePrelude& prelude, const std::string& body);
+
+// The first error of a GLSL compiler's or linker's log, on one line: its line number (0 when the log
+// names none) and what it says, without the log's own location prefix and "error:". Reads the logs of
+// Mesa ("0:12(5): error: ..."), NVIDIA ("0(12) : error C1008: ...") and glslang-style drivers
+// ("ERROR: 0:12: ..."); another line shape comes back whole, at line 0.
+struct CompilerMessage {
+  int line = 0;
+  std::string text;
+};
+CompilerMessage firstCompilerError(const std::string& log);
+
+}  // namespace hairgen

@@ -1,0 +1,79 @@
+// The render stage: a coupe, the head and the Setup's looks to an image with AOVs (thesis §4.1.5-4.1.6;
+// the passes are in libcore/render/renderer.h). Prints nothing, reads no files: the caller opens the
+// device (GlContext) and reads the coupe, the head and any custom shader files.
+//
+// Custom shaders (README, Custom shaders). The Setup keys HairVert, HairFrag, HeadVert and HeadFrag
+// name GLSL files that take the place of hairgen's own stage in that slot:
+//   HairVert  the hair vertex stage of every pass that draws hair (the light's depth and deep opacity
+//             passes, and the shading pass), so a shader that moves the strands moves their shadows;
+//   HairFrag  the hair shading fragment stage;
+//   HeadVert  the head vertex stage of every pass that draws the head (the light's depth pass and the
+//             shading pass);
+//   HeadFrag  the head shading fragment stage.
+// hairgen's own stage for a slot is the reference example: libcore/render/glsl/hair_vertex.glsl,
+// hair_fragment.glsl, head_vertex.glsl and head_fragment.glsl. A custom stage declares the inputs,
+// outputs and uniforms it uses from those of hairgen's stage, with the same names, types and locations
+// (an unused uniform may be left out; hairgen sets whatever the program has):
+//   HairVert  lines: attributes aPosition, aTangent, aColor, aNormal at locations 0-3; ribbons
+//             (RIBBON defined): storage buffers 0-3 of floats (points, tangents, colors, normals, 3 per
+//             point), uHasColor, uHasNormal, and two vertices per point (gl_VertexID 2i, 2i + 1).
+//             Uniforms uView, uProj, uViewport, uFocalPx, uWidth, uOpacity, uMinWidth. Writes
+//             gl_Position and vWorld, vTangent, vColor, vNormal (vec3), vAlpha, vDepth (float: metres
+//             along the view axis; the light's passes read it).
+//   HairFrag  reads those outputs; uniforms uEye, uLightPosition, uLightColor, uAmbient,
+//             uAmbientColor, uDiffuseColor, uSpecularColor, uGlossiness, uModel, uBlend; writes
+//             oColor (location 0: RGB, and the strand's opacity) and oData (location 1: Z in metres, hair
+//             opacity 1, the shadow, 0).
+//   HeadVert  attributes aPosition, aNormal at locations 0-1; uniforms uView, uProj; writes gl_Position
+//             and vWorld, vNormal, vDepth.
+//   HeadFrag  reads those; uniforms uLightPosition, uLightColor, uAmbient, uHeadColor; writes oColor
+//             (RGB, 1) and oData (Z, hair opacity 0, the shadow, 0).
+// In front of the file hairgen puts `#version 450 core`, `#define RIBBON` when the program draws
+// strands as ribbons, the constants kShading<Model> (kShadingKajiyaKay, kShadingThesis, kShadingAnjyo,
+// kShadingVolumetric: uModel's values), kUnit<Map> (texture units) and kShadowBiasHair,
+// kShadowOffsetHead, kShadowBiasHeadDepth (metres), and in a fragment stage the shadow function
+// `float lightArriving(vec3 world, float bias)` (1 in the open, down to 0.25; libcore/render/glsl/
+// shadow.glsl) and for HairFrag `void screenDoor(float alpha)` (supersampling's coverage; call it
+// first). Then `#line 1`, so the compiler's line numbers are the file's. The file has no #version line.
+// A file that fails to compile or link is an InputError (exit 2) whose one line names the file and the
+// compiler's line: "hairfrag.glsl:12: 'foo' : undeclared identifier (compiling HairFrag, named at
+// setup.txt:9)".
+#pragma once
+
+#include <optional>
+#include <string>
+
+#include "libcore/config/params.h"
+#include "libcore/model/mesh.h"
+#include "libcore/model/strands.h"
+#include "libcore/render/gl_context.h"
+#include "libcore/render/renderer.h"
+
+namespace hairgen {
+
+// What the render stage does beyond Render Info.
+struct RenderOptions {
+  bool frame = false;     // aim the camera and the light at the hair and back the camera off until it fits
+  bool zUp = false;       // the hair is z-up (made elsewhere): turned to hairgen's y-up
+  double scale = 1.0;     // multiplies the hair's positions and widths, to metres (0.01 for centimetres)
+  bool keepDom = false;   // return the light's maps in RenderOutput::dom
+  int domResolution = 0;  // texels per side of the light's maps; 0: domResolutionFor(Resolution)
+};
+
+// Hair made elsewhere, to hairgen's conventions: z-up turned to y-up (x, y, z) → (x, z, −y), then
+// positions and widths scaled by `scale`.
+void conform(Strands& hair, bool zUp, double scale);
+
+// Keeps the camera's and the light's directions and distances from the target in proportion, but aims
+// them at the centre of the hair's bounding sphere and backs the camera off until the sphere fits the
+// view (5% spare). No hair: `render` unchanged.
+void frameHair(RenderSettings& render, const Strands& hair);
+
+// Renders `hair` (and `head`, which may be null) with the current context of `gl`: conformed, framed
+// when asked, with the Setup's custom shaders in place of hairgen's stages. Throws InputError for a
+// custom shader that does not compile or link, Error (exit 1) when the device fails.
+RenderOutput render(GlContext& gl, const Strands& hair, const Mesh* head, const Visuality& visuality,
+                    const RenderSettings& settings, const CustomShaders& shaders,
+                    const RenderOptions& options);
+
+}  // namespace hairgen
