@@ -64,6 +64,7 @@ std::string glslConstants() {
   for (int unit = 0; unit < kTextureUnitCount; ++unit)
     out += std::string("const int ") + name(TextureUnit(unit)) + " = " + std::to_string(unit) + ";\n";
   out += "const float kShadowBiasHair = " + glslFloat(kShadowBiasHair) + ";\n";
+  out += "const float kShadowFloor = " + glslFloat(kShadowFloor) + ";\n";
   out += "const float kShadowOffsetHead = " + glslFloat(kShadowOffsetHead) + ";\n";
   out += "const float kShadowBiasHeadDepth = " + glslFloat(kShadowBiasHeadDepth) + ";\n";
   return out;

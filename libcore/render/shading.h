@@ -15,12 +15,14 @@
 //   SpecularColor·specular)
 // A strand's per-vertex colour, where the cache has one, multiplies AmbientColor and DiffuseColor.
 // Head: AmbientIntensity·HeadColor + shadow·LightColor·HeadColor·max(n·l, 0).
-// `shadow` is the light that arrives: 1 − 0.75·opacity (the thesis maps opacity [0, 1] to [1, 0.25]).
+// `shadow` is the light that arrives: 1 − (1 − kShadowFloor)·opacity (the thesis maps opacity [0, 1]
+// to [1, 0.25]).
 #pragma once
 
 #include <glm/glm.hpp>
 
 #include "libcore/config/params.h"
+#include "libcore/render/shader_interface.h"
 
 namespace hairgen {
 
@@ -30,7 +32,7 @@ glm::dvec3 shadeHair(ShadingModel model, const glm::dvec3& t, const glm::dvec3& 
                      double shadow);
 
 inline double shadowFactor(double opacity) {
-  return 1.0 - 0.75 * glm::clamp(opacity, 0.0, 1.0);
+  return 1.0 - (1.0 - double(kShadowFloor)) * glm::clamp(opacity, 0.0, 1.0);
 }
 
 }  // namespace hairgen

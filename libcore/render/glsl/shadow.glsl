@@ -7,14 +7,14 @@ layout(binding = kUnitHeadDepth) uniform sampler2D uHeadDepth;
 layout(binding = kUnitOpacityMap) uniform sampler2D uOpacityMap;
 uniform vec4 uLayers;     // the deep opacity layers' depths, metres
 // `bias`: metres toward the light, so a surface does not shadow itself through the maps' resolution.
-// Returns 1 in the open, down to 0.25 behind the head or opaque hair.
+// Returns 1 in the open, down to kShadowFloor behind the head or opaque hair.
 float lightArriving(vec3 world, float bias) {
   vec4 lv = uLightView * vec4(world, 1.0);
   float z = -lv.z - bias;
   vec4 c = uLightProj * lv;
   vec2 uv = c.xy / c.w * 0.5 + 0.5;
   if (any(lessThan(uv, vec2(0.0))) || any(greaterThan(uv, vec2(1.0)))) return 1.0;
-  if (z > texture(uHeadDepth, uv).r + kShadowBiasHeadDepth) return 0.25;  // the head is in the way: opaque
+  if (z > texture(uHeadDepth, uv).r + kShadowBiasHeadDepth) return kShadowFloor;  // the head is in the way: opaque
   // Over the 2×2 texels around the point: where the hair begins nearest, and each layer's largest
   // opacity, so a strand one texel wide still shadows what lies behind it.
   vec4 starts = textureGather(uStart, uv, 0);
@@ -32,5 +32,5 @@ float lightArriving(vec3 world, float bias) {
   else if (z < ends.z) s = mix(op.g, op.b, (z - ends.y) / uLayers.z);
   else if (z < ends.w) s = mix(op.b, op.a, (z - ends.z) / uLayers.w);
   else s = op.a;
-  return 1.0 - 0.75 * clamp(s, 0.0, 1.0);
+  return 1.0 - (1.0 - kShadowFloor) * clamp(s, 0.0, 1.0);
 }
