@@ -36,7 +36,9 @@ RenderOutput renderStage(const CommonOptions& common, const Config& config, cons
                    std::to_string(hair.strandCount()) + " strands at " +
                    std::to_string(config.render.resolution.x) + "x" +
                    std::to_string(config.render.resolution.y));
-  RenderOutput out = render(gl, hair, head, config.visuality, config.render, shaders, options);
+  RenderOptions withForce = options;
+  withForce.force = common.force;
+  RenderOutput out = render(gl, hair, head, config.visuality, config.render, shaders, withForce);
   stats.time("upload", out.timings.upload);
   stats.time("lightDepth", out.timings.lightDepth);
   stats.time("opacity", out.timings.opacity);

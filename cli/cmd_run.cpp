@@ -2,6 +2,8 @@
 // chained by hand. With no SETUP it runs the bundled default coupe.
 #include <cstdlib>
 #include <filesystem>
+
+#include <tbb/task_arena.h>
 #include <iostream>
 #include <optional>
 
@@ -11,6 +13,7 @@
 #include "libcore/io/hair_cache.h"
 #include "libcore/io/obj_io.h"
 #include "libcore/util/error.h"
+#include "stages/estimate.h"
 #include "stages/shade.h"
 
 namespace hairgen::cli {
@@ -72,8 +75,13 @@ void registerRun(CLI::App& app, int& exitCode) {
       stats.time("read", clock.lap());
       std::error_code made;
       fs::create_directories(out, made);
-      if (made)
-        throw InputError("-o " + out.string() + ": cannot create the output folder: " + made.message());
+      if (made) {
+        // A name that is already something else is bad usage; a folder that cannot be made (read-only
+        // file system, permissions) is the work failing to write.
+        const std::string why = "-o " + out.string() + ": cannot create the output folder: " + made.message();
+        if (fs::exists(out) && !fs::is_directory(out)) throw InputError(why);
+        throw IoError(why);
+      }
 
       Strands coupe;
       if (config.setup.load) {
@@ -83,6 +91,12 @@ void registerRun(CLI::App& app, int& exitCode) {
       } else {
         Mesh wick = readObj(config.setup.wickModel.path);
         stats.add("read", clock.lap());
+        // Every stage's work is estimated before the first starts: a coupe that cannot be rendered is
+        // refused before minutes of growing.
+        for (const WorkEstimate& e :
+             estimateRun(config, wick, wantsShade(config.visuality, config.render), !options->noRender,
+                         size_t(tbb::this_task_arena::max_concurrency())))
+          requireFits(e, options->common.force);
         GrowResult grown = growStage(options->common, config, wick, stats);
         const fs::path guidesFile = out / "guides.hair";
         clock.lap();

@@ -27,8 +27,9 @@ constexpr double kSecondsPerPoint = 25e-9;
 // The volume: per grid node (sweeps, slides) and per splatted vertex (ShadeCoupe3: 800k nodes and 9.6M
 // vertices in 1 s).
 constexpr double kSecondsPerNode = 500e-9, kSecondsPerSplat = 60e-9;
-// llvmpipe: per vertex pushed through a pass, and per fragment shaded (render benchmarks).
-constexpr double kSecondsPerVertex = 150e-9, kSecondsPerFragment = 8e-9;
+// llvmpipe: per vertex pushed through a pass, and per fragment of the shading pass with its shadow
+// look-ups and overdraw (render benchmarks; 1,000 strands 0.5 m wide at 640x640 took 113 s).
+constexpr double kSecondsPerVertex = 150e-9, kSecondsPerFragment = 60e-9;
 
 double cores(size_t threads) {
   return double(std::max<size_t>(threads, 1));
@@ -109,7 +110,11 @@ WorkEstimate estimateInterpolate(const Hairstyle& style, double wickAreaCm2, siz
   // Points and tangents, and per strand its id, root, guides and weights.
   e.bytes = bytesOf(points * 24.0 + strands * 64.0);
   e.seconds = points * kSecondsPerPoint;
-  e.memoryKey = e.timeKey = "Hairstyle.HairDensity";
+  // Many points per strand come from the guides' sampling, not from the density.
+  const char* sampling =
+      style.model == StylingModel::kCantilever ? "Hairstyle.Segments" : "Hairstyle.VisualityStep";
+  e.memoryKey = e.timeKey =
+      pointsPerGuide > 1000 ? std::string(sampling) + " or Hairstyle.HairDensity" : "Hairstyle.HairDensity";
   e.detail = formatReal(std::round(strands)) + " strands of " + std::to_string(pointsPerGuide) + " points";
   return e;
 }
@@ -156,6 +161,34 @@ WorkEstimate estimateRender(const RenderSettings& r, size_t strands, size_t poin
   e.detail = std::to_string(r.resolution.x) + "x" + std::to_string(r.resolution.y) + " pixels at " +
              std::to_string(block * block) + " samples, " + std::to_string(strands) + " strands";
   return e;
+}
+
+size_t pointsPerGuide(const Hairstyle& style) {
+  if (style.model == StylingModel::kCantilever) return size_t(style.segments) + 1;
+  const double points = std::ceil(style.totalLength() / style.visualityStep) + 1.0;
+  return points < 1e15 ? size_t(points) : size_t(1e15);
+}
+
+std::vector<WorkEstimate> estimateRun(const Config& config, const Mesh& wick, bool shade, bool render,
+                                      size_t threads) {
+  const Hairstyle& style = config.hairstyle;
+  const double area = surfaceArea(wick) * 1e4, length = style.totalLength();
+  const size_t points = pointsPerGuide(style);
+  std::vector<WorkEstimate> out = {estimateGrow(style, config.collision, wick.vertexCount(), threads),
+                                   estimateInterpolate(style, area, wick.triangleCount(), points)};
+  const double strands = std::min(area * style.hairDensity + double(wick.triangleCount()), 1e18);
+  const double coupePoints = std::min(strands * double(points), 1e18);
+  // The hair reaches at most its length beyond the wick.
+  const Bounds box = bounds(wick.positions);
+  const glm::dvec3 span = glm::dvec3(box.max) - glm::dvec3(box.min) + 2.0 * length;
+  if (shade) out.push_back(estimateShade(config.render, size_t(strands), size_t(coupePoints), span));
+  if (render) {
+    const glm::dvec3 centre = 0.5 * (glm::dvec3(box.min) + glm::dvec3(box.max));
+    const double nearest = glm::length(config.render.cameraPosition - centre) - 0.5 * glm::length(span);
+    out.push_back(estimateRender(config.render, size_t(strands), size_t(coupePoints), 0,
+                                 std::max(nearest, 1e-3), length, 16384));
+  }
+  return out;
 }
 
 }  // namespace hairgen

@@ -8,6 +8,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <string>
+#include <vector>
 
 #include "libcore/config/params.h"
 #include "libcore/model/mesh.h"
@@ -45,5 +46,13 @@ WorkEstimate estimateShade(const RenderSettings& render, size_t strands, size_t 
 // longest strand, metres.
 WorkEstimate estimateRender(const RenderSettings& render, size_t strands, size_t points, size_t headTriangles,
                             double nearest, double hairLength, int maxTextureSize);
+
+// The points a grown guide has: one every VisualityStep (Super-Helix), or Segments + 1 (cantilever).
+size_t pointsPerGuide(const Hairstyle& style);
+
+// Every stage of `hairgen run` on `wick`, before any of them runs, from the config alone: the coupe's
+// size and extent are predicted from the wick, the density and the hair's length.
+std::vector<WorkEstimate> estimateRun(const Config& config, const Mesh& wick, bool shade, bool render,
+                                      size_t threads);
 
 }  // namespace hairgen

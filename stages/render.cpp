@@ -4,6 +4,8 @@
 #include <cmath>
 
 #include "libcore/render/views.h"
+#include "libcore/util/error.h"
+#include "stages/estimate.h"
 
 namespace hairgen {
 
@@ -32,14 +34,55 @@ void frameHair(RenderSettings& r, const Strands& hair) {
   r.lightPosition = sphere.centre + glm::normalize(toLight) * distance * lightRatio;
 }
 
+namespace {
+
+// A strand's colour multiplies its reflectances; far beyond 1 it only overflows the half-float image to
+// infinity (and NaN where it meets a zero), so colours are clamped to [0, kMaxHairColor].
+constexpr float kMaxHairColor = 1000.0f;
+
+bool colorsInRange(const Strands& hair) {
+  for (const glm::vec3& c : hair.colors)
+    if (!(glm::all(glm::greaterThanEqual(c, glm::vec3(0.0f))) &&
+          glm::all(glm::lessThanEqual(c, glm::vec3(kMaxHairColor)))))
+      return false;
+  return true;
+}
+
+double longestStrand(const Strands& hair) {
+  double longest = 0.0;
+  for (size_t s = 0; s < hair.strandCount(); ++s) {
+    double length = 0.0;
+    for (uint32_t p = hair.firstPoint[s] + 1; p < hair.firstPoint[s + 1]; ++p)
+      length += glm::length(glm::dvec3(hair.points[p]) - glm::dvec3(hair.points[p - 1]));
+    longest = std::max(longest, length);
+  }
+  return longest;
+}
+
+// A rendered image must hold numbers: a non-finite pixel is a bug (or an input the checks missed),
+// never something to write into an EXR.
+void requireFinite(const Image& image) {
+  for (size_t c = 0; c < image.channels.size(); ++c) {
+    size_t bad = 0;
+    for (float v : image.planes[c]) bad += !std::isfinite(v);
+    if (bad)
+      throw NumericError("rendering produced " + std::to_string(bad) + " non-finite pixels in channel " +
+                         image.channels[c] + "; please report it with the command and inputs");
+  }
+}
+
+}  // namespace
+
 RenderOutput render(GlContext& gl, const Strands& hair, const Mesh* head, const Visuality& visuality,
                     const RenderSettings& settings, const CustomShaders& shaders,
                     const RenderOptions& options) {
-  // Hair made elsewhere is conformed in a copy; hairgen's own is rendered as it is.
+  // Hair made elsewhere is conformed in a copy, as is hair with colours past what a pixel can hold;
+  // hairgen's own is rendered as it is.
   std::optional<Strands> conformed;
-  if (options.zUp || options.scale != 1.0) {
+  if (options.zUp || options.scale != 1.0 || !colorsInRange(hair)) {
     conformed = hair;
     conform(*conformed, options.zUp, options.scale);
+    for (glm::vec3& c : conformed->colors) c = glm::clamp(c, glm::vec3(0.0f), glm::vec3(kMaxHairColor));
   }
   RenderInput input;
   input.hair = conformed ? &*conformed : &hair;
@@ -51,7 +94,16 @@ RenderOutput render(GlContext& gl, const Strands& hair, const Mesh* head, const 
   input.domResolution =
       options.domResolution > 0 ? options.domResolution : domResolutionFor(settings.resolution);
   input.keepDom = options.keepDom;
-  return renderHair(gl, input);
+  const BoundingSphere scene = boundingSphere(*input.hair, head);
+  const double nearest =
+      std::max(glm::length(scene.centre - input.settings.cameraPosition) - scene.radius, 1e-3);
+  requireFits(estimateRender(input.settings, input.hair->strandCount(), input.hair->pointCount(),
+                             head ? head->triangleCount() : 0, nearest, longestStrand(*input.hair),
+                             gl.maxTextureSize()),
+              options.force);
+  RenderOutput out = renderHair(gl, input);
+  requireFinite(out.beauty);
+  return out;
 }
 
 }  // namespace hairgen

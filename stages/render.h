@@ -58,6 +58,7 @@ struct RenderOptions {
   double scale = 1.0;     // multiplies the hair's positions and widths, to metres (0.01 for centimetres)
   bool keepDom = false;   // return the light's maps in RenderOutput::dom
   int domResolution = 0;  // texels per side of the light's maps; 0: domResolutionFor(Resolution)
+  bool force = false;     // render work estimated to take absurdly long (never work that cannot fit)
 };
 
 // Hair made elsewhere, to hairgen's conventions: z-up turned to y-up (x, y, z) → (x, z, −y), then

@@ -196,6 +196,12 @@ std::string GlContext::version() const {
   return reinterpret_cast<const char*>(glGetString(GL_VERSION));
 }
 
+int GlContext::maxTextureSize() const {
+  GLint size = 4096;
+  glGetIntegerv(GL_MAX_TEXTURE_SIZE, &size);
+  return size;
+}
+
 std::vector<GlDeviceInfo> GlContext::probe() {
   std::vector<GlDeviceInfo> out;
   Platforms p;

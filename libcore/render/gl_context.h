@@ -28,6 +28,7 @@ class GlContext {
   const std::string& platform() const;  // "device" or "surfaceless"
   std::string renderer() const;         // GL_RENDERER, e.g. "llvmpipe (LLVM 15.0.6, 256 bits)"
   std::string version() const;          // GL_VERSION
+  int maxTextureSize() const;           // GL_MAX_TEXTURE_SIZE, texels per side
 
   // Every EGL device and the surfaceless platform, each tried, for `hairgen render --list-devices`.
   static std::vector<GlDeviceInfo> probe();

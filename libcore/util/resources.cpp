@@ -44,7 +44,9 @@ uint64_t peakResidentBytes() {
 std::string formatBytes(uint64_t bytes) {
   char buffer[32];
   const double b = double(bytes);
-  if (b >= 1e9)
+  if (b >= 1e12)
+    std::snprintf(buffer, sizeof buffer, "%.3g TB", b / 1e12);
+  else if (b >= 1e9)
     std::snprintf(buffer, sizeof buffer, "%.1f GB", b / 1e9);
   else if (b >= 1e6)
     std::snprintf(buffer, sizeof buffer, "%.0f MB", b / 1e6);
