@@ -48,15 +48,15 @@ void registerDiff(CLI::App& app, int& exitCode) {
   cmd->add_option("--fail", options->thresholds.fail,
                   "A pixel fails when a channel differs by more than this")
       ->capture_default_str()
-      ->check(CLI::NonNegativeNumber);
+      ->check(kFiniteNonNegative);
   cmd->add_option("--failpercent", options->thresholds.failPercent,
                   "The images fail when more than this percent of pixels fail")
       ->capture_default_str()
-      ->check(CLI::Range(0.0, 100.0));
+      ->check(kFiniteNonNegative & CLI::Range(0.0, 100.0));
   cmd->add_option("--hardfail", options->thresholds.hardFail,
                   "The images fail when any channel anywhere differs by more than this")
       ->capture_default_str()
-      ->check(CLI::NonNegativeNumber);
+      ->check(kFiniteNonNegative);
   cmd->add_option("--channels", options->channels, "Compare only these channels (default: all of A's)")
       ->delimiter(',');
   cmd->add_option("--out", options->out, "Write |A - B| per channel")->type_name("DIFF.exr");

@@ -106,7 +106,7 @@ void registerRender(CLI::App& app, int& exitCode) {
       ->check(CLI::IsMember({"y", "z"}));
   cmd->add_option("--scale", options->scale,
                   "Multiply the hair's positions and widths (e.g. 0.01 for centimetres)")
-      ->check(CLI::PositiveNumber);
+      ->check(kFiniteNonNegative & CLI::PositiveNumber);
   cmd->add_flag("--frame", options->frame, "Aim the camera and light at the hair and fit it in the view");
   cmd->add_flag("--list-devices", options->listDevices, "List the EGL devices and platforms found, and exit");
   addCommonFlags(*cmd, options->common, true);

@@ -1,5 +1,6 @@
 #include "cli/common.h"
 
+#include <cmath>
 #include <cstdio>
 #include <iostream>
 
@@ -13,6 +14,20 @@
 #include "libcore/util/text.h"
 
 namespace hairgen::cli {
+
+const CLI::Validator kNonNegativeInteger(
+    [](std::string& text) -> std::string {
+      return parseUInt(text) ? std::string() : "'" + text + "' is not a non-negative integer";
+    },
+    "UINT");
+
+const CLI::Validator kFiniteNonNegative(
+    [](std::string& text) -> std::string {
+      std::optional<double> v = parseReal(text);
+      return v && std::isfinite(*v) && *v >= 0.0 ? std::string()
+                                                 : "'" + text + "' is not a finite number >= 0";
+    },
+    "FINITE >= 0");
 
 void addCommonFlags(CLI::App& command, CommonOptions& options, bool configFlags) {
   command
@@ -29,6 +44,7 @@ void addCommonFlags(CLI::App& command, CommonOptions& options, bool configFlags)
       "--force", options.force,
       "Run work estimated to take more than an hour (work that cannot fit in memory is always refused)");
   command.add_option("--seed", options.seed, "Seed of every random number (overrides Hairstyle.Seed)")
+      ->check(kNonNegativeInteger)
       ->type_name("N");
   std::string sections;
   for (const SectionSpec* s : allSections()) sections += (sections.empty() ? "" : ", ") + s->name;

@@ -26,6 +26,11 @@ struct CommonOptions {
   std::string statsFile;  // --stats FILE.json
 };
 
+// Validators for numbers on the command line, as strict as the config reader: no sign wrapping into an
+// unsigned integer, no NaN or infinity passing a range check.
+extern const CLI::Validator kNonNegativeInteger;
+extern const CLI::Validator kFiniteNonNegative;
+
 // Registers --threads, --quiet and --stats; with `configFlags` also --seed and --set.
 void addCommonFlags(CLI::App& command, CommonOptions& options, bool configFlags);
 

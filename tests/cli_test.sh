@@ -273,6 +273,84 @@ wick_info)
   expect_rc 0 "$hairgen" info "$src/configs/assets/wick.obj"
   grep -q "759 vertices, 1443 triangles, area" "$tmp/out" || fail "wick info: $(cat "$tmp/out")"
   ;;
+hardening_flags)
+  # Flags are validated like config values: no sign wrapping, no NaN passing a range.
+  expect_rc 2 "$hairgen" check "$src/configs/default/setup.txt" --seed -5
+  grep -q -- "--seed: '-5' is not a non-negative integer" "$tmp/err" || fail "seed: $(cat "$tmp/err")"
+  ref="$src/golden/coupe1/reference.exr"
+  expect_rc 2 "$hairgen" diff "$ref" "$ref" --fail nan
+  expect_rc 2 "$hairgen" diff "$ref" "$ref" --hardfail inf
+  # Names and provenance that are not UTF-8 are written into JSON, not thrown on.
+  cp "$src/golden/fixtures/coupe3-shaded.hair" "$tmp/$(printf 'bad\xff.hair')"
+  expect_rc 0 "$hairgen" info "$tmp/$(printf 'bad\xff.hair')" --json --stats "$tmp/s.json"
+  ;;
+hardening_outputs)
+  # A character device named as --stats stays a device (as root: a node of our own, so nothing real is
+  # at stake); without root, /dev/null and /dev/full stand in.
+  if [ "$(id -u)" -eq 0 ] && mknod "$tmp/null" c 1 3 2>/dev/null; then
+    expect_rc 0 "$hairgen" check "$src/configs/default/setup.txt" -q --stats "$tmp/null"
+    [ -c "$tmp/null" ] || fail "--stats replaced the character device with a $(stat -c %F "$tmp/null")"
+  else
+    echo "not root or no mknod here: checking /dev/null instead"
+    expect_rc 0 "$hairgen" check "$src/configs/default/setup.txt" -q --stats /dev/null
+    [ -c /dev/null ] || fail "/dev/null is no longer a device"
+  fi
+  expect_rc 1 "$hairgen" check "$src/configs/default/setup.txt" -q --stats /dev/full
+  grep -q "/dev/full: write failed" "$tmp/err" || fail "full: $(cat "$tmp/err")"
+  expect_rc 0 "$hairgen" check "$src/configs/default/setup.txt" -q --stats /dev/stdout
+  grep -q '"command": "check"' "$tmp/out" || fail "--stats /dev/stdout wrote nothing"
+  # A command that fails removes what it wrote: grow's diagnostics when the guides cannot be written,
+  # render's EXR when its preview cannot.
+  mkdir "$tmp/taken.hair" "$tmp/taken.png"
+  expect_rc 2 "$hairgen" grow "$src/configs/thesis/coupe1/setup.txt" -o "$tmp/taken.hair" --diagnostics "$tmp/d.json" -q
+  [ ! -e "$tmp/d.json" ] || fail "a failed grow left its diagnostics"
+  expect_rc 2 "$hairgen" render "$src/configs/thesis/coupe3/setup.txt" --hair "$src/golden/fixtures/coupe3-shaded.hair" \
+    -o "$tmp/i.exr" --preview "$tmp/taken.png" --set "Render.Resolution=32 32" -q
+  [ ! -e "$tmp/i.exr" ] || fail "a failed render left its EXR"
+  [ -z "$(ls -A "$tmp" | grep tmp-)" ] || fail "temporaries left: $(ls -A "$tmp")"
+  ;;
+hardening_interrupt)
+  # SIGTERM while interpolate writes a large coupe: exit 143, and neither the coupe nor a temporary.
+  expect_rc 0 "$hairgen" grow "$src/configs/default/setup.txt" -o "$tmp/g.hair" -q
+  for attempt in 1 2 3; do
+    "$hairgen" interpolate "$src/configs/default/setup.txt" --guides "$tmp/g.hair" -o "$tmp/c.hair" -q \
+      --set Hairstyle.HairDensity=400 &
+    pid=$!
+    seen=0
+    for _ in $(seq 3000); do
+      if ls "$tmp" | grep -q '^c\.hair\.tmp-'; then seen=1; kill -TERM "$pid"; break; fi
+      kill -0 "$pid" 2>/dev/null || break
+      sleep 0.01
+    done
+    wait "$pid"; rc=$?
+    [ "$seen" -eq 1 ] || { rm -f "$tmp/c.hair"; echo "attempt $attempt: the write finished before it was seen"; continue; }
+    [ "$rc" -eq 143 ] || fail "interpolate ended with $rc after SIGTERM, expected 143"
+    [ -z "$(ls -A "$tmp" | grep tmp-)" ] || fail "SIGTERM left a temporary: $(ls -A "$tmp")"
+    [ ! -e "$tmp/c.hair" ] || fail "SIGTERM left a coupe"
+    echo "ok ($case)"; exit 0
+  done
+  fail "never caught interpolate while it wrote"
+  ;;
+hardening_memory)
+  # Under a 4 GB address-space limit no config ends in "out of memory": each is refused first, naming
+  # the key to change.
+  command -v prlimit >/dev/null || { echo "no prlimit here: skipped"; exit 0; }
+  limit=(prlimit --as=4000000000)
+  d="$src/configs/default/setup.txt"
+  for set in "Hairstyle.HairDensity=1e20" "Hairstyle.CollisionStep=1e-9" "Hairstyle.VisualityStep=1e-9" \
+             "Render.Resolution=16384 16384" "Render.VoxelSize=1e-6"; do
+    key=${set%%=*}; key=${key#*.}
+    expect_rc 2 "${limit[@]}" "$hairgen" run "$d" -o "$tmp/r" -q --set Render.ShadingModel=volumetric --set "$set"
+    grep -q "$key" "$tmp/err" || fail "$set: the message does not name $key: $(cat "$tmp/err")"
+    ! grep -q "out of memory" "$tmp/err" || fail "$set: out of memory"
+  done
+  expect_rc 2 "${limit[@]}" "$hairgen" run "$src/configs/anjyo/bob/setup.txt" -o "$tmp/r" -q --set Hairstyle.Segments=100000
+  grep -q "Segments" "$tmp/err" || fail "Segments: $(cat "$tmp/err")"
+  expect_rc 2 "${limit[@]}" "$hairgen" render "$d" --hair "$src/golden/fixtures/coupe3-shaded.hair" -o "$tmp/i.exr" -q \
+    --set "Render.Resolution=16384 16384"
+  expect_rc 2 "$hairgen" grow "$d" -o "$tmp/g.hair" -q --set "Hairstyle.HairLengths=$(printf '0.000625 %.0s' $(seq 256))"
+  grep -q -- "--force" "$tmp/err" || fail "256 elements: $(cat "$tmp/err")"
+  ;;
 *) fail "unknown case" ;;
 esac
 echo "ok ($case)"

@@ -1,0 +1,263 @@
+// The attacks of the hardening review, each kept as a test of the class of bug it found: wrapped
+// extents, files read from outside a glTF's folder, images sized by their header, outputs that replaced
+// devices and links, stale temporaries, runaway estimates, text as editors write it, non-UTF-8 JSON.
+#include <gtest/gtest.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <fstream>
+#include <random>
+#include <thread>
+
+#include <nlohmann/json.hpp>
+
+#include "libcore/config/keys.h"
+#include "libcore/io/exr_io.h"
+#include "libcore/io/gltf_io.h"
+#include "libcore/io/obj_io.h"
+#include "libcore/util/checked.h"
+#include "libcore/util/file_util.h"
+#include "libcore/util/json.h"
+#include "stages/estimate.h"
+#include "stages/interpolate.h"
+#include "tests/test_util.h"
+
+namespace hairgen {
+namespace {
+
+namespace fs = std::filesystem;
+
+std::string inputError(const std::function<void()>& fn) {
+  try {
+    fn();
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  ADD_FAILURE() << "expected an InputError";
+  return {};
+}
+
+std::string slurp(const fs::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  return {std::istreambuf_iterator<char>(in), {}};
+}
+
+void spit(const fs::path& p, const std::string& text) {
+  std::ofstream(p, std::ios::binary) << text;
+}
+
+// --------------------------------------------------------------------------------------------- extents
+
+TEST(Hardening, ExtentsAreCheckedInExactArithmetic) {
+  EXPECT_TRUE(extentFits(0, 10, 12, 12, 120));
+  EXPECT_FALSE(extentFits(0, 11, 12, 12, 120));
+  EXPECT_TRUE(extentFits(7, 0, 12, 12, 0));
+  // 2^62 elements 4 bytes apart wrap a 64-bit product to a small number.
+  EXPECT_FALSE(extentFits(0, 1ull << 62, 4, 4, 1024));
+  EXPECT_FALSE(extentFits(UINT64_MAX - 2, 1, 4, 4, UINT64_MAX));
+}
+
+// A glTF whose accessor claims 2^62 elements: the bounds check used to wrap and read past the buffer.
+TEST(Hardening, AGltfAccessorCountNear2To62IsRefused) {
+  std::vector<uint8_t> json = encodeGltf(test::sampleStrands(3), false);
+  nlohmann::json doc = nlohmann::json::parse(json.begin(), json.end());
+  for (auto& accessor : doc["accessors"]) accessor["count"] = uint64_t(1) << 62;
+  const std::string text = doc.dump();
+  std::string m =
+      inputError([&] { decodeGltf(reinterpret_cast<const uint8_t*>(text.data()), text.size(), "x.gltf"); });
+  EXPECT_NE(m.find("reaches past the end"), std::string::npos) << m;
+}
+
+// --------------------------------------------------------------------------------------- glTF's folder
+
+TEST(Hardening, AGltfReadsOnlyFilesInItsOwnFolder) {
+  test::TempDir dir("hardening");
+  const fs::path sub = dir.path() / "sub";
+  fs::create_directories(sub / "folder");
+  std::vector<uint8_t> json = encodeGltf(test::sampleStrands(3), false);
+  nlohmann::json doc = nlohmann::json::parse(json.begin(), json.end());
+  spit(dir.path() / "secret.txt", "not hair");
+  ::symlink((dir.path() / "secret.txt").c_str(), (sub / "link.bin").c_str());
+  ::mkfifo((sub / "pipe.bin").c_str(), 0600);
+  for (const char* uri : {"/etc/passwd", "../secret.txt", "%2e%2e/secret.txt", "folder", "link.bin",
+                          "pipe.bin", "file:///etc/passwd", "missing.bin"}) {
+    doc["buffers"][0]["uri"] = uri;
+    const std::string text = doc.dump();
+    const fs::path file = sub / "hair.gltf";
+    spit(file, text);
+    std::string m = inputError([&] { readGltf(file); });
+    EXPECT_NE(m.find(std::string("URI '") + uri + "' is refused"), std::string::npos) << m;
+  }
+  // Read from memory there is no folder: an external buffer is refused, whatever it names.
+  doc["buffers"][0]["uri"] = "buffer.bin";
+  const std::string text = doc.dump();
+  EXPECT_THROW(decodeGltf(reinterpret_cast<const uint8_t*>(text.data()), text.size(), "x.gltf"), InputError);
+}
+
+// --------------------------------------------------------------------------------------------- images
+
+TEST(Hardening, AnImageIsSizedBeforeItIsAllocated) {
+  test::TempDir dir("hardening");
+  // Noise, so that compression leaves the file long enough to hold the offset table of the size it
+  // will claim: OpenEXR then gets as far as the header's data window.
+  Image small;
+  small.width = small.height = 128;
+  small.channels = {"R", "G", "B", "A"};
+  std::mt19937 rng(1);
+  for (int c = 0; c < 4; ++c) {
+    small.planes.emplace_back(128 * 128);
+    for (float& v : small.planes.back()) v = float(rng() % 1000) / 1000.0f;
+  }
+  const fs::path file = dir.path() / "small.exr";
+  writeExr(file, small, {});
+  // The same file, its header claiming 30000 x 30000 pixels: kilobytes asking for gigabytes.
+  std::string bytes = slurp(file);
+  for (const std::string key : {"dataWindow", "displayWindow"}) {
+    const size_t at = bytes.find(key + std::string("\0box2i\0", 7));
+    ASSERT_NE(at, std::string::npos);
+    const int32_t window[4] = {0, 0, 29999, 29999};
+    std::memcpy(&bytes[at + key.size() + 7 + 4], window, sizeof window);
+  }
+  spit(dir.path() / "huge.exr", bytes);
+  std::string m = inputError([&] { readImage(dir.path() / "huge.exr"); });
+  EXPECT_NE(m.find("30000x30000"), std::string::npos) << m;
+}
+
+// --------------------------------------------------------------------------------------------- outputs
+
+TEST(Hardening, AWriteToALinkReplacesItsFileAndKeepsTheLink) {
+  test::TempDir dir("hardening");
+  ::symlink("target.json", (dir.path() / "link.json").c_str());  // dangling until written
+  writeFileAtomic(dir.path() / "link.json", std::string("{}\n"));
+  EXPECT_TRUE(fs::is_symlink(dir.path() / "link.json"));
+  EXPECT_EQ(slurp(dir.path() / "target.json"), "{}\n");
+}
+
+TEST(Hardening, AWriteToAFifoGoesIntoItAndLeavesItAFifo) {
+  test::TempDir dir("hardening");
+  const fs::path fifo = dir.path() / "stats.json";
+  ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+  std::string received;
+  std::thread reader([&] { received = slurp(fifo); });
+  writeFileAtomic(fifo, std::string("{\"ok\": true}\n"));
+  reader.join();
+  EXPECT_EQ(received, "{\"ok\": true}\n");
+  struct stat st {};
+  ASSERT_EQ(::lstat(fifo.c_str(), &st), 0);
+  EXPECT_TRUE(S_ISFIFO(st.st_mode));
+}
+
+TEST(Hardening, AWriteErrorIsAnIoError) {
+  if (!fs::exists("/dev/full")) GTEST_SKIP() << "no /dev/full";
+  EXPECT_THROW(writeFileAtomic("/dev/full", std::string(1 << 16, 'x')), IoError);
+  EXPECT_TRUE(fs::is_character_file("/dev/full"));
+}
+
+TEST(Hardening, ADirectoryIsNotAnOutput) {
+  test::TempDir dir("hardening");
+  EXPECT_THROW(writeFileAtomic(dir.path(), std::string("x")), InputError);
+}
+
+TEST(Hardening, TemporariesOfDeadProcessesAreSweptAndLiveOnesKept) {
+  test::TempDir dir("hardening");
+  char host[256] = {};
+  ::gethostname(host, sizeof host - 1);
+  std::string name = host;
+  for (char& c : name)
+    if (c == '-' || c == '/') c = '_';
+  // A PID above the kernel's maximum never runs; our own PID does.
+  const fs::path dead = dir.path() / ("coupe.hair.tmp-" + name + "-99999999-0");
+  const fs::path live = dir.path() / ("coupe.hair.tmp-" + name + "-" + std::to_string(::getpid()) + "-99");
+  const fs::path foreign = dir.path() / "coupe.hair.tmp-otherhost-99999999-0";
+  for (const fs::path& p : {dead, live, foreign}) spit(p, "partial");
+  writeFileAtomic(dir.path() / "coupe.hair", std::string("whole"));
+  EXPECT_FALSE(fs::exists(dead));
+  EXPECT_TRUE(fs::exists(live));
+  EXPECT_TRUE(fs::exists(foreign));  // another host's process may still be writing
+}
+
+TEST(Hardening, AFailedCommandsCommittedOutputsCanBeDiscarded) {
+  test::TempDir dir("hardening");
+  forgetCommittedOutputs();
+  writeFileAtomic(dir.path() / "image.exr", std::string("pixels"));
+  writeFileAtomic(dir.path() / "guides.json", std::string("{}"));
+  discardCommittedOutputs();
+  EXPECT_FALSE(fs::exists(dir.path() / "image.exr"));
+  EXPECT_FALSE(fs::exists(dir.path() / "guides.json"));
+}
+
+// ---------------------------------------------------------------------------------------------- inputs
+
+TEST(Hardening, AFifoNamedAsAnInputIsRefusedNotWaitedOn) {
+  test::TempDir dir("hardening");
+  const fs::path fifo = dir.path() / "setup.txt";
+  ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+  std::string m = inputError([&] { readConfigText(fifo); });
+  EXPECT_NE(m.find("not a regular file"), std::string::npos) << m;
+  EXPECT_THROW(readObj(fifo), InputError);
+}
+
+TEST(Hardening, TextAsEditorsWriteIt) {
+  // A byte-order mark, CRLF and a lone CR (old Mac) line end.
+  Hairstyle h = readHairstyle(test::text("\xEF\xBB\xBFHairLengths 0.04\r\nHairDensity 90\rClump 0.5\n"), {});
+  EXPECT_EQ(h.hairDensity, 90.0);
+  EXPECT_EQ(h.clump, 0.5);
+  Mesh m = parseObj("\xEF\xBB\xBFv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n", "bom.obj");
+  EXPECT_EQ(m.vertexCount(), 3u);
+  // A lone CR ends the comment: the validator sees the vertex that tinyobjloader would read.
+  std::string err =
+      inputError([] { parseObj("v 0 0 0\nv 1 0 0\nv 0 1 0\n# x\rv nan nan nan\nf 1 2 3\n", "cr.obj"); });
+  EXPECT_NE(err.find("cr.obj:5:"), std::string::npos) << err;
+}
+
+TEST(Hardening, JsonOfBytesThatAreNotUtf8IsWrittenNotThrown) {
+  nlohmann::ordered_json doc = {{"provenance", std::string("made by \xff\xfe")}};
+  std::string text;
+  EXPECT_NO_THROW(text = jsonText(doc));
+  EXPECT_NE(text.find("\xEF\xBF\xBD"), std::string::npos);  // U+FFFD
+}
+
+// ---------------------------------------------------------------------------------------- estimates
+
+TEST(Hardening, AbsurdConfigsAreRefusedBeforeTheWork) {
+  Hairstyle style;
+  style.hairLengths = {0.04, 0.04, 0.04, 0.04};
+  Collision head;
+  head.shapes.push_back(
+      {ShapeKind::kEllipsoid, 0.0, 10.0, glm::dvec3(0), glm::dvec3(0.1), glm::dmat3(1), {}});
+  EXPECT_NO_THROW(requireFits(estimateGrow(style, head, 759, 2), false));
+  Hairstyle fine = style;
+  fine.collisionStep = 1e-9;
+  EXPECT_NE(inputError([&] { requireFits(estimateGrow(fine, head, 759, 2), false); }).find("CollisionStep"),
+            std::string::npos);
+  fine = style;
+  fine.visualityStep = 1e-9;
+  EXPECT_NE(inputError([&] { requireFits(estimateGrow(fine, head, 759, 2), true); }).find("VisualityStep"),
+            std::string::npos);
+  fine = style;
+  fine.hairLengths.assign(256, 0.000625);
+  EXPECT_NE(inputError([&] { requireFits(estimateGrow(fine, head, 759, 2), false); }).find("--force"),
+            std::string::npos);
+  EXPECT_NO_THROW(requireFits(estimateGrow(fine, head, 759, 2), true));  // --force runs it
+  fine = style;
+  fine.hairDensity = 1e20;
+  EXPECT_NE(
+      inputError([&] { requireFits(estimateInterpolate(fine, 700.0, 1443, 65), true); }).find("HairDensity"),
+      std::string::npos);
+  RenderSettings render;
+  render.voxelSize = 1e-6;
+  EXPECT_NE(inputError([&] {
+              requireFits(estimateShade(render, 1000, 64000, glm::dvec3(0.3)), true);
+            }).find("VoxelSize"),
+            std::string::npos);
+  render = {};
+  render.resolution = {16384, 16384};
+  render.samples = 4;
+  EXPECT_THROW(requireFits(estimateRender(render, 50000, 3200000, 31696, 0.3, 0.16, 16384), true),
+               InputError);
+  // A float-to-integer conversion before the overflow guard used to give a bald coupe.
+  EXPECT_EQ(strandsInTriangle(1.0, 1e20, 0.5), std::numeric_limits<uint32_t>::max());
+}
+
+}  // namespace
+}  // namespace hairgen
