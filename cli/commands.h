@@ -26,6 +26,7 @@ void registerInterpolate(CLI::App& app, int& exitCode);
 void registerRun(CLI::App& app, int& exitCode);
 void registerRender(CLI::App& app, int& exitCode);
 void registerShade(CLI::App& app, int& exitCode);
+void registerSimulate(CLI::App& app, int& exitCode);
 void registerDiff(CLI::App& app, int& exitCode);
 
 GrowResult growStage(const CommonOptions& common, const Config& config, const Mesh& wick, Stats& stats);

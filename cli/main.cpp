@@ -23,6 +23,7 @@ int main(int argc, char** argv) {
   registerRun(app, exitCode);
   registerGrow(app, exitCode);
   registerInterpolate(app, exitCode);
+  registerSimulate(app, exitCode);
   registerShade(app, exitCode);
   registerRender(app, exitCode);
   registerDiff(app, exitCode);

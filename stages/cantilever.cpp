@@ -169,7 +169,7 @@ GrowResult growCantilever(const Mesh& wick, const Hairstyle& style, const Collis
     result.reports[i].stop = RosenbrockStop::kEpsilon;
   }
   guides.defaultThickness = static_cast<float>(style.hairRadius1 + style.hairRadius2);
-  guides.provenance = {"hairgen " HAIRGEN_VERSION, "grow", style.seed, options.configDigest};
+  guides.provenance = madeByHairgen("grow", style.seed, options.configDigest);
   return result;
 }
 

@@ -27,6 +27,8 @@ constexpr double kSecondsPerPoint = 25e-9;
 // The volume: per grid node (sweeps, slides) and per splatted vertex (ShadeCoupe3: 800k nodes and 9.6M
 // vertices in 1 s).
 constexpr double kSecondsPerNode = 500e-9, kSecondsPerSplat = 60e-9;
+// Anjyo's dynamics: one segment's step, with its trigonometry, joint limit and collision tests.
+constexpr double kSecondsPerSegmentStep = 60e-9;
 // llvmpipe: per vertex pushed through a pass, and per fragment of the shading pass with its shadow
 // look-ups and overdraw (render benchmarks; 1,000 strands 0.5 m wide at 640x640 took 113 s).
 constexpr double kSecondsPerVertex = 150e-9, kSecondsPerFragment = 60e-9;
@@ -160,6 +162,18 @@ WorkEstimate estimateRender(const RenderSettings& r, size_t strands, size_t poin
   e.timeKey = widthPx > 4.0 * block ? "Render.StrandWidth" : "Render.Resolution or Render.Samples";
   e.detail = std::to_string(r.resolution.x) + "x" + std::to_string(r.resolution.y) + " pixels at " +
              std::to_string(block * block) + " samples, " + std::to_string(strands) + " strands";
+  return e;
+}
+
+WorkEstimate estimateSimulate(const Dynamics& d, size_t segments, const FrameRange& frames, size_t threads) {
+  WorkEstimate e;
+  e.stage = "simulate";
+  const double steps = double(frames.count()) * double(d.substeps);
+  e.bytes = bytesOf(double(segments) * 200.0);  // state, rest, constants and a posed copy per segment
+  e.seconds = double(segments) * steps * kSecondsPerSegmentStep / cores(threads);
+  e.memoryKey = "the guides' size";
+  e.timeKey = "Dynamics.Substeps or Dynamics.Frames";
+  e.detail = std::to_string(segments) + " segments, " + formatReal(steps) + " steps";
   return e;
 }
 

@@ -13,6 +13,7 @@
 #include "libcore/config/params.h"
 #include "libcore/model/mesh.h"
 #include "libcore/model/strands.h"
+#include "libcore/util/frames.h"
 
 namespace hairgen {
 
@@ -46,6 +47,10 @@ WorkEstimate estimateShade(const RenderSettings& render, size_t strands, size_t 
 // longest strand, metres.
 WorkEstimate estimateRender(const RenderSettings& render, size_t strands, size_t points, size_t headTriangles,
                             double nearest, double hairLength, int maxTextureSize);
+
+// `segments`: the guides' segments (points − strands); `frames`: the frames to simulate.
+WorkEstimate estimateSimulate(const Dynamics& dynamics, size_t segments, const FrameRange& frames,
+                              size_t threads);
 
 // The points a grown guide has: one every VisualityStep (Super-Helix), or Segments + 1 (cantilever).
 size_t pointsPerGuide(const Hairstyle& style);

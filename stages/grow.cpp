@@ -104,7 +104,7 @@ GrowResult grow(const Mesh& wick, const Hairstyle& style, const Collision& colli
     result.evaluations += result.reports[i].evaluations;
   }
   guides.defaultThickness = static_cast<float>(style.hairRadius1 + style.hairRadius2);  // a diameter
-  guides.provenance = {"hairgen " HAIRGEN_VERSION, "grow", style.seed, options.configDigest};
+  guides.provenance = madeByHairgen("grow", style.seed, options.configDigest);
   return result;
 }
 

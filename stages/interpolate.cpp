@@ -234,7 +234,7 @@ Strands interpolate(const Mesh& wick, const Strands& guides, const Hairstyle& st
   coupe.defaultThickness = guides.defaultThickness;
   coupe.defaultTransparency = guides.defaultTransparency;
   coupe.defaultColor = guides.defaultColor;
-  coupe.provenance = {"hairgen " HAIRGEN_VERSION, "interpolate", seed, options.configDigest};
+  coupe.provenance = madeByHairgen("interpolate", seed, options.configDigest);
   return coupe;
 }
 

@@ -48,7 +48,7 @@ ShadeResult shade(Strands coupe, const Visuality& visuality, const RenderSetting
       for (uint32_t p = out.firstPoint[s]; p < out.firstPoint[s + 1]; ++p) out.colors[p] = glm::vec3(a);
     }
   }
-  out.provenance = {"hairgen " HAIRGEN_VERSION, "shade", seed, options.configDigest};
+  out.provenance = madeByHairgen("shade", seed, options.configDigest);
   result.timings.normals = clock.lap();
   return result;
 }

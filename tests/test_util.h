@@ -76,7 +76,10 @@ inline Strands sampleStrands(size_t count = 7, uint32_t seed = 1) {
     s.thickness.push_back(7e-5f + 1e-5f * u(rng));
     s.transparency.push_back(0.25f + 0.2f * u(rng));
   }
-  s.provenance = {"hairgen test", "unit", 42, "0123456789abcdef"};
+  s.provenance.producer = "hairgen test";
+  s.provenance.stage = "unit";
+  s.provenance.seed = 42;
+  s.provenance.configDigest = "0123456789abcdef";
   return s;
 }
 

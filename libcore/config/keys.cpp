@@ -138,6 +138,8 @@ Section<Setup> makeSetup() {
        pathKey<Setup>({"CollisionInfo", "", "the Collision Info file"}, &Setup::collisionInfo),
        pathKey<Setup>({"VisualityInfo", "", "the Visuality Info file"}, &Setup::visualityInfo),
        pathKey<Setup>({"RenderInfo", "", "the Render Info file"}, &Setup::renderInfo),
+       pathKey<Setup>({"DynamicsInfo", "", "the Dynamics Info file: naming one makes the hair move"},
+                      &Setup::dynamicsInfo),
        pathKey<Setup>({"WickModel", "", "the wick OBJ: every vertex a follicle", {"HairModel"}},
                       &Setup::wickModel),
        pathKey<Setup>({"HeadModel", "", "the head OBJ: rendered, and shadows the hair"}, &Setup::headModel),
@@ -432,6 +434,228 @@ Section<RenderSettings> makeRender() {
       });
 }
 
+// ------------------------------------------------------------------------------------------ Dynamics
+
+// A whole frame number (a key may name any frame, before or after the shot).
+double frameOf(const SectionReader& r, const ConfigLine& line) {
+  double frame = r.checkReal(line, 0, Range::closed(-1e6, 1e6), "frame");
+  if (frame != std::floor(frame)) throw r.error(line, "the frame must be a whole number");
+  return frame;
+}
+
+Key<Dynamics> framesKey() {
+  return customKey<Dynamics>(
+      {"Frames", "", "the first frame (the rest state, the input guides) and the last"}, "first last",
+      "whole numbers, first < last",
+      [](SectionReader& r, Dynamics& d) {
+        const ConfigLine* line = r.line("Frames");
+        if (!line) return;
+        if (line->values.size() != 2) throw r.error(*line, "Frames takes the first and the last frame");
+        const double first = frameOf(r, *line),
+                     last = r.checkReal(*line, 1, Range::closed(-1e6, 1e6), "last");
+        if (last != std::floor(last) || !(last > first))
+          throw r.error(*line, "the last frame must be a whole number after the first");
+        d.firstFrame = int(first);
+        d.lastFrame = int(last);
+      },
+      [](const Dynamics& d) {
+        return std::vector<std::string>{std::to_string(d.firstFrame) + " " + std::to_string(d.lastFrame)};
+      });
+}
+
+Key<Dynamics> windKey() {
+  return repeatable(customKey<Dynamics>(
+      {"Wind", "m/s²", "an acceleration on the hair from FRAME on; linear: ramped from the previous key"},
+      "FRAME ax ay az [hold | linear]", "",
+      [](SectionReader& r, Dynamics& d) {
+        for (const ConfigLine* line : r.lines("Wind")) {
+          if (line->values.size() != 4 && line->values.size() != 5)
+            throw r.error(*line, "Wind takes FRAME ax ay az and, optionally, hold or linear");
+          WindKey w;
+          w.frame = frameOf(r, *line);
+          for (int i = 0; i < 3; ++i)
+            w.acceleration[i] = r.checkReal(*line, 1 + i, Range::closed(-1e4, 1e4), "acceleration");
+          if (line->values.size() == 5) {
+            const std::string mode = toLower(line->values[4]);
+            if (mode != "hold" && mode != "linear")
+              throw r.error(*line, "'" + line->values[4] + "' is not hold or linear");
+            w.linear = mode == "linear";
+          }
+          w.where = line->where;
+          d.wind.push_back(w);
+        }
+        std::stable_sort(d.wind.begin(), d.wind.end(),
+                         [](const WindKey& a, const WindKey& b) { return a.frame < b.frame; });
+        for (size_t i = 1; i < d.wind.size(); ++i)
+          if (d.wind[i].frame == d.wind[i - 1].frame)
+            throw InputError(d.wind[i].where, "a second Wind key at frame " + formatReal(d.wind[i].frame) +
+                                                  " (the first is at " + d.wind[i - 1].where.str() + ")");
+      },
+      [](const Dynamics& d) {
+        std::vector<std::string> lines;
+        for (const WindKey& w : d.wind)
+          lines.push_back(formatReal(w.frame) + " " + join(w.acceleration) +
+                          (w.linear ? " linear" : " hold"));
+        return lines;
+      }));
+}
+
+Key<Dynamics> headKeyKey() {
+  return repeatable(customKey<Dynamics>(
+      {"HeadKey", "m, degrees",
+       "the head's pose at FRAME: a translation, and rotations about x, y, z (in that order) about its "
+       "centre"},
+      "FRAME tx ty tz rx ry rz", "",
+      [](SectionReader& r, Dynamics& d) {
+        for (const ConfigLine* line : r.lines("HeadKey")) {
+          if (line->values.size() != 7) throw r.error(*line, "HeadKey takes FRAME tx ty tz rx ry rz");
+          HeadKey k;
+          k.frame = frameOf(r, *line);
+          for (int i = 0; i < 3; ++i)
+            k.translation[i] = r.checkReal(*line, 1 + i, Range::closed(-1e4, 1e4), "translation");
+          for (int i = 0; i < 3; ++i)
+            k.rotation[i] = r.checkReal(*line, 4 + i, Range::closed(-36000, 36000), "rotation");
+          k.where = line->where;
+          d.headKeys.push_back(k);
+        }
+        std::stable_sort(d.headKeys.begin(), d.headKeys.end(),
+                         [](const HeadKey& a, const HeadKey& b) { return a.frame < b.frame; });
+        for (size_t i = 1; i < d.headKeys.size(); ++i)
+          if (d.headKeys[i].frame == d.headKeys[i - 1].frame)
+            throw InputError(d.headKeys[i].where, "a second HeadKey at frame " +
+                                                      formatReal(d.headKeys[i].frame) + " (the first is at " +
+                                                      d.headKeys[i - 1].where.str() + ")");
+      },
+      [](const Dynamics& d) {
+        std::vector<std::string> lines;
+        for (const HeadKey& k : d.headKeys)
+          lines.push_back(formatReal(k.frame) + " " + join(k.translation) + " " + join(k.rotation));
+        return lines;
+      }));
+}
+
+Key<Dynamics> headCentreKey() {
+  return customKey<Dynamics>(
+      {"HeadCentre", "m",
+       "the point the head turns about; auto = the first Ellipsoid's centre (else the origin)"},
+      "auto | x y z", "",
+      [](SectionReader& r, Dynamics& d) {
+        const ConfigLine* line = r.line("HeadCentre");
+        if (!line) return;
+        if (line->values.size() == 1 && toLower(line->values[0]) == "auto") return;
+        if (line->values.size() != 3) throw r.error(*line, "HeadCentre takes auto or x y z");
+        d.headCentreAuto = false;
+        for (int i = 0; i < 3; ++i)
+          d.headCentre[i] = r.checkReal(*line, i, Range::closed(-1e4, 1e4), "centre");
+      },
+      [](const Dynamics& d) {
+        return std::vector<std::string>{d.headCentreAuto ? std::string("auto") : join(d.headCentre)};
+      });
+}
+
+Key<Dynamics> inertiaKey() {
+  return customKey<Dynamics>(
+      {"Inertia", "",
+       "anjyo: segment i of k has (k/i)^p the inertia of its mass at the hair's length, times f for the "
+       "first n "
+       "segments"},
+      "p [f n]", "p in [0, 4], f > 0, n >= 0",
+      [](SectionReader& r, Dynamics& d) {
+        const ConfigLine* line = r.line("Inertia");
+        if (!line) return;
+        if (line->values.size() != 1 && line->values.size() != 3)
+          throw r.error(*line,
+                        "Inertia takes the exponent p and, optionally, a factor f for the first n segments");
+        d.inertiaExponent = r.checkReal(*line, 0, Range::closed(0.0, 4.0), "exponent");
+        if (line->values.size() == 3) {
+          d.rootInertia = r.checkReal(*line, 1, {0.0, 1e6, true, false}, "factor");
+          const double n = r.checkReal(*line, 2, Range::closed(0.0, 100000.0), "segments");
+          if (n != std::floor(n)) throw r.error(*line, "the number of segments must be a whole number");
+          d.rootSegments = int(n);
+        }
+      },
+      [](const Dynamics& d) {
+        return std::vector<std::string>{formatReal(d.inertiaExponent) + " " + formatReal(d.rootInertia) +
+                                        " " + std::to_string(d.rootSegments)};
+      });
+}
+
+Key<Dynamics> pseudoForceKey() {
+  return customKey<Dynamics>(
+      {"PseudoForce", "-, -, m",
+       "anjyo: within reach of the head ellipsoid, a force with D·F < α|D||F| (into the head) is scaled by "
+       "ε"},
+      "alpha epsilon reach", "α in [-1, 1], ε in [0, 1], reach >= 0",
+      [](SectionReader& r, Dynamics& d) {
+        const ConfigLine* line = r.line("PseudoForce");
+        if (!line) return;
+        if (line->values.size() != 3) throw r.error(*line, "PseudoForce takes alpha epsilon reach");
+        d.pseudoAlpha = r.checkReal(*line, 0, Range::closed(-1.0, 1.0), "alpha");
+        d.pseudoEpsilon = r.checkReal(*line, 1, Range::closed(0.0, 1.0), "epsilon");
+        d.pseudoReach = r.checkReal(*line, 2, Range::closed(0.0, 10.0), "reach");
+      },
+      [](const Dynamics& d) {
+        return std::vector<std::string>{formatReal(d.pseudoAlpha) + " " + formatReal(d.pseudoEpsilon) + " " +
+                                        formatReal(d.pseudoReach)};
+      });
+}
+
+Key<Dynamics> fluctuationKey() {
+  return customKey<Dynamics>(
+      {"Fluctuation", "radians, frames",
+       "anjyo: random turns of each segment up to the amplitude (the most at the tip), drawn once every N "
+       "frames"},
+      "amplitude N", "amplitude in [0, 1], N >= 1",
+      [](SectionReader& r, Dynamics& d) {
+        const ConfigLine* line = r.line("Fluctuation");
+        if (!line) return;
+        if (line->values.size() != 2)
+          throw r.error(*line, "Fluctuation takes an amplitude and every how many frames");
+        d.fluctuation = r.checkReal(*line, 0, Range::closed(0.0, 1.0), "amplitude");
+        const double n = r.checkReal(*line, 1, Range::closed(1.0, 1e6), "frames");
+        if (n != std::floor(n)) throw r.error(*line, "the number of frames must be a whole number");
+        d.fluctuationEvery = int(n);
+      },
+      [](const Dynamics& d) {
+        return std::vector<std::string>{formatReal(d.fluctuation) + " " + std::to_string(d.fluctuationEvery)};
+      });
+}
+
+Key<Dynamics> restFrequencyKey() {
+  return customKey<Dynamics>(
+      {"RestFrequency", "Hz",
+       "anjyo: the angular spring that holds the styled shape (0 = none); auto = the hair's first bending "
+       "mode"},
+      "auto | Hz", "[0, 1000]",
+      [](SectionReader& r, Dynamics& d) {
+        const ConfigLine* line = r.line("RestFrequency");
+        if (!line) return;
+        if (line->values.size() != 1) throw r.error(*line, "RestFrequency takes auto or a frequency in Hz");
+        if (toLower(line->values[0]) == "auto") return;
+        d.restFrequencyAuto = false;
+        d.restFrequency = r.checkReal(*line, 0, Range::closed(0.0, 1000.0), "frequency");
+      },
+      [](const Dynamics& d) {
+        return std::vector<std::string>{d.restFrequencyAuto ? std::string("auto")
+                                                            : formatReal(d.restFrequency)};
+      });
+}
+
+Section<Dynamics> makeDynamics() {
+  using D = Dynamics;
+  return makeSection<D>(
+      "Dynamics", "Dynamics Info", "DynamicsInfo",
+      {choiceKey<D, DynamicsModel>({"Model", "", "anjyo (Anjyo et al. §3) or springs (Petrovic et al. §5)"},
+                                   &D::model, {std::begin(kDynamicsModels), std::end(kDynamicsModels)}),
+       framesKey(),
+       realKey<D>({"FrameRate", "1/s", "frames per second"}, &D::frameRate, {0.0, 10000.0, true, false}),
+       integerKey<D>({"Substeps", "", "integration steps per frame"}, &D::substeps, 1, 1000),
+       realKey<D>({"Damping", "1/s", "the rate at which motion dies away (air, hair on hair)"}, &D::damping,
+                  Range::closed(0.0, 1000.0)),
+       windKey(), headKeyKey(), headCentreKey(), inertiaKey(), pseudoForceKey(), fluctuationKey(),
+       restFrequencyKey()});
+}
+
 }  // namespace
 
 const Section<Setup>& setupKeys() {
@@ -455,9 +679,14 @@ const Section<RenderSettings>& renderKeys() {
   return section;
 }
 
+const Section<Dynamics>& dynamicsKeys() {
+  static const Section<Dynamics> section = makeDynamics();
+  return section;
+}
+
 const SectionList& allSections() {
-  static const SectionList sections = {&setupKeys().spec, &hairstyleKeys().spec, &collisionKeys().spec,
-                                       &visualityKeys().spec, &renderKeys().spec};
+  static const SectionList sections = {&setupKeys().spec,     &hairstyleKeys().spec, &collisionKeys().spec,
+                                       &visualityKeys().spec, &renderKeys().spec,    &dynamicsKeys().spec};
   return sections;
 }
 
@@ -476,11 +705,16 @@ Visuality readVisuality(const ConfigText& text, const std::vector<Override>& ove
 RenderSettings readRender(const ConfigText& text, const std::vector<Override>& overrides) {
   return readSection(renderKeys(), text, overrides);
 }
+Dynamics readDynamics(const ConfigText& text, const std::vector<Override>& overrides) {
+  return readSection(dynamicsKeys(), text, overrides);
+}
 
 std::string Config::canonicalText() const {
+  // Dynamics only when the Setup names a Dynamics Info, so that a still coupe's digest is the one it
+  // had before hairgen could simulate.
   return setupKeys().canonicalText(setup) + hairstyleKeys().canonicalText(hairstyle) +
          collisionKeys().canonicalText(collision) + visualityKeys().canonicalText(visuality) +
-         renderKeys().canonicalText(render);
+         renderKeys().canonicalText(render) + (dynamics.given ? dynamicsKeys().canonicalText(dynamics) : "");
 }
 
 }  // namespace hairgen

@@ -14,6 +14,7 @@ const Section<Hairstyle>& hairstyleKeys();
 const Section<Collision>& collisionKeys();
 const Section<Visuality>& visualityKeys();
 const Section<RenderSettings>& renderKeys();
+const Section<Dynamics>& dynamicsKeys();
 
 // Each reader parses one file's text (after applying the overrides of its section) and rejects any
 // unknown, duplicate, malformed, non-finite or out-of-range value with its file:line.
@@ -22,5 +23,6 @@ Hairstyle readHairstyle(const ConfigText& text, const std::vector<Override>& ove
 Collision readCollision(const ConfigText& text, const std::vector<Override>& overrides);
 Visuality readVisuality(const ConfigText& text, const std::vector<Override>& overrides);
 RenderSettings readRender(const ConfigText& text, const std::vector<Override>& overrides);
+Dynamics readDynamics(const ConfigText& text, const std::vector<Override>& overrides);
 
 }  // namespace hairgen

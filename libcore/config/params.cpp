@@ -26,6 +26,10 @@ const char* name(ShadingModel model) {
   return "kajiya-kay";
 }
 
+const char* name(DynamicsModel model) {
+  return model == DynamicsModel::kSprings ? "springs" : "anjyo";
+}
+
 const char* name(ShapeKind kind) {
   switch (kind) {
     case ShapeKind::kEllipsoid:

@@ -129,6 +129,58 @@ struct RenderSettings {
   double volumetricBlend = 1.0;  // 0 = Kajiya-Kay, 1 = volumetric
 };
 
+// Dynamics Info (DESIGN §8): hair in motion, `hairgen simulate`.
+enum class DynamicsModel { kAnjyo, kSprings };
+const char* name(DynamicsModel model);
+inline constexpr DynamicsModel kDynamicsModels[] = {DynamicsModel::kAnjyo, DynamicsModel::kSprings};
+
+// Wind as an acceleration on the hair (m/s², added to gravity) from FRAME on. `linear`: reached from
+// the previous key's value by a linear ramp; otherwise the value jumps at FRAME and is held.
+struct WindKey {
+  double frame = 0.0;
+  glm::dvec3 acceleration{0.0};
+  bool linear = false;
+  FileLoc where;
+};
+
+// A pose of the head at FRAME: a translation (metres) and rotations (degrees) about x, then y, then z
+// (R = Rz·Ry·Rx), about the head's centre. Between keys the pose moves smoothly (README, Dynamics).
+struct HeadKey {
+  double frame = 0.0;
+  glm::dvec3 translation{0.0};
+  glm::dvec3 rotation{0.0};  // degrees
+  FileLoc where;
+};
+
+struct Dynamics {
+  bool given = false;  // the Setup names a Dynamics Info: hairgen simulates
+  DynamicsModel model = DynamicsModel::kAnjyo;
+  int firstFrame = 1, lastFrame = 48;  // firstFrame is the rest state, the input guides
+  double frameRate = 24.0;             // frames per second
+  int substeps = 4;                    // integration steps per frame
+  double damping = 1.0;                // 1/s: the rate at which motion dies away (air, hair on hair)
+  std::vector<WindKey> wind;
+  std::vector<HeadKey> headKeys;
+  bool headCentreAuto = true;  // the first Ellipsoid's centre of Collision Info (else the origin)
+  glm::dvec3 headCentre{0.0};  // metres, when not auto
+  // Anjyo et al. 1992 §3.2: the inertia of segment i of k is (k/i)^inertiaExponent times that of the
+  // segment's mass at the hair's length, and rootInertia times that again for i <= rootSegments (the
+  // paper's "rough approximation of friction" near the scalp).
+  double inertiaExponent = 1.0;
+  double rootInertia = 1.0;
+  int rootSegments = 0;
+  // §3.2.2, the pseudo-force field: near the head (within pseudoReach of the head ellipsoid) a force
+  // pointing into it (D·F < α|D||F|) is scaled by ε.
+  double pseudoAlpha = -0.75, pseudoEpsilon = 0.1, pseudoReach = 0.01;
+  // §3.2.3: random turns of up to `fluctuation` radians, drawn once every fluctuationEvery frames.
+  double fluctuation = 0.0;
+  int fluctuationEvery = 10;
+  // The styled shape is held by an angular spring at this frequency (Hz; 0 = no spring), or, when auto,
+  // at the hair's own first bending mode, 1.875²·sqrt(E·I/(ρ·A·L⁴))/2π (README, Dynamics).
+  bool restFrequencyAuto = true;
+  double restFrequency = 0.0;
+};
+
 // A path named by a config file, with where it was named (for "missing file" errors).
 struct PathRef {
   std::filesystem::path path;  // resolved against the naming file's directory
@@ -142,14 +194,14 @@ struct Setup {
   bool load = false;           // read the coupe from loadFile instead of growing it
   bool save = false;           // write the coupe to saveFile
   PathRef loadFile, saveFile;
-  PathRef hairstyleInfo, collisionInfo, visualityInfo, renderInfo;
+  PathRef hairstyleInfo, collisionInfo, visualityInfo, renderInfo, dynamicsInfo;
   PathRef wickModel, headModel;
   PathRef hairVert, hairFrag, headVert, headFrag;  // optional GLSL overrides
 };
 
 // A command-line override `--set Section.Key=VALUE`.
 struct Override {
-  std::string section;  // canonical: Setup, Hairstyle, Collision, Visuality, Render
+  std::string section;  // canonical: Setup, Hairstyle, Collision, Visuality, Render, Dynamics
   std::string key;      // as written
   std::vector<std::string> values;
   std::string text;  // the argument as given
@@ -162,6 +214,7 @@ struct Config {
   Collision collision;
   Visuality visuality;
   RenderSettings render;
+  Dynamics dynamics;
 
   // Canonical text of every value that shapes the output (not the paths), one `Section.Key value` a
   // line; and its 64-bit FNV-1a digest in hex. Two configs with equal digests give equal output.

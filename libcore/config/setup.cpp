@@ -45,6 +45,7 @@ Config loadConfig(const std::filesystem::path& setupFile, const std::vector<Over
                           {&s.collisionInfo, "CollisionInfo"},
                           {&s.visualityInfo, "VisualityInfo"},
                           {&s.renderInfo, "RenderInfo"},
+                          {&s.dynamicsInfo, "DynamicsInfo"},
                           {&s.wickModel, "WickModel"},
                           {&s.headModel, "HeadModel"},
                           {&s.hairVert, "HairVert"},
@@ -62,6 +63,8 @@ Config loadConfig(const std::filesystem::path& setupFile, const std::vector<Over
   config.collision = readCollision(text(s.collisionInfo, "Collision Info"), overrides);
   config.visuality = readVisuality(text(s.visualityInfo, "Visuality Info"), overrides);
   config.render = readRender(text(s.renderInfo, "Render Info"), overrides);
+  config.dynamics = readDynamics(text(s.dynamicsInfo, "Dynamics Info"), overrides);
+  config.dynamics.given = s.dynamicsInfo.given();
   return config;
 }
 

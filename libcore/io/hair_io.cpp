@@ -1,5 +1,6 @@
 #include "libcore/io/hair_io.h"
 
+#include <cmath>
 #include <cstring>
 #include <limits>
 
@@ -7,6 +8,7 @@
 
 #include "libcore/util/error.h"
 #include "libcore/util/file_util.h"
+#include "libcore/util/text.h"
 
 namespace hairgen {
 namespace {
@@ -38,6 +40,11 @@ class Writer {
     uint32_t bits;
     std::memcpy(&bits, &v, 4);
     u32(bits);
+  }
+  void f64(double v) {
+    uint64_t bits;
+    std::memcpy(&bits, &v, 8);
+    u64(bits);
   }
   void vec(const glm::vec3& v) {
     f32(v.x);
@@ -112,8 +119,10 @@ std::vector<uint8_t> payload(Fn fill) {
 }
 
 std::string provenanceText(const Provenance& p) {
-  return "producer=" + p.producer + "\nstage=" + p.stage + "\nseed=" + std::to_string(p.seed) +
-         "\nconfig=" + p.configDigest + "\n";
+  std::string text = "producer=" + p.producer + "\nstage=" + p.stage + "\nseed=" + std::to_string(p.seed) +
+                     "\nconfig=" + p.configDigest + "\n";
+  if (p.frame) text += "frame=" + std::to_string(*p.frame) + "\ntime=" + formatReal(p.time) + "\n";
+  return text;
 }
 
 Provenance parseProvenance(const std::string& text, const std::string& name) {
@@ -133,7 +142,16 @@ Provenance parseProvenance(const std::string& text, const std::string& name) {
       p.stage = value;
     else if (key == "config")
       p.configDigest = value;
-    else if (key == "seed") {
+    else if (key == "frame" || key == "time") {
+      std::optional<double> v = parseReal(value);
+      if (!v || !std::isfinite(*v) || (key == "frame" && (*v != std::floor(*v) || std::abs(*v) > 1e9)))
+        throw InputError({name, 0}, "PROV chunk: " + key + " '" + value + "' is not a " +
+                                        (key == "frame" ? "frame number" : "time"));
+      if (key == "frame")
+        p.frame = int(*v);
+      else
+        p.time = *v;
+    } else if (key == "seed") {
       char* end2 = nullptr;
       p.seed = std::strtoull(value.c_str(), &end2, 10);
       if (value.empty() || *end2 != '\0')
@@ -217,6 +235,10 @@ std::vector<uint8_t> encodeHair(const Strands& s) {
                           }
                         }));
   if (!s.guideWeights.empty()) chunks.emplace_back("GWTS", vec3s(s.guideWeights));
+  if (!s.simulationState.empty())
+    chunks.emplace_back("DYNS", payload([&](Writer& p) {
+                          for (double v : s.simulationState) p.f64(v);
+                        }));
   if (!s.provenance.empty()) {
     std::string prov = provenanceText(s.provenance);
     chunks.emplace_back("PROV", std::vector<uint8_t>(prov.begin(), prov.end()));
@@ -357,6 +379,14 @@ Strands decodeHair(const uint8_t* data, size_t size, const std::string& name, Ha
           x.x = p.u32();
           x.y = p.u32();
           x.z = p.u32();
+        }
+      } else if (tag == "DYNS") {
+        if (length % 8) throw InputError({name, 0}, "chunk 'DYNS' is not a whole number of float64 values");
+        s.simulationState.resize(length / 8);
+        for (double& v : s.simulationState) {
+          uint64_t bits = uint64_t(p.u32());
+          bits |= uint64_t(p.u32()) << 32;
+          std::memcpy(&v, &bits, 8);
         }
       } else if (tag == "PROV") {
         s.provenance = parseProvenance(std::string(reinterpret_cast<const char*>(bytes), length), name);

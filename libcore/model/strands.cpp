@@ -16,6 +16,9 @@ bool finite(const glm::vec2& v) {
 bool finite(float v) {
   return std::isfinite(v);
 }
+bool finite(double v) {
+  return std::isfinite(v);
+}
 bool finite(uint32_t) {
   return true;
 }
@@ -35,6 +38,15 @@ void checkArray(const std::string& source, const char* name, const std::vector<T
 }
 
 }  // namespace
+
+Provenance madeByHairgen(std::string stage, uint64_t seed, std::string configDigest) {
+  Provenance p;
+  p.producer = "hairgen " HAIRGEN_VERSION;
+  p.stage = std::move(stage);
+  p.seed = seed;
+  p.configDigest = std::move(configDigest);
+  return p;
+}
 
 void Strands::addStrand(const std::vector<glm::vec3>& strandPoints) {
   points.insert(points.end(), strandPoints.begin(), strandPoints.end());
@@ -63,6 +75,9 @@ void Strands::validate(const std::string& source) const {
   checkArray(source, "root UVs", rootUv, s);
   checkArray(source, "guide ids", guideIds, s);
   checkArray(source, "guide weights", guideWeights, s);
+  size_t segments = 0;
+  for (size_t i = 0; i < s; ++i) segments += pointsOf(i) > 0 ? pointsOf(i) - 1 : 0;
+  checkArray(source, "simulation state", simulationState, 4 * segments);
   if (!std::isfinite(defaultThickness) || !std::isfinite(defaultTransparency) || !finite(defaultColor))
     throw InputError({source, 0}, "header defaults are not finite");
 }

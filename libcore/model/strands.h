@@ -3,6 +3,7 @@
 #pragma once
 
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -16,10 +17,15 @@ struct Provenance {
   std::string stage;     // "grow", "interpolate", "shade", "convert", ...
   uint64_t seed = 0;
   std::string configDigest;  // hex digest of the effective configuration, or ""
+  std::optional<int> frame;  // the frame of a sequence this cache is (DESIGN §8); none for a still
+  double time = 0.0;         // seconds from the sequence's first frame, when `frame` is set
 
   bool empty() const { return producer.empty() && stage.empty() && configDigest.empty() && seed == 0; }
   bool operator==(const Provenance&) const = default;
 };
+
+// The provenance of what this build of hairgen makes: producer "hairgen VERSION", no frame.
+Provenance madeByHairgen(std::string stage, uint64_t seed, std::string configDigest);
 
 // A set of polyline strands. Strand s owns points [firstPoint[s], firstPoint[s+1]).
 //
@@ -50,6 +56,10 @@ struct Strands {
   glm::vec3 defaultColor{0.45f, 0.25f, 0.0f};
 
   Provenance provenance;
+
+  // What `hairgen simulate` needs to resume from this frame (4 doubles per segment: the angles of the
+  // last step and the step before); empty for anything else. Opaque to every other stage.
+  std::vector<double> simulationState;
 
   size_t strandCount() const { return firstPoint.empty() ? 0 : firstPoint.size() - 1; }
   size_t pointCount() const { return points.size(); }

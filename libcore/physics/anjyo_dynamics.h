@@ -1,0 +1,120 @@
+// Anjyo, Usami and Kurihara 1992 §3: hair dynamics as one-dimensional projective equations. Each hair
+// is a chain of rigid segments from its root; segment i has a polar angle θ_i and an azimuth φ_i, and
+//   θ_i'' = c_i u_i F_θ        (4)       φ_i'' = c_i v_i F_φ        (5)
+// with c_i = 1/I_i, u_i = |s_i|/2, v_i = the half length of s_i's projection on the horizontal plane, and
+// F_θ, F_φ the force's components perpendicular to s_i in the θ and φ planes. They are solved by the
+// paper's second-order recurrences (4)' and (5)' (Störmer-Verlet), segment by segment from the root, each
+// segment placed from the one before; then, at each node, the joint angle is limited (§3.2.3) and the node
+// is kept out of the collision shapes.
+//
+// hairgen's choices where the paper is open (README, Dynamics):
+// - Angles: the paper measures θ from the vertical. A hanging segment then sits at the pole, where φ is
+//   undefined and (5) loses its force, and a small sideways push turns into a spin of φ. hairgen
+//   measures each segment's angles in a frame of its own whose pole is perpendicular to the segment's
+//   rest direction: the rest is θ = φ = 0 on the equator, where (4) and (5) are exactly the equations of
+//   a stick turning about its root, and the pole is 90° of departure away.
+// - Units: F is the segment's mass times an acceleration field (gravity, wind, and in the head's frame the
+//   head's own acceleration, with the rotating frame's Euler, centrifugal and Coriolis terms). I_i is
+//   (k/i)^p times the segment's mass at the hair's length L, m_i L²/3 — for one segment, the compound
+//   pendulum ρL³/3 — times a root factor for the first n segments. The mass cancels: c_i u_i m_i =
+//   3 d_i (i/k)^p / (2 L²).
+// - Rest: the guides were styled under gravity, which the equations alone do not hold. The hair moves by
+//   its departure from the styled state: the styling load (the rest pose's gravity on the rest segment)
+//   is subtracted from the force, and an angular spring at RestFrequency pulls each segment toward its
+//   rest direction. Still hair (a still head, no wind) therefore stays exactly at rest.
+// - The pseudo-force field (§3.2.2) scales the departure force, not gravity: near the head ellipsoid, a
+//   departure pointing into it (D·F < α|D||F|, D the ellipsoid's gradient) is multiplied by ε.
+// - Joint limits and collisions are measured against the rest shape: a node may turn as much as it did at
+//   rest, and sink as deep into a shape as it sat at rest, so the styled shape is always allowed.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include "libcore/config/params.h"
+#include "libcore/model/strands.h"
+#include "libcore/physics/head_motion.h"
+
+namespace hairgen {
+
+// The frame a segment's angles are measured in: `rest` its rest direction, `pole` perpendicular to it,
+// `side` = pole × rest. θ is the latitude toward the pole and φ the longitude from the rest direction,
+// so the rest is (0, 0) exactly and sits on the equator.
+struct SegmentFrame {
+  glm::dvec3 rest, pole, side;
+};
+
+// The acceleration the hair feels in the head's frame, per substep: base (gravity, wind and the centre's
+// acceleration, rotated into the head's frame), and the rotating frame's terms about `centre`.
+struct AccelerationField {
+  glm::dvec3 base{0.0};
+  glm::dvec3 omega{0.0}, alpha{0.0};  // the head's angular velocity and acceleration, head frame
+  glm::dvec3 centre{0.0};
+  bool rotating = false;
+  // At point r moving at v (head frame).
+  glm::dvec3 at(const glm::dvec3& r, const glm::dvec3& v) const {
+    if (!rotating) return base;
+    const glm::dvec3 x = r - centre;
+    return base - glm::cross(alpha, x) - glm::cross(omega, glm::cross(omega, x)) - 2.0 * glm::cross(omega, v);
+  }
+};
+
+// The head-frame field at a state of the head: gravity (−y, Hairstyle's g), the wind, and the head's
+// acceleration, all turned into the head's frame.
+AccelerationField headFrameField(const HeadState& head, const glm::dvec3& wind, double gravity);
+
+class AnjyoHair {
+ public:
+  // `rest`: the styled guides, in the head's rest pose (the pose the wick and Collision Info describe).
+  // Strands of one point stay put. Throws InputError for a strand with a zero-length segment.
+  AnjyoHair(const Strands& rest, const Hairstyle& style, const Dynamics& dynamics, const Collision& collision,
+            uint64_t seed);
+
+  // One substep of `dt` seconds for every strand (in parallel; the result does not depend on the
+  // thread count). `frame` and `firstSubstep` key the fluctuations, drawn at the first substep of every
+  // Fluctuation-th frame.
+  void step(const AccelerationField& field, double dt, int frame, bool firstSubstep);
+
+  // The current hair in world coordinates: the head frame moved by `pose`. Points at rest are the input
+  // points exactly; tangents are the input's, turned with their segment.
+  Strands posed(const Pose& pose) const;
+
+  // What a restart needs: θ, φ and the previous substep's θ, φ of every segment, in that order per
+  // segment (4 × segments doubles), and the inverse.
+  std::vector<double> state() const;
+  void restore(const std::vector<double>& state, const std::string& source);
+
+  size_t segmentCount() const { return theta_.size(); }
+  // Diagnostics for tests: every node's position (head frame), and each joint's turn in radians.
+  std::vector<glm::dvec3> nodes() const;
+
+ private:
+  void stepStrand(size_t strand, const AccelerationField& field, double dt, int frame, bool fluctuate);
+  SegmentFrame basisOf(size_t segment) const;
+
+  Strands rest_;
+  std::vector<uint32_t> firstSegment_;                     // per strand, + 1
+  std::vector<double> theta_, phi_, thetaPrev_, phiPrev_;  // 0 at rest
+  std::vector<glm::dvec3> restDir_, pole_, side_;          // each segment's frame (README, Dynamics)
+  std::vector<double> length_, coefficient_;               // d_i and c_i u_i m_i (1/m)
+  std::vector<double> restTurn_;                // radians: the turn at the node before segment i at rest
+  std::vector<glm::dvec3> restForward_;         // the rest nodes as the forward recurrence computes them
+  std::vector<std::vector<double>> restDepth_;  // per shape, per node: the depth it sat at in the shape
+  std::vector<CollisionShape> shapes_;
+  int head_ = -1;  // the first ellipsoid (the pseudo-force head), an index into shapes_
+  glm::dvec3 restAcceleration_;
+  double springOmega2_ = 0.0, damping_ = 0.0;
+  double jointLimit_ = M_PI;  // radians
+  int jointFrom_ = 1;
+  double pseudoAlpha_, pseudoEpsilon_, pseudoReach_;
+  double fluctuation_;
+  int fluctuationEvery_, firstFrame_;
+  uint64_t seed_;
+};
+
+// The first bending mode of a clamped hair, Hz: 1.875² sqrt(E I / (ρ A L⁴)) / 2π, I = π a b³/4, A = π a b.
+double firstBendingFrequency(const Hairstyle& style, double length);
+
+}  // namespace hairgen

@@ -1,0 +1,84 @@
+#include "libcore/util/frames.h"
+
+#include <cstdio>
+
+#include "libcore/util/error.h"
+#include "libcore/util/text.h"
+
+namespace hairgen {
+namespace {
+
+// Where the placeholder is in the file name: [begin, end) and its width; begin == npos when absent.
+struct Placeholder {
+  size_t begin = std::string::npos, end = 0;
+  int width = 0;
+  int count = 0;  // placeholders found
+};
+
+Placeholder findPlaceholder(const std::string& name) {
+  Placeholder p;
+  for (size_t i = 0; i < name.size();) {
+    if (name[i] == '#') {
+      size_t j = i;
+      while (j < name.size() && name[j] == '#') ++j;
+      if (p.count++ == 0) {
+        p.begin = i;
+        p.end = j;
+        p.width = int(j - i);
+      }
+      i = j;
+    } else if (name[i] == '%') {
+      size_t j = i + 1;
+      int width = 0;
+      while (j < name.size() && name[j] >= '0' && name[j] <= '9') width = width * 10 + (name[j++] - '0');
+      if (j < name.size() && name[j] == 'd' && width <= 12) {
+        if (p.count++ == 0) {
+          p.begin = i;
+          p.end = j + 1;
+          p.width = width;
+        }
+        i = j + 1;
+      } else {
+        ++i;
+      }
+    } else {
+      ++i;
+    }
+  }
+  return p;
+}
+
+}  // namespace
+
+FrameRange parseFrameRange(std::string_view text, const std::string& flag) {
+  auto bad = [&] {
+    return InputError(flag + " " + std::string(text) + ": expected FIRST-LAST (e.g. 1-48) or one frame");
+  };
+  // The separator is the first '-' after the first character (so "-5--1" splits at the second '-').
+  size_t dash = text.find('-', 1);
+  std::optional<int64_t> a = parseInt(text.substr(0, dash == std::string_view::npos ? text.size() : dash));
+  std::optional<int64_t> b = dash == std::string_view::npos ? a : parseInt(text.substr(dash + 1));
+  if (!a || !b || *a < -1000000000 || *b > 1000000000) throw bad();
+  if (*b < *a) throw InputError(flag + " " + std::string(text) + ": the last frame is before the first");
+  return {int(*a), int(*b)};
+}
+
+bool isFramePattern(const std::filesystem::path& pattern) {
+  return findPlaceholder(pattern.filename().string()).count > 0;
+}
+
+std::filesystem::path framePath(const std::filesystem::path& pattern, int frame) {
+  const std::string name = pattern.filename().string();
+  const Placeholder p = findPlaceholder(name);
+  if (p.count == 0)
+    throw InputError({pattern.string(), 0},
+                     "has no frame number in its name; write #### (or %04d) where it goes");
+  if (p.count > 1) throw InputError({pattern.string(), 0}, "has more than one frame-number placeholder");
+  char digits[32];
+  std::snprintf(digits, sizeof digits, "%0*d", p.width, frame);
+  std::filesystem::path out = pattern;
+  out.replace_filename(name.substr(0, p.begin) + digits + name.substr(p.end));
+  return out;
+}
+
+}  // namespace hairgen

@@ -1,0 +1,82 @@
+#include "stages/simulate.h"
+
+#include <tbb/task_arena.h>
+
+#include "libcore/physics/anjyo_dynamics.h"
+#include "libcore/util/error.h"
+#include "stages/estimate.h"
+
+namespace hairgen {
+
+HeadMotion headMotionOf(const Config& config) {
+  return HeadMotion(config.dynamics.headKeys, headCentre(config.dynamics, config.collision),
+                    config.dynamics.frameRate);
+}
+
+void simulate(const Strands& restGuides, const Config& config, const SimulateOptions& options,
+              const std::function<void(int frame, Strands&& guides)>& frameDone) {
+  const Dynamics& d = config.dynamics;
+  if (!d.given)
+    throw InputError(config.setup.file.string() +
+                     ": the Setup names no Dynamics Info; add `DynamicsInfo FILE` "
+                     "(Model, Frames, FrameRate, Wind, HeadKey, ...)");
+  if (d.model != DynamicsModel::kAnjyo)
+    throw InputError("Dynamics Model " + std::string(name(d.model)) +
+                     " is not available in this build of hairgen");
+  const FrameRange frames = options.frames;
+  if (frames.first < d.firstFrame || frames.last > d.lastFrame)
+    throw InputError("frames " + std::to_string(frames.first) + "-" + std::to_string(frames.last) +
+                     " are outside the shot's Frames " + std::to_string(d.firstFrame) + "-" +
+                     std::to_string(d.lastFrame));
+  requireFits(estimateSimulate(d, restGuides.pointCount() - restGuides.strandCount(), frames,
+                               size_t(tbb::this_task_arena::max_concurrency())),
+              options.force);
+
+  const HeadMotion head = headMotionOf(config);
+  AnjyoHair hair(restGuides, config.hairstyle, d, config.collision, config.hairstyle.seed);
+  auto emit = [&](int frame) {
+    Strands guides = hair.posed(head.pose(frame));
+    guides.simulationState = hair.state();
+    guides.provenance = madeByHairgen("simulate", config.hairstyle.seed, options.configDigest);
+    guides.provenance.frame = frame;
+    guides.provenance.time = double(frame - d.firstFrame) / d.frameRate;
+    frameDone(frame, std::move(guides));
+    if (options.progress) options.progress->advance();
+  };
+
+  if (frames.first > d.firstFrame) {
+    // A restart: the state of the frame before, as this same shot wrote it.
+    const Strands* before = options.restart;
+    const FileLoc where{options.restartName, 0};
+    if (!before)
+      throw InputError("frame " + std::to_string(frames.first) + " follows the shot's first frame " +
+                       std::to_string(d.firstFrame) + ": simulate resumes from frame " +
+                       std::to_string(frames.first - 1) +
+                       "'s cache, which is not there; simulate that frame first");
+    if (before->provenance.stage != "simulate" || !before->provenance.frame ||
+        *before->provenance.frame != frames.first - 1 || before->simulationState.empty())
+      throw InputError(where, "is not frame " + std::to_string(frames.first - 1) +
+                                  " of a simulation with its restart state; simulate from the first frame");
+    if (before->provenance.configDigest != options.configDigest)
+      throw InputError(where, "was simulated with another configuration (digest " +
+                                  before->provenance.configDigest + ", this one " + options.configDigest +
+                                  "); simulate from the first frame");
+    if (before->firstPoint != restGuides.firstPoint)
+      throw InputError(where, "holds other strands than the guides; restart from a frame of the same guides");
+    hair.restore(before->simulationState, options.restartName);
+  } else {
+    emit(d.firstFrame);
+  }
+  const double dt = 1.0 / (d.frameRate * d.substeps);
+  for (int frame = std::max(frames.first, d.firstFrame + 1); frame <= frames.last; ++frame) {
+    for (int s = 0; s < d.substeps; ++s) {
+      // The forces of the substep's start (Störmer-Verlet), in frames since the shot began.
+      const double t = double(frame - 1) + double(s) / double(d.substeps);
+      const AccelerationField field = headFrameField(head.at(t), windAt(d.wind, t), config.hairstyle.gravity);
+      hair.step(field, dt, frame, s == 0);
+    }
+    emit(frame);
+  }
+}
+
+}  // namespace hairgen

@@ -1,0 +1,40 @@
+// The simulate stage (DESIGN §8): the rest guides stepped through time under Dynamics Info — the wind,
+// the keyed head motion, gravity — one guide cache per frame. Model anjyo is Anjyo et al. 1992 §3
+// (libcore/physics/anjyo_dynamics.h).
+//
+// Frame Frames.first is the rest state: the input guides, moved by the head's pose at that frame. Each
+// later frame is one step of 1/FrameRate seconds in Substeps substeps. Every frame carries its frame
+// number, its time and the state a restart needs, so a shot split at any frame and resumed gives the
+// same bytes as one run.
+#pragma once
+
+#include <functional>
+#include <string>
+
+#include "libcore/config/params.h"
+#include "libcore/model/strands.h"
+#include "libcore/physics/head_motion.h"
+#include "libcore/util/frames.h"
+#include "libcore/util/progress.h"
+
+namespace hairgen {
+
+struct SimulateOptions {
+  std::string configDigest;          // recorded in every frame's provenance
+  FrameRange frames;                 // the frames to produce, within Dynamics Frames
+  const Strands* restart = nullptr;  // frame frames.first − 1 as simulate wrote it, when frames.first is
+                                     // after Frames.first
+  std::string restartName;           // names it in errors
+  Progress* progress = nullptr;      // advanced once per frame
+  bool force = false;                // run work estimated to take absurdly long
+};
+
+// Calls `frameDone(frame, guides)` for every frame of options.frames, in order. Throws InputError for
+// frames outside Dynamics Frames, a missing or foreign restart cache, or guides that cannot move.
+void simulate(const Strands& restGuides, const Config& config, const SimulateOptions& options,
+              const std::function<void(int frame, Strands&& guides)>& frameDone);
+
+// The head's pose at `frame` for a job: its keys about its centre (Dynamics Info, Collision Info).
+HeadMotion headMotionOf(const Config& config);
+
+}  // namespace hairgen

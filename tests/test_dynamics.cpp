@@ -1,0 +1,255 @@
+// Anjyo's dynamics (libcore/physics/anjyo_dynamics) and the simulate stage: a pendulum swings with the
+// paper's inertia and keeps its energy; still hair stays still; the pseudo-force field keeps hair out of
+// the head; joint limits and segment lengths hold; roots follow the head; restarts and threads change
+// no bit.
+#include <gtest/gtest.h>
+
+#include <tbb/global_control.h>
+#include <cmath>
+
+#include "libcore/physics/anjyo_dynamics.h"
+#include "libcore/physics/head_motion.h"
+#include "libcore/physics/strand_energy.h"
+#include "stages/grow.h"
+#include "stages/simulate.h"
+#include "tests/test_util.h"
+
+namespace hairgen {
+namespace {
+
+// One strand from `root` along `dirs`, each segment `d` long.
+Strands chain(const glm::dvec3& root, const std::vector<glm::dvec3>& dirs, double d) {
+  std::vector<glm::vec3> points{glm::vec3(root)};
+  glm::dvec3 p = root;
+  for (const glm::dvec3& dir : dirs) points.push_back(glm::vec3(p += d * glm::normalize(dir)));
+  Strands s;
+  s.addStrand(points);
+  return s;
+}
+
+Dynamics still() {
+  Dynamics d;
+  d.given = true;
+  d.damping = 0.0;
+  d.restFrequencyAuto = false;
+  d.restFrequency = 0.0;  // no spring: the paper's equations alone
+  d.pseudoEpsilon = 1.0;
+  return d;
+}
+
+// A compound pendulum: θ'' = −(3g/2L) sin θ, period 2π sqrt(2L/3g) at small amplitude.
+TEST(AnjyoDynamics, ASingleSegmentSwingsWithTheCompoundPendulumsPeriodAndKeepsItsEnergy) {
+  const double length = 0.1, g = 9.81, dt = 2e-4, amplitude = 0.02;
+  Hairstyle style;
+  style.gravity = g;
+  AnjyoHair hair(chain(glm::dvec3(0.0), {{0, -1, 0}}, length), style, still(), Collision{}, 0);
+  hair.restore({amplitude, 0.0, amplitude, 0.0}, "start");  // displaced and let go
+  AccelerationField field;
+  field.base = {0.0, -g, 0.0};
+  const double expected = 2.0 * M_PI * std::sqrt(2.0 * length / (3.0 * g));
+  const double k = 3.0 / (2.0 * length);
+  auto energy = [&](const std::vector<double>& s) {  // per unit inertia, with θ' from the last step
+    const double rate = (s[0] - s[2]) / dt, mid = 0.5 * (s[0] + s[2]);
+    return 0.5 * rate * rate + k * g * (1.0 - std::cos(mid));
+  };
+  std::vector<double> crossings;
+  double previous = amplitude, startEnergy = 0.0, worst = 0.0;
+  const int steps = int(100.5 * expected / dt);
+  for (int n = 1; n <= steps; ++n) {
+    hair.step(field, dt, 1, false);
+    const std::vector<double> s = hair.state();
+    if (n == 2) startEnergy = energy(s);
+    if (n > 2) worst = std::max(worst, std::abs(energy(s) / startEnergy - 1.0));
+    if (previous > 0.0 && s[0] <= 0.0) crossings.push_back((n - 1 + previous / (previous - s[0])) * dt);
+    previous = s[0];
+  }
+  ASSERT_GE(crossings.size(), 100u);
+  const double period = (crossings.back() - crossings.front()) / double(crossings.size() - 1);
+  EXPECT_NEAR(period / expected, 1.0, 0.01)
+      << "period " << period << " s, compound pendulum " << expected << " s";
+  EXPECT_LT(worst, 0.01) << "energy drifted by " << worst * 100 << "% over 100 periods";
+}
+
+// Fig. 11 of the paper, in its units (Δt = 0.1, d = ρ = 1, k = 18, no gravity, no spring): hair lying
+// along the side of an ellipsoidal head, and a push F = (−500, 0, 0) into it. Counted: the nodes inside the
+// head, summed over the frames of the snapshot.
+struct Fig11 {
+  Strands hair;
+  Collision head;
+  int inside(const Dynamics& dynamics, bool collide, int frames) const {
+    Collision shapes = head;
+    shapes.shapes[0].penalty = collide ? 1.0 : 0.0;  // without penalty a shape does not collide
+    Hairstyle style;
+    style.gravity = 0.0;
+    AnjyoHair dynamicHair(hair, style, dynamics, shapes, 0);
+    AccelerationField push;
+    push.base = {-500.0, 0.0, 0.0};
+    int entered = 0;
+    for (int n = 0; n < frames; ++n) {
+      dynamicHair.step(push, 0.1, 2, false);
+      for (const glm::dvec3& p : dynamicHair.nodes()) entered += penetration(head.shapes[0], p) > 1e-6;
+    }
+    return entered;
+  }
+};
+
+Fig11 fig11() {
+  Fig11 f;
+  const glm::dvec3 axes(10.0, 12.0, 11.0);
+  f.head.shapes.push_back({ShapeKind::kEllipsoid, 0.0, 1.0, glm::dvec3(0.0), axes, glm::dmat3(1.0), {}});
+  // Seven hairs down the +x side, 3% off the surface along its meridians, from 60° above the equator.
+  for (int a = -3; a <= 3; ++a) {
+    const double u = glm::radians(12.0 * a);
+    std::vector<glm::vec3> points;
+    for (int j = 0; j <= 18; ++j) {
+      const double v = glm::radians(60.0 - 5.5 * j);
+      points.push_back(glm::vec3(
+          1.03 * axes * glm::dvec3(std::cos(v) * std::cos(u), std::sin(v), std::cos(v) * std::sin(u))));
+    }
+    f.hair.addStrand(points);
+  }
+  return f;
+}
+
+TEST(AnjyoDynamics, ThePseudoForceFieldKeepsHairOutOfTheHead) {
+  const Fig11 f = fig11();
+  Dynamics without = still();
+  Dynamics with = still();
+  with.pseudoAlpha = -0.75;
+  with.pseudoEpsilon = 0.1;
+  with.pseudoReach = 2.0;  // "near the head": within two segment lengths
+  // Half a second, the paper's snapshot: without the pseudo-force the hair has gone into the head. The
+  // scaled push is still unopposed, so later it follows (measured: 261 against 10 node-frames here, 3081
+  // against 2732 over 3 s), which is why hairgen's collision handling is on top.
+  const int free = f.inside(without, false, 5), pseudo = f.inside(with, false, 5);
+  ASSERT_GT(free, 100) << "the push must drive hair into the head for the test to mean anything";
+  EXPECT_LE(pseudo * 10, free) << pseudo << " nodes entered with the pseudo-force, " << free << " without";
+  EXPECT_EQ(f.inside(with, true, 30), 0) << "with hairgen's collision handling on top";
+  EXPECT_EQ(f.inside(without, true, 30), 0);
+}
+
+TEST(AnjyoDynamics, JointLimitsHoldAndSegmentsKeepTheirLength) {
+  Fig11 f = fig11();
+  Hairstyle style;
+  style.gravity = 0.0;
+  style.jointLimit = 10.0;
+  style.jointLimitFrom = 2;
+  Dynamics dynamics = still();
+  dynamics.fluctuation = 0.3;
+  dynamics.fluctuationEvery = 1;
+  AnjyoHair hair(f.hair, style, dynamics, f.head, 7);
+  const std::vector<glm::dvec3> rest = hair.nodes();
+  AccelerationField push;
+  push.base = {-500.0, 0.0, 0.0};
+  double worstLength = 0.0, worstTurn = 0.0;
+  for (int n = 0; n < 30; ++n) {
+    hair.step(push, 0.1, 2 + n, true);
+    const std::vector<glm::dvec3> nodes = hair.nodes();
+    for (size_t s = 0; s < f.hair.strandCount(); ++s)
+      for (uint32_t p = f.hair.firstPoint[s]; p + 1 < f.hair.firstPoint[s + 1]; ++p) {
+        worstLength = std::max(
+            worstLength, std::abs(glm::length(nodes[p + 1] - nodes[p]) - glm::length(rest[p + 1] - rest[p])));
+        if (p < f.hair.firstPoint[s] + 2) continue;  // the limit applies from node 2
+        const glm::dvec3 a = glm::normalize(nodes[p] - nodes[p - 1]),
+                         b = glm::normalize(nodes[p + 1] - nodes[p]);
+        const glm::dvec3 ra = glm::normalize(rest[p] - rest[p - 1]),
+                         rb = glm::normalize(rest[p + 1] - rest[p]);
+        const double allowed =
+            std::max(glm::radians(10.0), std::acos(std::clamp(glm::dot(ra, rb), -1.0, 1.0)));
+        worstTurn = std::max(worstTurn, std::acos(std::clamp(glm::dot(a, b), -1.0, 1.0)) - allowed);
+      }
+  }
+  EXPECT_LT(worstLength, 1e-9);
+  EXPECT_LT(worstTurn, 1e-9) << "a joint turned " << glm::degrees(worstTurn) << "° past its limit";
+}
+
+// A job on the bundled default coupe with a Dynamics Info in memory.
+Config dynamicJob(const std::vector<HeadKey>& keys, const std::vector<WindKey>& wind, int last) {
+  Config config = test::loadJob("default/setup.txt").config;
+  config.dynamics.given = true;
+  config.dynamics.lastFrame = last;
+  config.dynamics.headKeys = keys;
+  config.dynamics.wind = wind;
+  return config;
+}
+
+SimulateOptions frames(const Config& config, FrameRange range, const Strands* restart = nullptr) {
+  SimulateOptions options;
+  options.configDigest = config.digest();
+  options.frames = range;
+  options.restart = restart;
+  options.restartName = "restart";
+  return options;
+}
+
+Strands someGuides(const Config& config, size_t every) {
+  const Mesh wick = test::loadJob("default/setup.txt").wick;
+  Mesh few = wick;
+  few.positions.clear();
+  few.normals.clear();
+  for (size_t i = 0; i < wick.vertexCount(); i += every) {
+    few.positions.push_back(wick.positions[i]);
+    few.normals.push_back(wick.normals[i]);
+  }
+  few.triangles.clear();
+  return grow(few, config.hairstyle, config.collision, GrowOptions{}).guides;
+}
+
+TEST(Simulate, StillHairStaysStill) {
+  const Config config = dynamicJob({}, {}, 240);
+  const Strands rest = someGuides(config, 7);
+  double worst = 0.0;
+  simulate(rest, config, frames(config, {1, 240}), [&](int, Strands&& guides) {
+    for (size_t p = 0; p < rest.pointCount(); ++p)
+      worst = std::max(worst, double(glm::length(guides.points[p] - rest.points[p])));
+  });
+  EXPECT_LT(worst, 1e-4) << "a vertex moved " << worst * 1e3 << " mm";
+}
+
+TEST(Simulate, RootsFollowTheHead) {
+  HeadKey start, turned;
+  turned.frame = 12;
+  turned.translation = {0.01, -0.02, 0.03};
+  turned.rotation = {10.0, -70.0, 5.0};
+  const Config config = dynamicJob({start, turned}, {{4, {3.0, 0.0, 0.0}, false, {}}}, 20);
+  const Strands rest = someGuides(config, 11);
+  const HeadMotion head = headMotionOf(config);
+  double worst = 0.0;
+  simulate(rest, config, frames(config, {1, 20}), [&](int frame, Strands&& guides) {
+    const Pose pose = head.pose(frame);
+    for (size_t s = 0; s < rest.strandCount(); ++s) {
+      const uint32_t root = rest.firstPoint[s];
+      worst = std::max(
+          worst, glm::length(glm::dvec3(guides.points[root]) - pose.apply(glm::dvec3(rest.points[root]))));
+    }
+  });
+  EXPECT_LT(worst, 1e-6);
+}
+
+TEST(Simulate, ThreadsAndRestartsChangeNoBit) {
+  HeadKey start, turned;
+  turned.frame = 10;
+  turned.rotation = {0.0, 60.0, 0.0};
+  const Config config = dynamicJob({start, turned}, {{3, {-8.0, 0.0, 2.0}, true, {}}}, 16);
+  Config fluctuating = config;
+  fluctuating.dynamics.fluctuation = 0.05;
+  fluctuating.dynamics.fluctuationEvery = 3;
+  const Strands rest = someGuides(config, 13);
+  auto run = [&](size_t threads, FrameRange range, const Strands* restart) {
+    tbb::global_control limit(tbb::global_control::max_allowed_parallelism, threads);
+    std::vector<Strands> out;
+    simulate(rest, fluctuating, frames(fluctuating, range, restart),
+             [&](int, Strands&& guides) { out.push_back(std::move(guides)); });
+    return out;
+  };
+  const std::vector<Strands> one = run(1, {1, 16}, nullptr);
+  EXPECT_TRUE(one == run(2, {1, 16}, nullptr));
+  EXPECT_TRUE(one == run(4, {1, 16}, nullptr));
+  const std::vector<Strands> second = run(2, {9, 16}, &one[7]);  // resumed from frame 8
+  ASSERT_EQ(second.size(), 8u);
+  for (size_t i = 0; i < 8; ++i) EXPECT_TRUE(second[i] == one[8 + i]) << "frame " << 9 + i;
+  EXPECT_THROW(run(1, {9, 16}, &one[6]), InputError);  // frame 7 is not the frame before 9
+}
+
+}  // namespace
+}  // namespace hairgen
