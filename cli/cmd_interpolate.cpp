@@ -4,26 +4,33 @@
 #include "libcore/config/setup.h"
 #include "libcore/io/hair_cache.h"
 #include "libcore/io/obj_io.h"
+#include "libcore/util/frames.h"
 #include "libcore/util/text.h"
 #include "stages/interpolate.h"
+#include "stages/simulate.h"
 
 namespace hairgen::cli {
 
 void registerInterpolate(CLI::App& app, int& exitCode) {
   struct Options {
     CommonOptions common;
-    std::string setup, guides, output;
+    std::string setup, guides, output, frames;
   };
   auto options = std::make_shared<Options>();
   CLI::App* cmd = app.add_subcommand(
       "interpolate",
-      "Fill every wick triangle with strands blended from its corner guides (clumping, stray hairs)");
+      "Fill every wick triangle with strands blended from its corner guides (clumping, stray hairs); with "
+      "--frames, every frame of a simulated sequence, each with the same strands, ids and weights");
   cmd->add_option("SETUP", options->setup, "The Setup file")->required();
-  cmd->add_option("--guides", options->guides,
-                  "Guides from `hairgen grow` on the same Setup (.hair, .gltf, .glb)")
+  cmd->add_option(
+         "--guides", options->guides,
+         "Guides from `hairgen grow` on the same Setup (.hair, .gltf, .glb); with --frames a pattern such "
+         "as sim/guides.####.hair")
       ->required();
-  cmd->add_option("-o,--output", options->output, "Coupe to write: .hair, .gltf or .glb (written atomically)")
+  cmd->add_option("-o,--output", options->output,
+                  "Coupe to write: .hair, .gltf or .glb (written atomically); with --frames a pattern")
       ->required();
+  cmd->add_option("--frames", options->frames, "Interpolate these frames of a sequence")->type_name("A-B");
   addCommonFlags(*cmd, options->common, true);
   cmd->footer(exitCodeHelp());
   cmd->callback([options, &exitCode] {
@@ -33,12 +40,40 @@ void registerInterpolate(CLI::App& app, int& exitCode) {
       Stopwatch clock;
       Config config = loadStageConfig(options->setup, options->common, SetupUse::kInterpolate, stats);
       Mesh wick = readObj(config.setup.wickModel.path);
-      Strands guides = readStrands(options->guides);
-      stats.time("read", clock.lap());
-      Strands coupe = interpolateStage(options->common, config, wick, guides, options->guides, stats);
-      writeStrands(options->output, coupe);
-      stats.time("write", clock.lap());
-      note(options->common, "interpolate: wrote " + options->output);
+      if (options->frames.empty()) {
+        Strands guides = readStrands(options->guides);
+        stats.time("read", clock.lap());
+        Strands coupe = interpolateStage(options->common, config, wick, guides, options->guides, stats);
+        writeStrands(options->output, coupe);
+        stats.time("write", clock.lap());
+        note(options->common, "interpolate: wrote " + options->output);
+        stats.write(options->common);
+        return;
+      }
+      const FrameRange frames = parseFrameRange(options->frames, "--frames");
+      for (const std::string* pattern : {&options->guides, &options->output})
+        if (!isFramePattern(*pattern))
+          throw InputError(*pattern + ": with --frames, write #### where the frame number goes");
+      const HeadMotion head = headMotionOf(config);
+      Progress progress("interpolate", "frames", size_t(frames.count()), !options->common.quiet);
+      for (int f = frames.first; f <= frames.last; ++f) {
+        const std::filesystem::path in = framePath(options->guides, f);
+        const Strands guides = readStrands(in);
+        stats.add("read", clock.lap());
+        InterpolateOptions frameOptions{config.digest(), in.string(), nullptr, options->common.force,
+                                        head.pose(f).matrix()};
+        const Strands coupe = interpolate(wick, guides, config.hairstyle, config.collision, frameOptions);
+        stats.add("interpolate", clock.lap());
+        writeStrands(framePath(options->output, f), coupe);
+        stats.add("write", clock.lap());
+        stats.counts()["strands"] = coupe.strandCount();
+        stats.counts()["points"] = coupe.pointCount();
+        progress.advance();
+      }
+      progress.finish();
+      stats.counts()["frames"] = frames.count();
+      note(options->common, "interpolate: wrote " + framePath(options->output, frames.first).string() +
+                                " to " + framePath(options->output, frames.last).filename().string());
       stats.write(options->common);
     });
   });

@@ -10,8 +10,11 @@
 #include "libcore/io/obj_io.h"
 #include "libcore/render/gl_context.h"
 #include "libcore/util/error.h"
+#include "libcore/util/frames.h"
+#include "libcore/util/progress.h"
 #include "libcore/util/text.h"
 #include "stages/render.h"
+#include "stages/simulate.h"
 
 namespace hairgen::cli {
 namespace {
@@ -25,34 +28,36 @@ void requireExtension(const std::string& file, const char* extension, const char
 
 }  // namespace
 
-RenderOutput renderStage(const CommonOptions& common, const Config& config, const Strands& hair,
-                         const Mesh* head, const RenderOptions& options, Stats& stats) {
+RenderOutput renderStage(const CommonOptions& common, const Config& config, GlContext& gl,
+                         const Strands& hair, const Mesh* head, const RenderOptions& options, Stats& stats) {
   Stopwatch clock;
   const CustomShaders shaders = readCustomShaders(config.setup);
   stats.add("read", clock.lap());
-  GlContext gl;
-  stats.time("device", clock.lap());
-  note(common, "render: " + gl.renderer() + " through EGL " + gl.platform() + ", " +
-                   std::to_string(hair.strandCount()) + " strands at " +
-                   std::to_string(config.render.resolution.x) + "x" +
-                   std::to_string(config.render.resolution.y));
   RenderOptions withForce = options;
   withForce.force = common.force;
   RenderOutput out = render(gl, hair, head, config.visuality, config.render, shaders, withForce);
-  stats.time("upload", out.timings.upload);
-  stats.time("lightDepth", out.timings.lightDepth);
-  stats.time("opacity", out.timings.opacity);
-  stats.time("shading", out.timings.shading);
-  stats.time("readback", out.timings.readback);
+  stats.add("upload", out.timings.upload);
+  stats.add("lightDepth", out.timings.lightDepth);
+  stats.add("opacity", out.timings.opacity);
+  stats.add("shading", out.timings.shading);
+  stats.add("readback", out.timings.readback);
   stats.counts()["strands"] = hair.strandCount();
   stats.counts()["points"] = hair.pointCount();
   stats.counts()["samples"] = out.samples;
+  return out;
+}
+
+std::unique_ptr<GlContext> openDevice(const CommonOptions& common, const Config& config, Stats& stats) {
+  Stopwatch clock;
+  auto device = std::make_unique<GlContext>();
+  const GlContext& gl = *device;
+  stats.add("device", clock.lap());
   stats.json()["device"] = {
       {"platform", gl.platform()}, {"renderer", gl.renderer()}, {"version", gl.version()}};
-  if (out.samples != config.render.samples)
-    note(common, "render: the device offers " + std::to_string(out.samples) + " samples; Samples " +
-                     std::to_string(config.render.samples) + " was asked for");
-  return out;
+  note(common, "render: " + gl.renderer() + " through EGL " + gl.platform() + " at " +
+                   std::to_string(config.render.resolution.x) + "x" +
+                   std::to_string(config.render.resolution.y));
+  return device;
 }
 
 void writeRenderOutputs(const Config& config, const RenderOutput& out, const std::string& exr,
@@ -83,7 +88,7 @@ void writeRenderOutputs(const Config& config, const RenderOutput& out, const std
 void registerRender(CLI::App& app, int& exitCode) {
   struct Options {
     CommonOptions common;
-    std::string setup, hair, output, dom, preview, upAxis = "y";
+    std::string setup, hair, output, dom, preview, frames, upAxis = "y";
     double scale = 1.0;
     bool frame = false, listDevices = false;
   };
@@ -108,6 +113,11 @@ void registerRender(CLI::App& app, int& exitCode) {
                   "Multiply the hair's positions and widths (e.g. 0.01 for centimetres)")
       ->check(kFiniteNonNegative & CLI::PositiveNumber);
   cmd->add_flag("--frame", options->frame, "Aim the camera and light at the hair and fit it in the view");
+  cmd->add_option(
+         "--frames", options->frames,
+         "Render these frames of a sequence in one process, one device: --hair, -o, --dom and --preview "
+         "are patterns with ####, and the head moves with the Setup's HeadKeys")
+      ->type_name("A-B");
   cmd->add_flag("--list-devices", options->listDevices, "List the EGL devices and platforms found, and exit");
   addCommonFlags(*cmd, options->common, true);
   cmd->footer(exitCodeHelp());
@@ -129,30 +139,59 @@ void registerRender(CLI::App& app, int& exitCode) {
       Stats stats("render");
       Stopwatch clock;
       Config config = loadStageConfig(options->setup, options->common, SetupUse::kRender, stats);
-      const Strands hair = readStrands(options->hair);
-      if (config.render.shadingModel == ShadingModel::kVolumetric && config.render.volumetricBlend > 0.0 &&
-          hair.normals.empty())
-        throw InputError({options->hair, 0},
-                         "ShadingModel volumetric needs the coupe's volume normals, and this one has "
-                         "none; run `hairgen shade SETUP --hair " +
-                             options->hair + " -o shaded.hair` and render that");
+      const bool sequence = !options->frames.empty();
+      const FrameRange frames = sequence ? parseFrameRange(options->frames, "--frames") : FrameRange{0, 0};
+      if (sequence)
+        for (const std::string* pattern :
+             {&options->hair, &options->output, &options->dom, &options->preview})
+          if (!pattern->empty() && !isFramePattern(*pattern))
+            throw InputError(*pattern + ": with --frames, write #### where the frame number goes");
+      auto frameFile = [&](const std::string& pattern, int f) {
+        return sequence && !pattern.empty() ? framePath(pattern, f).string() : pattern;
+      };
       std::optional<Mesh> head;
       if (config.setup.headModel.given()) head = readObj(config.setup.headModel.path);
+      const HeadMotion motion = headMotionOf(config);
       stats.time("read", clock.lap());
       RenderOptions renderOptions;
       renderOptions.frame = options->frame;
       renderOptions.zUp = options->upAxis == "z";
       renderOptions.scale = options->scale;
       renderOptions.keepDom = !options->dom.empty();
-      RenderOutput out =
-          renderStage(options->common, config, hair, head ? &*head : nullptr, renderOptions, stats);
-      clock.lap();
-      // The image's config digest is that of the camera and light it was rendered with (--frame aims them).
-      config.render = out.settings;
-      writeRenderOutputs(config, out, options->output, options->dom, options->preview);
-      stats.time("write", clock.lap());
+      const std::unique_ptr<GlContext> gl =
+          openDevice(options->common, config, stats);  // one for every frame
+      Progress progress("render", "frames", size_t(frames.count()), sequence && !options->common.quiet);
+      for (int f = frames.first; f <= frames.last; ++f) {
+        const std::string hairFile = frameFile(options->hair, f);
+        const Strands hair = readStrands(hairFile);
+        if (config.render.shadingModel == ShadingModel::kVolumetric && config.render.volumetricBlend > 0.0 &&
+            hair.normals.empty())
+          throw InputError({hairFile, 0},
+                           "ShadingModel volumetric needs the coupe's volume normals, and this one "
+                           "has none; run `hairgen shade SETUP --hair " +
+                               hairFile + " -o shaded.hair` and render that");
+        // In a sequence the head moves with its keys (Dynamics Info), as the hair's roots did.
+        std::optional<Mesh> posedHead;
+        if (head && sequence && !motion.still()) posedHead = posedMesh(*head, motion.pose(f));
+        stats.add("read", clock.lap());
+        RenderOutput out = renderStage(options->common, config, *gl, hair,
+                                       posedHead ? &*posedHead
+                                       : head    ? &*head
+                                                 : nullptr,
+                                       renderOptions, stats);
+        clock.lap();
+        // The image's config digest is that of the camera and light it was rendered with (--frame aims them).
+        Config rendered = config;
+        rendered.render = out.settings;
+        writeRenderOutputs(rendered, out, frameFile(options->output, f), frameFile(options->dom, f),
+                           frameFile(options->preview, f));
+        stats.add("write", clock.lap());
+        progress.advance();
+      }
+      progress.finish();
       note(options->common,
-           "render: wrote " + options->output + (options->preview.empty() ? "" : " and " + options->preview));
+           "render: wrote " + frameFile(options->output, frames.last) +
+               (options->preview.empty() ? "" : " and " + frameFile(options->preview, frames.last)));
       stats.write(options->common);
     });
   });

@@ -11,10 +11,17 @@
 #include "cli/common.h"
 #include "libcore/config/setup.h"
 #include "libcore/io/hair_cache.h"
+#include "libcore/io/movie.h"
 #include "libcore/io/obj_io.h"
+#include "libcore/physics/head_motion.h"
 #include "libcore/util/error.h"
+#include "libcore/util/frames.h"
+#include "libcore/util/progress.h"
+#include "libcore/util/text.h"
 #include "stages/estimate.h"
+#include "stages/interpolate.h"
 #include "stages/shade.h"
+#include "stages/simulate.h"
 
 namespace hairgen::cli {
 namespace {
@@ -40,6 +47,64 @@ fs::path defaultSetup() {
   throw InputError(
       "no SETUP given and the default coupe (configs/default/setup.txt) was not found next to the "
       "executable; name a Setup file or set HAIRGEN_DATA to the folder that holds configs/");
+}
+
+// A shot (the Setup names a Dynamics Info): the guides simulated frame by frame into DIR/sim, and each
+// frame interpolated, shaded like the rest coupe (its normals re-posed, its colours kept) and rendered
+// to DIR/beauty.####.exr and .png, then the preview movies DIR/beauty.mp4 and DIR/beauty.gif. The
+// per-frame coupes stay in memory: a shot of a full coupe would write gigabytes of them.
+void runShot(const CommonOptions& common, const Config& config, const Mesh& wick, const Strands& guides,
+             const Strands& restCoupe, const fs::path& out, bool render, Stats& stats) {
+  const Dynamics& d = config.dynamics;
+  const FrameRange frames{d.firstFrame, d.lastFrame};
+  const HeadMotion motion = headMotionOf(config);
+  const bool shaded = wantsShade(config.visuality, config.render);
+  std::optional<Mesh> head;
+  if (render && config.setup.headModel.given()) head = readObj(config.setup.headModel.path);
+  std::unique_ptr<GlContext> gl;
+  if (render) gl = openDevice(common, config, stats);
+  const fs::path simPattern = out / "sim" / "guides.####.hair", exrPattern = out / "beauty.####.exr",
+                 pngPattern = out / "beauty.####.png";
+  note(common, "run: a shot of frames " + std::to_string(frames.first) + "-" + std::to_string(frames.last) +
+                   " at " + formatReal(d.frameRate) + " fps");
+  Progress progress("run", "frames", size_t(frames.count()), !common.quiet);
+  Stopwatch clock;
+  SimulateOptions simOptions;
+  simOptions.configDigest = config.digest();
+  simOptions.frames = frames;
+  simOptions.force = common.force;
+  simulate(guides, config, simOptions, [&](int f, Strands&& frameGuides) {
+    stats.add("simulate", clock.lap());
+    writeStrands(framePath(simPattern, f), frameGuides);
+    stats.add("write", clock.lap());
+    if (!render) return progress.advance();
+    InterpolateOptions interpolation{config.digest(), framePath(simPattern, f).string(), nullptr,
+                                     common.force, motion.pose(f).matrix()};
+    Strands coupe = interpolate(wick, frameGuides, config.hairstyle, config.collision, interpolation);
+    if (shaded) coupe = repose(restCoupe, coupe);
+    stats.add("interpolate", clock.lap());
+    std::optional<Mesh> posedHead;
+    if (head) posedHead = motion.still() ? *head : posedMesh(*head, motion.pose(f));
+    RenderOutput image =
+        renderStage(common, config, *gl, coupe, posedHead ? &*posedHead : nullptr, {}, stats);
+    clock.lap();
+    writeRenderOutputs(config, image, framePath(exrPattern, f).string(), "",
+                       framePath(pngPattern, f).string());
+    stats.add("write", clock.lap());
+    progress.advance();
+  });
+  progress.finish();
+  stats.counts()["frames"] = frames.count();
+  if (!render) return;
+  clock.lap();
+  MovieOptions movie;
+  movie.frameRate = d.frameRate;
+  if (writeMovie(pngPattern, frames, out / "beauty.mp4", out / "beauty.gif", movie))
+    note(common, "run: wrote " + framePath(exrPattern, frames.first).string() + " to " +
+                     framePath(exrPattern, frames.last).filename().string() + ", beauty.mp4 and beauty.gif");
+  else
+    note(common, "run: ffmpeg is not installed, so no preview movie; the frames are " + pngPattern.string());
+  stats.add("movie", clock.lap());
 }
 
 }  // namespace
@@ -84,12 +149,18 @@ void registerRun(CLI::App& app, int& exitCode) {
       }
 
       Strands coupe;
+      Mesh wick;
+      GrowResult grown;
+      if (config.setup.load && config.dynamics.given)
+        throw InputError(config.setup.file.string() +
+                         ": Load and DynamicsInfo together: a shot simulates the guides, "
+                         "which a loaded coupe does not have; grow them (Load false)");
       if (config.setup.load) {
         coupe = readStrands(config.setup.loadFile.path);
         note(options->common, "run: loaded " + config.setup.loadFile.path.string() + " (" +
                                   std::to_string(coupe.strandCount()) + " strands)");
       } else {
-        Mesh wick = readObj(config.setup.wickModel.path);
+        wick = readObj(config.setup.wickModel.path);
         stats.add("read", clock.lap());
         // Every stage's work is estimated before the first starts: a coupe that cannot be rendered is
         // refused before minutes of growing.
@@ -97,7 +168,7 @@ void registerRun(CLI::App& app, int& exitCode) {
              estimateRun(config, wick, wantsShade(config.visuality, config.render), !options->noRender,
                          size_t(tbb::this_task_arena::max_concurrency())))
           requireFits(e, options->common.force);
-        GrowResult grown = growStage(options->common, config, wick, stats);
+        grown = growStage(options->common, config, wick, stats);
         const fs::path guidesFile = out / "guides.hair";
         clock.lap();
         writeStrands(guidesFile, grown.guides);
@@ -118,10 +189,14 @@ void registerRun(CLI::App& app, int& exitCode) {
         writeStrands(config.setup.saveFile.path, coupe);
         note(options->common, "run: saved the coupe to " + config.setup.saveFile.path.string());
       }
-      if (!options->noRender) {
+      if (config.dynamics.given) {
+        runShot(options->common, config, wick, grown.guides, coupe, out, !options->noRender, stats);
+      } else if (!options->noRender) {
         std::optional<Mesh> head;
         if (config.setup.headModel.given()) head = readObj(config.setup.headModel.path);
-        RenderOutput image = renderStage(options->common, config, coupe, head ? &*head : nullptr, {}, stats);
+        const std::unique_ptr<GlContext> gl = openDevice(options->common, config, stats);
+        RenderOutput image =
+            renderStage(options->common, config, *gl, coupe, head ? &*head : nullptr, {}, stats);
         clock.lap();
         writeRenderOutputs(config, image, (out / "beauty.exr").string(), "", (out / "beauty.png").string());
         stats.add("write", clock.lap());

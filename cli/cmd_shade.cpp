@@ -10,6 +10,8 @@
 #include "libcore/config/setup.h"
 #include "libcore/io/hair_cache.h"
 #include "libcore/io/vdb_io.h"
+#include "libcore/util/frames.h"
+#include "libcore/util/progress.h"
 #include "libcore/util/text.h"
 #include "stages/shade.h"
 
@@ -42,7 +44,7 @@ ShadeResult shadeStage(const CommonOptions& common, const Config& config, Strand
 void registerShade(CLI::App& app, int& exitCode) {
   struct Options {
     CommonOptions common;
-    std::string first, hair, rest, output, vdb;
+    std::string first, hair, rest, output, vdb, frames;
   };
   auto options = std::make_shared<Options>();
   CLI::App* cmd = app.add_subcommand(
@@ -66,6 +68,9 @@ void registerShade(CLI::App& app, int& exitCode) {
                   "Also write the density and signed-distance grids as OpenVDB float grids "
                   "named 'density' and 'sdf'")
       ->type_name("FILE.vdb");
+  cmd->add_option("--frames", options->frames,
+                  "With --rest: re-pose every frame of a sequence, the coupe and -o being patterns with ####")
+      ->type_name("A-B");
   addCommonFlags(*cmd, options->common, true);
   cmd->footer(exitCodeHelp());
   cmd->callback([options, &exitCode] {
@@ -81,16 +86,32 @@ void registerShade(CLI::App& app, int& exitCode) {
         const std::string& coupeFile = options->hair.empty() ? options->first : options->hair;
         if (coupeFile.empty())
           throw InputError("--rest needs the deformed coupe: hairgen shade --rest REST COUPE -o OUT");
-        Strands rest = readStrands(options->rest), deformed = readStrands(coupeFile);
-        stats.time("read", clock.lap());
-        Strands out = repose(rest, deformed);
-        stats.time("repose", clock.lap());
-        stats.counts()["strands"] = out.strandCount();
-        stats.counts()["points"] = out.pointCount();
-        writeStrands(options->output, out);
-        stats.time("write", clock.lap());
-        note(options->common, "shade: re-posed " + std::to_string(out.pointCount()) + " normals from " +
-                                  options->rest + "; wrote " + options->output);
+        const Strands rest = readStrands(options->rest);
+        // One coupe, or every frame of a sequence (--frames): the rest's normals on each.
+        const bool sequence = !options->frames.empty();
+        const FrameRange frames = sequence ? parseFrameRange(options->frames, "--frames") : FrameRange{0, 0};
+        if (sequence)
+          for (const std::string* pattern : {&coupeFile, static_cast<const std::string*>(&options->output)})
+            if (!isFramePattern(*pattern))
+              throw InputError(*pattern + ": with --frames, write #### where the frame number goes");
+        Progress progress("shade", "frames", size_t(frames.count()), sequence && !options->common.quiet);
+        for (int f = frames.first; f <= frames.last; ++f) {
+          const std::string in = sequence ? framePath(coupeFile, f).string() : coupeFile;
+          const std::string written = sequence ? framePath(options->output, f).string() : options->output;
+          const Strands deformed = readStrands(in);
+          stats.add("read", clock.lap());
+          const Strands out = repose(rest, deformed);
+          stats.add("repose", clock.lap());
+          stats.counts()["strands"] = out.strandCount();
+          stats.counts()["points"] = out.pointCount();
+          writeStrands(written, out);
+          stats.add("write", clock.lap());
+          if (sequence) progress.advance();
+        }
+        progress.finish();
+        note(options->common, "shade: re-posed the normals of " + options->rest + " onto " +
+                                  (sequence ? std::to_string(frames.count()) + " frames" : coupeFile) +
+                                  "; wrote " + options->output);
         stats.write(options->common);
         return;
       }

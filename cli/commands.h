@@ -35,8 +35,10 @@ Strands interpolateStage(const CommonOptions& common, const Config& config, cons
 ShadeResult shadeStage(const CommonOptions& common, const Config& config, Strands coupe, Stats& stats);
 // Opens the device, reads the Setup's custom shader files and calls the render stage; records the
 // device and the passes' times in `stats`.
-RenderOutput renderStage(const CommonOptions& common, const Config& config, const Strands& hair,
-                         const Mesh* head, const RenderOptions& options, Stats& stats);
+// Opens the rendering device (once per command) and names it on stderr.
+std::unique_ptr<GlContext> openDevice(const CommonOptions& common, const Config& config, Stats& stats);
+RenderOutput renderStage(const CommonOptions& common, const Config& config, GlContext& gl,
+                         const Strands& hair, const Mesh* head, const RenderOptions& options, Stats& stats);
 // Writes the EXR, and the light's maps and the preview where named (empty: not wanted).
 void writeRenderOutputs(const Config& config, const RenderOutput& out, const std::string& exr,
                         const std::string& dom, const std::string& preview);

@@ -53,7 +53,7 @@ void resample(const glm::vec3* p, const glm::vec3* t, uint32_t count, const std:
   }
 }
 
-void checkGuides(const Mesh& wick, const Strands& guides, const std::string& name) {
+void checkGuides(const Mesh& wick, const Strands& guides, const std::string& name, const glm::dmat4& pose) {
   const FileLoc where{name, 0};
   if (guides.strandCount() != wick.vertexCount())
     throw InputError(where, "has " + std::to_string(guides.strandCount()) + " guides but the wick has " +
@@ -64,7 +64,8 @@ void checkGuides(const Mesh& wick, const Strands& guides, const std::string& nam
     if (!guides.strandId.empty() && guides.strandId[i] != i)
       throw InputError(where, "guide " + std::to_string(i) + " has id " + std::to_string(guides.strandId[i]) +
                                   "; guides must be in the wick's vertex order");
-    double gap = glm::length(glm::dvec3(guides.points[guides.firstPoint[i]]) - glm::dvec3(wick.positions[i]));
+    const glm::dvec3 vertex(pose * glm::dvec4(glm::dvec3(wick.positions[i]), 1.0));
+    double gap = glm::length(glm::dvec3(guides.points[guides.firstPoint[i]]) - vertex);
     if (!(gap <= 1e-4)) {
       char mm[32];
       std::snprintf(mm, sizeof mm, "%.3g mm", gap * 1e3);
@@ -145,7 +146,7 @@ glm::dvec3 strayCentre(const Collision& collision) {
 
 Strands interpolate(const Mesh& wick, const Strands& guides, const Hairstyle& style,
                     const Collision& collision, const InterpolateOptions& options) {
-  checkGuides(wick, guides, options.guidesName);
+  checkGuides(wick, guides, options.guidesName, options.pose);
   const size_t triangleCount = wick.triangles.size();
   size_t pointsPerGuide = 0;
   for (size_t g = 0; g < guides.strandCount(); ++g)
@@ -187,7 +188,7 @@ Strands interpolate(const Mesh& wick, const Strands& guides, const Hairstyle& st
   if (!wick.uvs.empty()) coupe.rootUv.resize(strands);
   coupe.firstPoint[strands] = static_cast<uint32_t>(points);
 
-  const glm::dvec3 centre = strayCentre(collision);
+  const glm::dvec3 centre(options.pose * glm::dvec4(strayCentre(collision), 1.0));
   tbb::parallel_for(size_t(0), triangleCount, [&](size_t t) {
     const glm::uvec3 tri = wick.triangles[t];
     const uint32_t n = vertices[t];
@@ -235,6 +236,8 @@ Strands interpolate(const Mesh& wick, const Strands& guides, const Hairstyle& st
   coupe.defaultTransparency = guides.defaultTransparency;
   coupe.defaultColor = guides.defaultColor;
   coupe.provenance = madeByHairgen("interpolate", seed, options.configDigest);
+  coupe.provenance.frame = guides.provenance.frame;  // a frame's coupe is that frame's
+  coupe.provenance.time = guides.provenance.time;
   return coupe;
 }
 

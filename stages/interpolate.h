@@ -20,6 +20,10 @@ struct InterpolateOptions {
   std::string guidesName;        // names the guides in error messages
   Progress* progress = nullptr;  // advanced once per triangle
   bool force = false;            // run work estimated to take absurdly long (never work that cannot fit)
+  // A frame of a sequence: the head's pose at it. The guides' roots are checked against the posed wick
+  // and stray hairs scale about the posed head centre; counts, roots and weights come from the wick as
+  // given, so every frame has the same strands, ids and weights as the rest frame (DESIGN §8).
+  glm::dmat4 pose{1.0};
 };
 
 // Fills every wick triangle. Guide i must be the one grown from wick vertex i. The coupe is ordered by

@@ -63,6 +63,8 @@ Strands repose(const Strands& rest, const Strands& deformed) {
   if (out.colors.empty()) out.colors = rest.colors;
   out.provenance = rest.provenance;
   out.provenance.stage = "shade";
+  out.provenance.frame = deformed.provenance.frame;  // the deformed coupe's frame, when it is one
+  out.provenance.time = deformed.provenance.time;
   return out;
 }
 

@@ -40,8 +40,10 @@ Dynamics still() {
 // A compound pendulum: θ'' = −(3g/2L) sin θ, period 2π sqrt(2L/3g) at small amplitude.
 TEST(AnjyoDynamics, ASingleSegmentSwingsWithTheCompoundPendulumsPeriodAndKeepsItsEnergy) {
   const double length = 0.1, g = 9.81, dt = 2e-4, amplitude = 0.02;
+  // The styled state is held against its own styling load; a pendulum has none (gravity 0 at rest), and
+  // gravity arrives as the departure.
   Hairstyle style;
-  style.gravity = g;
+  style.gravity = 0.0;
   AnjyoHair hair(chain(glm::dvec3(0.0), {{0, -1, 0}}, length), style, still(), Collision{}, 0);
   hair.restore({amplitude, 0.0, amplitude, 0.0}, "start");  // displaced and let go
   AccelerationField field;
@@ -111,10 +113,19 @@ Fig11 fig11() {
   return f;
 }
 
+// The paper's own normalisation of the inertia, I_k = ρ(kd)²/3 for k = 18 (§3.2.1), is hairgen's times k:
+// (Δt)² c_i u_i = 3 (Δt)² i / (2 k³ ρ d).
+Dynamics paperUnits() {
+  Dynamics d = still();
+  d.rootInertia = 18.0;
+  d.rootSegments = 18;
+  return d;
+}
+
 TEST(AnjyoDynamics, ThePseudoForceFieldKeepsHairOutOfTheHead) {
   const Fig11 f = fig11();
-  Dynamics without = still();
-  Dynamics with = still();
+  Dynamics without = paperUnits();
+  Dynamics with = paperUnits();
   with.pseudoAlpha = -0.75;
   with.pseudoEpsilon = 0.1;
   with.pseudoReach = 2.0;  // "near the head": within two segment lengths
@@ -134,7 +145,7 @@ TEST(AnjyoDynamics, JointLimitsHoldAndSegmentsKeepTheirLength) {
   style.gravity = 0.0;
   style.jointLimit = 10.0;
   style.jointLimitFrom = 2;
-  Dynamics dynamics = still();
+  Dynamics dynamics = paperUnits();
   dynamics.fluctuation = 0.3;
   dynamics.fluctuationEvery = 1;
   AnjyoHair hair(f.hair, style, dynamics, f.head, 7);

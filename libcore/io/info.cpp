@@ -58,6 +58,11 @@ nlohmann::ordered_json describeStrands(const Strands& s) {
                        {"stage", s.provenance.stage},
                        {"seed", s.provenance.seed},
                        {"configDigest", s.provenance.configDigest}};
+  if (s.provenance.frame) {
+    j["provenance"]["frame"] = *s.provenance.frame;
+    j["provenance"]["time"] = s.provenance.time;
+  }
+  if (!s.simulationState.empty()) j["restartState"] = s.simulationState.size() / 4;
   return j;
 }
 
@@ -147,6 +152,9 @@ std::string formatDescription(const nlohmann::ordered_json& j) {
     out << "  made by " << j["provenance"]["producer"].get<std::string>() << " ("
         << j["provenance"]["stage"].get<std::string>() << "), seed " << j["provenance"]["seed"] << ", config "
         << j["provenance"]["configDigest"].get<std::string>() << "\n";
+  if (j.contains("provenance") && j["provenance"].contains("frame"))
+    out << "  frame " << j["provenance"]["frame"] << " at " << j["provenance"]["time"].get<double>() << " s"
+        << (j.contains("restartState") ? ", with the state a restart needs" : "") << "\n";
   return out.str();
 }
 

@@ -173,12 +173,15 @@ AnjyoHair::AnjyoHair(const Strands& rest, const Hairstyle& style, const Dynamics
       total += d;
     }
     longest = std::max(longest, total);
-    // I_i = f (k/i)^p m_i L²/3, c_i = 1/I_i, u_i = d_i/2: c_i u_i m_i = 3 d_i (i/k)^p / (2 f L²).
+    // I_i = f (k/i)^p m_i d_i L/3, c_i = 1/I_i, u_i = d_i/2: c_i u_i m_i = 3 (i/k)^p / (2 f L). The tip
+    // segment turns like the whole hair as one stick, as a single segment does (the compound pendulum),
+    // and the inertia grows toward the root as 1/i (§3.2.1): at a given fraction of the length the
+    // response is the same however finely the hair is cut into segments.
     for (uint32_t j = 0; j < k; ++j) {
       const size_t i = firstSegment_[s] + j;
       const double root = int(j) < dynamics.rootSegments ? dynamics.rootInertia : 1.0;
-      coefficient_[i] = 3.0 * length_[i] * std::pow(double(j + 1) / double(k), dynamics.inertiaExponent) /
-                        (2.0 * root * total * total);
+      coefficient_[i] =
+          3.0 * std::pow(double(j + 1) / double(k), dynamics.inertiaExponent) / (2.0 * root * total);
     }
   }
   thetaPrev_ = theta_;
@@ -244,12 +247,9 @@ void AnjyoHair::stepStrand(size_t s, const AccelerationField& field, double dt, 
     // The spring toward the rest direction, as an acceleration the projective equations turn into
     // θ'' = −ω²θ for a small departure θ.
     const double c = coefficient_[i];
-    const glm::dvec3 load = restAcceleration_ + departure + (springOmega2_ / c) * (basis.rest - dir);
-    const Trig rest = trig(0.0, 0.0);
-    const double thetaAcc =
-        c * (glm::dot(load, thetaVector(basis, now)) - glm::dot(restAcceleration_, thetaVector(basis, rest)));
-    const double phiAcc = c * (now.cl * glm::dot(load, phiVector(basis, now)) -
-                               glm::dot(restAcceleration_, phiVector(basis, rest)));
+    const glm::dvec3 push = departure + (springOmega2_ / c) * (basis.rest - dir);
+    const double thetaAcc = c * glm::dot(push, thetaVector(basis, now));
+    const double phiAcc = c * now.cl * glm::dot(push, phiVector(basis, now));
     // (4)' and (5)', with the damping as a loss of the last step's motion.
     double theta = theta_[i] + keep * (theta_[i] - thetaPrev_[i]) + dt2 * thetaAcc;
     double phi = phi_[i] + keep * (phi_[i] - phiPrev_[i]) + dt2 * phiAcc;

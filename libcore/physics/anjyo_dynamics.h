@@ -15,13 +15,16 @@
 //   a stick turning about its root, and the pole is 90° of departure away.
 // - Units: F is the segment's mass times an acceleration field (gravity, wind, and in the head's frame the
 //   head's own acceleration, with the rotating frame's Euler, centrifugal and Coriolis terms). I_i is
-//   (k/i)^p times the segment's mass at the hair's length L, m_i L²/3 — for one segment, the compound
-//   pendulum ρL³/3 — times a root factor for the first n segments. The mass cancels: c_i u_i m_i =
-//   3 d_i (i/k)^p / (2 L²).
+//   (k/i)^p m_i d_i L/3 (times a root factor for the first n segments), so c_i u_i m_i = 3 (i/k)^p/(2L):
+//   the mass cancels, the tip segment turns like the whole hair as one stick (for one segment, the
+//   compound pendulum ρL³/3), toward the root the inertia grows as 1/i, and at a given fraction of the
+//   length the response does not depend on how many segments the hair has. (The paper's own
+//   normalisation, I_k = ρ(kd)²/3, is k times this: `Inertia 1 k k`.)
 // - Rest: the guides were styled under gravity, which the equations alone do not hold. The hair moves by
-//   its departure from the styled state: the styling load (the rest pose's gravity on the rest segment)
-//   is subtracted from the force, and an angular spring at RestFrequency pulls each segment toward its
-//   rest direction. Still hair (a still head, no wind) therefore stays exactly at rest.
+//   its departure from the styled state: the force is the field minus the styling load (the rest pose's
+//   gravity), and an angular spring at RestFrequency pulls each segment toward its rest direction. Still
+//   hair (a still head, no wind) therefore stays exactly at rest, a wind or a turn of the head moves it,
+//   and a nod moves it as gravity turns in the head's frame.
 // - The pseudo-force field (§3.2.2) scales the departure force, not gravity: near the head ellipsoid, a
 //   departure pointing into it (D·F < α|D||F|, D the ellipsoid's gradient) is multiplied by ε.
 // - Joint limits and collisions are measured against the rest shape: a node may turn as much as it did at

@@ -39,6 +39,13 @@ glm::dmat4 Pose::matrix() const {
   return m;
 }
 
+Mesh posedMesh(const Mesh& mesh, const Pose& pose) {
+  Mesh out = mesh;
+  for (glm::vec3& p : out.positions) p = glm::vec3(pose.apply(glm::dvec3(p)));
+  for (glm::vec3& n : out.normals) n = glm::vec3(pose.rotation * glm::dvec3(n));
+  return out;
+}
+
 glm::dmat3 eulerRotation(const glm::dvec3& degrees) {
   const glm::dvec3 r = glm::radians(degrees);
   const double cx = std::cos(r.x), sx = std::sin(r.x), cy = std::cos(r.y), sy = std::sin(r.y);

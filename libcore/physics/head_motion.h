@@ -15,6 +15,7 @@
 #include <glm/glm.hpp>
 
 #include "libcore/config/params.h"
+#include "libcore/model/mesh.h"
 
 namespace hairgen {
 
@@ -51,6 +52,9 @@ class HeadMotion {
   glm::dvec3 centre_{0.0};
   double frameRate_ = 24.0;
 };
+
+// `mesh` moved by `pose`: positions, and normals turned with it.
+Mesh posedMesh(const Mesh& mesh, const Pose& pose);
 
 // Rz·Ry·Rx for rotations about x, y and z in degrees.
 glm::dmat3 eulerRotation(const glm::dvec3& degrees);
