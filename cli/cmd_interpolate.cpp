@@ -13,6 +13,7 @@ void registerInterpolate(CLI::App& app, int& exitCode) {
   struct Options {
     CommonOptions common;
     std::string setup, guides, output;
+    UnitOptions units;
   };
   auto options = std::make_shared<Options>();
   CLI::App* cmd = app.add_subcommand(
@@ -20,9 +21,11 @@ void registerInterpolate(CLI::App& app, int& exitCode) {
       "Fill every wick triangle with strands blended from its corner guides (clumping, stray hairs)");
   cmd->add_option("SETUP", options->setup, "The Setup file")->required();
   cmd->add_option("--guides", options->guides,
-                  "Guides from `hairgen grow` on the same Setup (.hair, .gltf, .glb)")
+                  "Guides from `hairgen grow` on the same Setup (.hair, .gltf, .glb, .ply, .data)")
       ->required();
-  cmd->add_option("-o,--output", options->output, "Coupe to write: .hair, .gltf or .glb (written atomically)")
+  addUnitFlags(*cmd, options->units, "the guides");
+  cmd->add_option("-o,--output", options->output,
+                  "Coupe to write: .hair, .gltf, .glb, .ply, .data or .usda (written atomically)")
       ->required();
   addCommonFlags(*cmd, options->common, true);
   cmd->footer(exitCodeHelp());
@@ -33,7 +36,7 @@ void registerInterpolate(CLI::App& app, int& exitCode) {
       Stopwatch clock;
       Config config = loadStageConfig(options->setup, options->common, SetupUse::kInterpolate, stats);
       Mesh wick = readObj(config.setup.wickModel.path);
-      Strands guides = readStrands(options->guides);
+      Strands guides = readStrandsAs(options->guides, options->units);
       stats.time("read", clock.lap());
       Strands coupe = interpolateStage(options->common, config, wick, guides, options->guides, stats);
       writeStrands(options->output, coupe);

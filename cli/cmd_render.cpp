@@ -83,7 +83,8 @@ void writeRenderOutputs(const Config& config, const RenderOutput& out, const std
 void registerRender(CLI::App& app, int& exitCode) {
   struct Options {
     CommonOptions common;
-    std::string setup, hair, output, dom, preview, upAxis = "y";
+    std::string setup, hair, output, dom, preview;
+    UnitOptions units;
     double scale = 1.0;
     bool frame = false, listDevices = false;
   };
@@ -93,7 +94,7 @@ void registerRender(CLI::App& app, int& exitCode) {
       "Render a coupe headless (EGL): Kajiya-Kay hair, Lambert head, deep opacity map shadows, to EXR");
   cmd->add_option("SETUP", options->setup, "The Setup file (Visuality and Render Info, the head)");
   cmd->add_option("--hair", options->hair,
-                  "The coupe: .hair (also cyHair files made elsewhere), .gltf or .glb");
+                  "The coupe: .hair (also cyHair files made elsewhere), .gltf, .glb, .ply or .data");
   cmd->add_option("-o,--output", options->output,
                   "Image to write: .exr with R G B A (half), Z, opacity, shadow");
   cmd->add_option("--dom", options->dom,
@@ -101,12 +102,11 @@ void registerRender(CLI::App& app, int& exitCode) {
       ->type_name("FILE.exr");
   cmd->add_option("--preview", options->preview, "Also write a tone-mapped sRGB preview")
       ->type_name("FILE.png");
-  cmd->add_option("--up-axis", options->upAxis,
-                  "The hair file's up axis; z turns z-up hair to hairgen's y-up")
-      ->check(CLI::IsMember({"y", "z"}));
-  cmd->add_option("--scale", options->scale,
-                  "Multiply the hair's positions and widths (e.g. 0.01 for centimetres)")
-      ->check(kFiniteNonNegative & CLI::PositiveNumber);
+  addUnitFlags(*cmd, options->units, "the hair file");
+  CLI::Option* scale = cmd->add_option("--scale", options->scale,
+                                       "Multiply the hair's positions and widths: --units as a factor")
+                           ->check(kFiniteNonNegative & CLI::PositiveNumber);
+  scale->excludes(cmd->get_option("--units"));
   cmd->add_flag("--frame", options->frame, "Aim the camera and light at the hair and fit it in the view");
   cmd->add_flag("--list-devices", options->listDevices, "List the EGL devices and platforms found, and exit");
   addCommonFlags(*cmd, options->common, true);
@@ -141,8 +141,9 @@ void registerRender(CLI::App& app, int& exitCode) {
       stats.time("read", clock.lap());
       RenderOptions renderOptions;
       renderOptions.frame = options->frame;
-      renderOptions.zUp = options->upAxis == "z";
-      renderOptions.scale = options->scale;
+      const UnitConversion conversion = unitConversion(options->units);
+      renderOptions.zUp = conversion.upAxis == UpAxis::kZ;
+      renderOptions.scale = conversion.metresPerUnit.value_or(options->scale);
       renderOptions.keepDom = !options->dom.empty();
       RenderOutput out =
           renderStage(options->common, config, hair, head ? &*head : nullptr, renderOptions, stats);

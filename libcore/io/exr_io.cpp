@@ -16,6 +16,7 @@
 #include "libcore/util/error.h"
 #include "libcore/util/file_util.h"
 #include "libcore/util/resources.h"
+#include "libcore/util/text.h"
 
 namespace hairgen {
 namespace {
@@ -114,6 +115,22 @@ Image readImage(const fs::path& file) {
     image.planes.push_back(std::move(plane));
   }
   return image;
+}
+
+ImageHeader readImageHeader(const fs::path& file) {
+  requireRegularFile(file);
+  auto in = OIIO::ImageInput::open(file.string());
+  if (!in) throw InputError({file.string(), 0}, "cannot read image: " + oneLine(OIIO::geterror()));
+  const OIIO::ImageSpec& spec = in->spec();
+  ImageHeader header;
+  header.format = in->format_name();
+  header.width = spec.width;
+  header.height = spec.height;
+  for (int c = 0; c < spec.nchannels; ++c)
+    header.channels.emplace_back(spec.channelnames[c], spec.channelformat(c).c_str());
+  for (const OIIO::ParamValue& p : spec.extra_attribs)
+    header.attributes.emplace_back(p.name().string(), oneLine(p.get_string(16)));
+  return header;
 }
 
 void writePreview(const fs::path& file, const Image& image) {

@@ -5,6 +5,8 @@
 #include <filesystem>
 #include <map>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include <glm/glm.hpp>
 
@@ -22,6 +24,15 @@ void writeExr(const std::filesystem::path& file, const Image& image, const ExrMe
 
 // Any image OpenImageIO reads, every channel as float. Throws InputError naming the file.
 Image readImage(const std::filesystem::path& file);
+
+// An image's header without its pixels, for `hairgen info`: size, channels and metadata.
+struct ImageHeader {
+  std::string format;  // OpenImageIO's name of the file format ("openexr")
+  int width = 0, height = 0;
+  std::vector<std::pair<std::string, std::string>> channels;    // name, type ("half", "float")
+  std::vector<std::pair<std::string, std::string>> attributes;  // name, value as text, file order
+};
+ImageHeader readImageHeader(const std::filesystem::path& file);
 
 // A tone-mapped 8-bit sRGB PNG of R G B (clamped to [0, 1]) for people to look at.
 void writePreview(const std::filesystem::path& file, const Image& image);

@@ -16,8 +16,19 @@ struct Provenance {
   std::string stage;     // "grow", "interpolate", "shade", "convert", ...
   uint64_t seed = 0;
   std::string configDigest;  // hex digest of the effective configuration, or ""
+  // A file made elsewhere (issue 19): what it was, what it said of itself and what hairgen did to it.
+  std::string source =
+      {};  // the name of the file this was read or converted from, when hairgen did not write it
+  std::string sourceInfo =
+      {};  // what that file said of itself, one line (cyHair info text, PLY comments, ...)
+  std::string conversion = {};  // what hairgen applied ("units mm (x0.001); up axis z turned to +y"), or ""
+  bool metres = true;           // positions and widths are metres; false: the file's own, unknown units
+  bool yUp = true;              // +y is up; false: the file's own, unknown axis
 
-  bool empty() const { return producer.empty() && stage.empty() && configDigest.empty() && seed == 0; }
+  bool empty() const {
+    return producer.empty() && stage.empty() && configDigest.empty() && seed == 0 && source.empty() &&
+           sourceInfo.empty() && conversion.empty() && metres && yUp;
+  }
   bool operator==(const Provenance&) const = default;
 };
 
