@@ -62,6 +62,12 @@ void writeRenderOutputs(const Config& config, const RenderOutput& out, const std
   meta.strings["hairgen:configDigest"] = config.digest();
   meta.strings["hairgen:shadingModel"] = name(config.render.shadingModel);
   meta.strings["hairgen:backgroundZ"] = "1e10";
+  meta.strings["hairgen:alpha"] = "premultiplied: over a background, R G B + (1 - A) x background";
+  const glm::dvec3& bg = config.render.background;
+  meta.strings["hairgen:previewBackground"] =
+      formatReal(bg.x) + " " + formatReal(bg.y) + " " + formatReal(bg.z);
+  meta.floats["hairgen:fieldOfView"] = static_cast<float>(config.render.fieldOfView);  // degrees, vertical
+  meta.sizes["hairgen:resolution"] = config.render.resolution;
   meta.camera = true;
   meta.worldToCamera = out.worldToCamera;
   meta.worldToNdc = out.worldToNdc;
@@ -77,7 +83,7 @@ void writeRenderOutputs(const Config& config, const RenderOutput& out, const std
     domMeta.worldToNdc = out.worldToLight;
     writeExr(dom, out.dom, domMeta);
   }
-  if (!preview.empty()) writePreview(preview, out.beauty);
+  if (!preview.empty()) writePreview(preview, out.beauty, config.render.background);
 }
 
 void registerRender(CLI::App& app, int& exitCode) {
@@ -96,11 +102,11 @@ void registerRender(CLI::App& app, int& exitCode) {
   cmd->add_option("--hair", options->hair,
                   "The coupe: .hair (also cyHair files made elsewhere), .gltf, .glb, .ply or .data");
   cmd->add_option("-o,--output", options->output,
-                  "Image to write: .exr with R G B A (half), Z, opacity, shadow");
+                  "Image to write: .exr with R G B A (half, premultiplied), Z, opacity.Y, shadow.Y");
   cmd->add_option("--dom", options->dom,
                   "Also write the light's maps: Z where the hair begins and the 4 opacity layers")
       ->type_name("FILE.exr");
-  cmd->add_option("--preview", options->preview, "Also write a tone-mapped sRGB preview")
+  cmd->add_option("--preview", options->preview, "Also write an sRGB preview, over Render Info's Background")
       ->type_name("FILE.png");
   addUnitFlags(*cmd, options->units, "the hair file");
   CLI::Option* scale = cmd->add_option("--scale", options->scale,

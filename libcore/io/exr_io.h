@@ -16,6 +16,8 @@ namespace hairgen {
 
 struct ExrMetadata {
   std::map<std::string, std::string> strings;  // e.g. "producer", "hairgen:configDigest"
+  std::map<std::string, float> floats;         // e.g. "hairgen:fieldOfView"
+  std::map<std::string, glm::ivec2> sizes;     // V2i attributes, e.g. "hairgen:resolution"
   glm::dmat4 worldToCamera{1.0}, worldToNdc{1.0};
   bool camera = false;  // write worldToCamera / worldToNDC
 };
@@ -34,7 +36,8 @@ struct ImageHeader {
 };
 ImageHeader readImageHeader(const std::filesystem::path& file);
 
-// A tone-mapped 8-bit sRGB PNG of R G B (clamped to [0, 1]) for people to look at.
-void writePreview(const std::filesystem::path& file, const Image& image);
+// An 8-bit sRGB PNG for people to look at: premultiplied R G B A over `background` (R G B + (1 − A) ×
+// background), clamped to [0, 1]. An image without A is shown as it is.
+void writePreview(const std::filesystem::path& file, const Image& image, const glm::dvec3& background);
 
 }  // namespace hairgen
