@@ -13,6 +13,7 @@
 #include "libcore/model/units.h"
 #include "libcore/util/error.h"
 #include "libcore/util/file_util.h"
+#include "libcore/util/text.h"
 #include "tests/test_util.h"
 
 namespace hairgen {
@@ -219,6 +220,45 @@ TEST(Units, ZUpMillimetresBecomeYUpMetresAndSaySo) {
   convertToHairgenFrame(t, UnitConversion{0.01, std::nullopt});
   EXPECT_TRUE(t.provenance.metres);
   EXPECT_FALSE(t.provenance.yUp);
+}
+
+std::string usdaOf(const Strands& s) {
+  std::ostringstream out;
+  encodeUsda(out, s);
+  return out.str();
+}
+
+TEST(Usd, OneLinearBasisCurvesPrimWithWhatHairgenKnows) {
+  Strands s = test::sampleStrands(4, 8);
+  const std::string usda = usdaOf(s);
+  EXPECT_EQ(usda.rfind("#usda 1.0\n", 0), 0u);
+  for (const char* want :
+       {"defaultPrim = \"hair\"", "metersPerUnit = 1", "upAxis = \"Y\"", "def BasisCurves \"hair\"",
+        "uniform token type = \"linear\"", "int[] curveVertexCounts = [2, 5, 8, 2]", "point3f[] points = [",
+        "float[] widths = [", "normal3f[] normals = [", "color3f[] primvars:displayColor = [",
+        "int[] primvars:groom_id = [1000, 1001, 1002, 1003] (\n        interpolation = \"uniform\"",
+        "float2[] primvars:groom_root_uv", "int3[] primvars:groom_closest_guides = [(0, 1, 2), (1, 2, 3)",
+        "float3[] primvars:groom_guide_weights", "string configDigest = \"0123456789abcdef\""})
+    EXPECT_NE(usda.find(want), std::string::npos) << want;
+  // The widths are the diameters, one per vertex, in their shortest exact form.
+  const size_t widths = usda.find("float[] widths = [");
+  EXPECT_EQ(usda.substr(widths + 18, formatFloat(s.thickness[0]).size()), formatFloat(s.thickness[0]));
+  EXPECT_NE(usda.find("interpolation = \"vertex\"", widths), std::string::npos);
+}
+
+TEST(Usd, UnknownUnitsAreNotClaimedAndCurvesUsdCannotHoldAreRefused) {
+  Strands s;
+  s.addStrand({glm::vec3(0), glm::vec3(1)});
+  s.provenance.metres = s.provenance.yUp = false;
+  const std::string usda = usdaOf(s);
+  EXPECT_EQ(usda.find("metersPerUnit"), std::string::npos);
+  EXPECT_EQ(usda.find("upAxis"), std::string::npos);
+  EXPECT_NE(usda.find("float[] widths = [7e-05] (\n        interpolation = \"constant\""), std::string::npos);
+  s.addStrand({glm::vec3(2)});  // one point: not a linear curve
+  EXPECT_THROW(usdaOf(s), InputError);
+  Strands ids = test::sampleStrands(2);
+  ids.strandId[1] = 1u << 31;
+  EXPECT_THROW(usdaOf(ids), InputError);
 }
 
 TEST(Provenance, AConvertedFileSaysWhereItCameFromThroughEveryFormat) {
