@@ -15,6 +15,7 @@ void registerInterpolate(CLI::App& app, int& exitCode) {
   struct Options {
     CommonOptions common;
     std::string setup, guides, output, frames;
+    UnitOptions units;
   };
   auto options = std::make_shared<Options>();
   CLI::App* cmd = app.add_subcommand(
@@ -24,11 +25,14 @@ void registerInterpolate(CLI::App& app, int& exitCode) {
   cmd->add_option("SETUP", options->setup, "The Setup file")->required();
   cmd->add_option(
          "--guides", options->guides,
-         "Guides from `hairgen grow` on the same Setup (.hair, .gltf, .glb); with --frames a pattern such "
-         "as sim/guides.####.hair")
+         "Guides from `hairgen grow` on the same Setup (.hair, .gltf, .glb, .ply, .data); with --frames a "
+         "pattern such as sim/guides.####.hair")
       ->required();
-  cmd->add_option("-o,--output", options->output,
-                  "Coupe to write: .hair, .gltf or .glb (written atomically); with --frames a pattern")
+  addUnitFlags(*cmd, options->units, "the guides");
+  cmd->add_option(
+         "-o,--output", options->output,
+         "Coupe to write: .hair, .gltf, .glb, .ply, .data or .usda (written atomically); with --frames a "
+         "pattern")
       ->required();
   cmd->add_option("--frames", options->frames, "Interpolate these frames of a sequence")->type_name("A-B");
   addCommonFlags(*cmd, options->common, true);
@@ -41,7 +45,7 @@ void registerInterpolate(CLI::App& app, int& exitCode) {
       Config config = loadStageConfig(options->setup, options->common, SetupUse::kInterpolate, stats);
       Mesh wick = readObj(config.setup.wickModel.path);
       if (options->frames.empty()) {
-        Strands guides = readStrands(options->guides);
+        Strands guides = readStrandsAs(options->guides, options->units);
         stats.time("read", clock.lap());
         Strands coupe = interpolateStage(options->common, config, wick, guides, options->guides, stats);
         writeStrands(options->output, coupe);
@@ -58,7 +62,7 @@ void registerInterpolate(CLI::App& app, int& exitCode) {
       Progress progress("interpolate", "frames", size_t(frames.count()), !options->common.quiet);
       for (int f = frames.first; f <= frames.last; ++f) {
         const std::filesystem::path in = framePath(options->guides, f);
-        const Strands guides = readStrands(in);
+        const Strands guides = readStrandsAs(in, options->units);
         stats.add("read", clock.lap());
         InterpolateOptions frameOptions{config.digest(), in.string(), nullptr, options->common.force,
                                         head.pose(f).matrix()};

@@ -67,6 +67,12 @@ void writeRenderOutputs(const Config& config, const RenderOutput& out, const std
   meta.strings["hairgen:configDigest"] = config.digest();
   meta.strings["hairgen:shadingModel"] = name(config.render.shadingModel);
   meta.strings["hairgen:backgroundZ"] = "1e10";
+  meta.strings["hairgen:alpha"] = "premultiplied: over a background, R G B + (1 - A) x background";
+  const glm::dvec3& bg = config.render.background;
+  meta.strings["hairgen:previewBackground"] =
+      formatReal(bg.x) + " " + formatReal(bg.y) + " " + formatReal(bg.z);
+  meta.floats["hairgen:fieldOfView"] = static_cast<float>(config.render.fieldOfView);  // degrees, vertical
+  meta.sizes["hairgen:resolution"] = config.render.resolution;
   meta.camera = true;
   meta.worldToCamera = out.worldToCamera;
   meta.worldToNdc = out.worldToNdc;
@@ -82,13 +88,14 @@ void writeRenderOutputs(const Config& config, const RenderOutput& out, const std
     domMeta.worldToNdc = out.worldToLight;
     writeExr(dom, out.dom, domMeta);
   }
-  if (!preview.empty()) writePreview(preview, out.beauty);
+  if (!preview.empty()) writePreview(preview, out.beauty, config.render.background);
 }
 
 void registerRender(CLI::App& app, int& exitCode) {
   struct Options {
     CommonOptions common;
-    std::string setup, hair, output, dom, preview, frames, upAxis = "y";
+    std::string setup, hair, output, dom, preview, frames;
+    UnitOptions units;
     double scale = 1.0;
     bool frame = false, listDevices = false;
   };
@@ -98,20 +105,19 @@ void registerRender(CLI::App& app, int& exitCode) {
       "Render a coupe headless (EGL): Kajiya-Kay hair, Lambert head, deep opacity map shadows, to EXR");
   cmd->add_option("SETUP", options->setup, "The Setup file (Visuality and Render Info, the head)");
   cmd->add_option("--hair", options->hair,
-                  "The coupe: .hair (also cyHair files made elsewhere), .gltf or .glb");
+                  "The coupe: .hair (also cyHair files made elsewhere), .gltf, .glb, .ply or .data");
   cmd->add_option("-o,--output", options->output,
-                  "Image to write: .exr with R G B A (half), Z, opacity, shadow");
+                  "Image to write: .exr with R G B A (half, premultiplied), Z, opacity.Y, shadow.Y");
   cmd->add_option("--dom", options->dom,
                   "Also write the light's maps: Z where the hair begins and the 4 opacity layers")
       ->type_name("FILE.exr");
-  cmd->add_option("--preview", options->preview, "Also write a tone-mapped sRGB preview")
+  cmd->add_option("--preview", options->preview, "Also write an sRGB preview, over Render Info's Background")
       ->type_name("FILE.png");
-  cmd->add_option("--up-axis", options->upAxis,
-                  "The hair file's up axis; z turns z-up hair to hairgen's y-up")
-      ->check(CLI::IsMember({"y", "z"}));
-  cmd->add_option("--scale", options->scale,
-                  "Multiply the hair's positions and widths (e.g. 0.01 for centimetres)")
-      ->check(kFiniteNonNegative & CLI::PositiveNumber);
+  addUnitFlags(*cmd, options->units, "the hair file");
+  CLI::Option* scale = cmd->add_option("--scale", options->scale,
+                                       "Multiply the hair's positions and widths: --units as a factor")
+                           ->check(kFiniteNonNegative & CLI::PositiveNumber);
+  scale->excludes(cmd->get_option("--units"));
   cmd->add_flag("--frame", options->frame, "Aim the camera and light at the hair and fit it in the view");
   cmd->add_option(
          "--frames", options->frames,
@@ -155,8 +161,9 @@ void registerRender(CLI::App& app, int& exitCode) {
       stats.time("read", clock.lap());
       RenderOptions renderOptions;
       renderOptions.frame = options->frame;
-      renderOptions.zUp = options->upAxis == "z";
-      renderOptions.scale = options->scale;
+      const UnitConversion conversion = unitConversion(options->units);
+      renderOptions.zUp = conversion.upAxis == UpAxis::kZ;
+      renderOptions.scale = conversion.metresPerUnit.value_or(options->scale);
       renderOptions.keepDom = !options->dom.empty();
       const std::unique_ptr<GlContext> gl =
           openDevice(options->common, config, stats);  // one for every frame

@@ -45,6 +45,7 @@ void registerShade(CLI::App& app, int& exitCode) {
   struct Options {
     CommonOptions common;
     std::string first, hair, rest, output, vdb, frames;
+    UnitOptions units;
   };
   auto options = std::make_shared<Options>();
   CLI::App* cmd = app.add_subcommand(
@@ -58,12 +59,14 @@ void registerShade(CLI::App& app, int& exitCode) {
          "SETUP", options->first,
          "The Setup file (Render Info, Visuality Info, Hairstyle's Seed); with --rest, the deformed coupe")
       ->type_name("SETUP|COUPE");
-  cmd->add_option("--hair", options->hair, "The coupe (.hair, .gltf, .glb)");
+  cmd->add_option("--hair", options->hair, "The coupe (.hair, .gltf, .glb, .ply, .data)");
+  addUnitFlags(*cmd, options->units, "the coupe");
   cmd->add_option("--rest", options->rest,
                   "A coupe shaded at rest; its normals are carried onto the coupe by "
                   "parallel-transport frames, with no volume built")
       ->type_name("REST");
-  cmd->add_option("-o,--output", options->output, "Shaded coupe to write (.hair, .gltf, .glb)")->required();
+  cmd->add_option("-o,--output", options->output, "Shaded coupe to write (.hair, .gltf, .glb, .ply, .usda)")
+      ->required();
   cmd->add_option("--vdb", options->vdb,
                   "Also write the density and signed-distance grids as OpenVDB float grids "
                   "named 'density' and 'sdf'")
@@ -86,7 +89,7 @@ void registerShade(CLI::App& app, int& exitCode) {
         const std::string& coupeFile = options->hair.empty() ? options->first : options->hair;
         if (coupeFile.empty())
           throw InputError("--rest needs the deformed coupe: hairgen shade --rest REST COUPE -o OUT");
-        const Strands rest = readStrands(options->rest);
+        const Strands rest = readStrandsAs(options->rest, options->units);
         // One coupe, or every frame of a sequence (--frames): the rest's normals on each.
         const bool sequence = !options->frames.empty();
         const FrameRange frames = sequence ? parseFrameRange(options->frames, "--frames") : FrameRange{0, 0};
@@ -98,7 +101,7 @@ void registerShade(CLI::App& app, int& exitCode) {
         for (int f = frames.first; f <= frames.last; ++f) {
           const std::string in = sequence ? framePath(coupeFile, f).string() : coupeFile;
           const std::string written = sequence ? framePath(options->output, f).string() : options->output;
-          const Strands deformed = readStrands(in);
+          const Strands deformed = readStrandsAs(in, options->units);
           stats.add("read", clock.lap());
           const Strands out = repose(rest, deformed);
           stats.add("repose", clock.lap());
@@ -120,7 +123,7 @@ void registerShade(CLI::App& app, int& exitCode) {
       if (!options->vdb.empty() && !toLower(options->vdb).ends_with(".vdb"))
         throw InputError("--vdb " + options->vdb + ": the volume file must end in .vdb");
       Config config = loadStageConfig(options->first, options->common, SetupUse::kRender, stats);
-      Strands coupe = readStrands(options->hair);
+      Strands coupe = readStrandsAs(options->hair, options->units);
       stats.time("read", clock.lap());
       ShadeResult shaded;
       try {

@@ -8,6 +8,7 @@
 #include <tbb/info.h>
 
 #include "libcore/config/reader.h"
+#include "libcore/io/hair_cache.h"
 #include "libcore/util/error.h"
 #include "libcore/util/file_util.h"
 #include "libcore/util/json.h"
@@ -114,6 +115,33 @@ Config loadStageConfig(const std::filesystem::path& setup, const CommonOptions& 
   std::vector<Override> overrides = parseOverrides(options);
   stats.setOverrides(overrides);
   return loadConfig(setup, overrides, use);
+}
+
+void addUnitFlags(CLI::App& command, UnitOptions& options, const std::string& file) {
+  command
+      .add_option("--units", options.units,
+                  "The length unit of " + file + " when it is not metres: m, cm, mm, in, or metres per unit")
+      ->type_name("UNIT")
+      ->check(CLI::Validator(
+          [](std::string& text) -> std::string {
+            return parseLengthUnit(text) ? std::string()
+                                         : "'" + text + "' is not m, cm, mm, in or a positive number";
+          },
+          "UNIT"));
+  command
+      .add_option("--up-axis", options.upAxis, "The up axis of " + file + ": z turns z-up to hairgen's +y up")
+      ->check(CLI::IsMember({"y", "z"}));
+}
+
+UnitConversion unitConversion(const UnitOptions& options) {
+  UnitConversion conversion;
+  if (!options.units.empty()) conversion.metresPerUnit = parseLengthUnit(options.units);
+  if (!options.upAxis.empty()) conversion.upAxis = parseUpAxis(options.upAxis);
+  return conversion;
+}
+
+Strands readStrandsAs(const std::string& file, const UnitOptions& options) {
+  return readStrands(file, unitConversion(options));
 }
 
 std::string formatSeconds(double seconds) {

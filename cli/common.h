@@ -12,6 +12,8 @@
 
 #include "libcore/config/params.h"
 #include "libcore/config/setup.h"
+#include "libcore/model/strands.h"
+#include "libcore/model/units.h"
 #include "libcore/util/error.h"
 #include "libcore/util/stopwatch.h"
 
@@ -56,6 +58,18 @@ class Stats {
   std::chrono::steady_clock::time_point start_;
   nlohmann::ordered_json json_;
 };
+
+// --units and --up-axis: the lengths and up axis of a strand file made elsewhere (PLY, .data, a cyHair
+// file), converted to metres, +y up on reading (UnitConversion in libcore/model/units.h).
+struct UnitOptions {
+  std::string units;   // m, cm, mm, in or metres per unit; "" leaves the file's own
+  std::string upAxis;  // y or z; "" leaves the file's own
+};
+// Registers both on `command`, saying they apply to `file` ("the guides").
+void addUnitFlags(CLI::App& command, UnitOptions& options, const std::string& file);
+UnitConversion unitConversion(const UnitOptions& options);
+// Reads strands (readStrands) and applies the options' conversion, recorded in their provenance.
+Strands readStrandsAs(const std::string& file, const UnitOptions& options);
 
 // "1.23 s"
 std::string formatSeconds(double seconds);

@@ -36,6 +36,14 @@ if [ ! -f tools/node_modules/gltf-validator/package.json ]; then
   npm install --silent --no-audit --no-fund --prefix tools gltf-validator@2.0.0-dev.3.10 >/dev/null
 fi
 
+# TinyUSDZ's WebAssembly build (npm package tinyusdz), an independent USD reader the tests check the
+# .usda export with.
+if [ ! -f tools/node_modules/tinyusdz/tinyusdz.wasm ]; then
+  echo "setup: installing tinyusdz (npm)" >&2
+  mkdir -p tools
+  npm install --silent --no-audit --no-fund --prefix tools tinyusdz@0.9.0-rc10 >/dev/null
+fi
+
 [ "${1:-}" = "--no-build" ] && exit 0
 cmake -S . -B build -G Ninja -DCMAKE_BUILD_TYPE=Release >/dev/null
 cmake --build build

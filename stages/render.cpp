@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "libcore/model/units.h"
 #include "libcore/render/views.h"
 #include "libcore/util/error.h"
 #include "stages/estimate.h"
@@ -10,16 +11,10 @@
 namespace hairgen {
 
 void conform(Strands& hair, bool zUp, double scale) {
-  const float s = static_cast<float>(scale);
-  auto fix = [&](glm::vec3 v, bool position) {
-    if (zUp) v = glm::vec3(v.x, v.z, -v.y);
-    return position ? v * s : v;
-  };
-  for (glm::vec3& p : hair.points) p = fix(p, true);
-  for (glm::vec3& t : hair.tangents) t = fix(t, false);
-  for (glm::vec3& n : hair.normals) n = fix(n, false);
-  for (float& t : hair.thickness) t *= s;
-  hair.defaultThickness *= s;
+  UnitConversion conversion;
+  if (scale != 1.0) conversion.metresPerUnit = scale;
+  if (zUp) conversion.upAxis = UpAxis::kZ;
+  convertToHairgenFrame(hair, conversion);
 }
 
 void frameHair(RenderSettings& r, const Strands& hair) {

@@ -22,7 +22,8 @@
 //             along the view axis; the light's passes read it).
 //   HairFrag  reads those outputs; uniforms uEye, uLightPosition, uLightColor, uAmbient,
 //             uAmbientColor, uDiffuseColor, uSpecularColor, uGlossiness, uModel, uBlend; writes
-//             oColor (location 0: RGB, and the strand's opacity) and oData (location 1: Z in metres, hair
+//             oColor (location 0: RGB, and the strand's opacity, which the image does not read: its A is
+//             the sub-pixels something was drawn in) and oData (location 1: Z in metres, hair
 //             opacity 1, the shadow, 0).
 //   HeadVert  attributes aPosition, aNormal at locations 0-1; uniforms uView, uProj; writes gl_Position
 //             and vWorld, vNormal, vDepth.

@@ -173,8 +173,9 @@ render_diff)
     --set "Render.LightPosition=-0.6 1.0 0.8"
   if command -v exrheader >/dev/null; then
     exrheader "$tmp/a.exr" > "$tmp/header"
-    for c in "R, 16-bit floating" "G, 16-bit" "B, 16-bit" "A, 16-bit" "Z, 32-bit floating" "opacity, 32-bit" \
-             "shadow, 32-bit" 'producer (type string): "hairgen' "hairgen:configDigest" "worldToCamera"; do
+    for c in "R, 16-bit floating" "G, 16-bit" "B, 16-bit" "A, 16-bit" "Z, 32-bit floating" "opacity.Y, 32-bit" \
+             "shadow.Y, 32-bit" 'producer (type string): "hairgen' "hairgen:configDigest" "worldToCamera" \
+             "hairgen:fieldOfView (type float)" "hairgen:resolution (type v2i): (96 96)" "hairgen:alpha"; do
       grep -q "$c" "$tmp/header" || fail "exrheader does not show '$c'"
     done
     exrheader "$tmp/dom.exr" | grep -q "layer4, 32-bit" || fail "the DOM file lacks its fourth layer"
@@ -187,7 +188,7 @@ render_diff)
   grep -q "worst pixel ([0-9]*, [0-9]*) channel" "$tmp/out" || fail "worst pixel not named: $(cat "$tmp/out")"
   [ -s "$tmp/d.exr" ] || fail "no difference image"
   # Moving the light changes the shading, not the geometry.
-  expect_rc 0 "$hairgen" diff "$tmp/a.exr" "$tmp/b.exr" --channels Z,opacity
+  expect_rc 0 "$hairgen" diff "$tmp/a.exr" "$tmp/b.exr" --channels Z,opacity.Y
   expect_rc 2 "$hairgen" diff "$tmp/a.exr" "$tmp/missing.exr"
   ;;
 run_default)
@@ -268,6 +269,65 @@ shade_rest)
   expect_rc 2 "$hairgen" shade --rest "$tmp/rest.hair" "$tmp/r/coupe.hair" -o "$tmp/x.hair" --vdb "$tmp/x.vdb"
   expect_rc 2 "$hairgen" shade --rest "$tmp/rest.hair" -o "$tmp/x.hair"
   [ ! -e "$tmp/x.hair" ] && [ ! -e "$tmp/x.vdb" ] || fail "a refused re-pose wrote output"
+  ;;
+formats)
+  # PLY (binary and ASCII) and .data round trips keep every point bit for bit: compared as .data, whose
+  # bytes are the points alone.
+  small=(--set "Render.Resolution=48 48" --set Hairstyle.HairDensity=5 --quiet)
+  expect_rc 0 "$hairgen" run "$src/configs/thesis/coupe2/setup.txt" -o "$tmp/r" --no-render "${small[@]}"
+  expect_rc 0 "$hairgen" convert "$tmp/r/coupe.hair" "$tmp/direct.data" -q
+  for via in "b.ply" "a.ply --ascii" "d.data"; do
+    set -- $via
+    expect_rc 0 "$hairgen" convert "$tmp/r/coupe.hair" "$tmp/$1" -q ${2:-}
+    expect_rc 0 "$hairgen" convert "$tmp/$1" "$tmp/back-$1.hair" -q
+    expect_rc 0 "$hairgen" convert "$tmp/back-$1.hair" "$tmp/back-$1.data" -q
+    cmp "$tmp/direct.data" "$tmp/back-$1.data" || fail "points changed through $1"
+  done
+  head -c 30 "$tmp/a.ply" | grep -q "format ascii 1.0" || fail "--ascii did not write ASCII"
+  # What each format holds, and where a converted file came from.
+  expect_rc 0 "$hairgen" info "$tmp/back-d.data.hair"
+  grep -q "converted from d.data by hairgen" "$tmp/out" && grep -q "units: unknown" "$tmp/out" || fail "provenance: $(cat "$tmp/out")"
+  expect_rc 0 "$hairgen" convert "$tmp/d.data" "$tmp/m.ply" --units cm --up-axis z -q
+  expect_rc 0 "$hairgen" info "$tmp/m.ply"
+  grep -q "converted with units cm (x0.01); up axis z turned to +y" "$tmp/out" && grep -q "units: metres, +y up" "$tmp/out" \
+    || fail "conversion not recorded: $(cat "$tmp/out")"
+  expect_rc 0 "$hairgen" convert "$tmp/r/coupe.hair" "$tmp/c.usda" -q
+  expect_rc 0 "$hairgen" info "$tmp/c.usda"
+  grep -q "curves" "$tmp/out" && grep -q "metersPerUnit: 1" "$tmp/out" || fail "usda info: $(cat "$tmp/out")"
+  expect_rc 2 "$hairgen" convert "$tmp/c.usda" "$tmp/x.hair"
+  grep -q "does not read it" "$tmp/err" || fail "reading USD: $(cat "$tmp/err")"
+  # The stages take the data sets' formats, with their units.
+  expect_rc 0 "$hairgen" convert "$tmp/r/guides.hair" "$tmp/g.ply" -q
+  expect_rc 0 "$hairgen" interpolate "$src/configs/thesis/coupe2/setup.txt" --guides "$tmp/g.ply" -o "$tmp/c2.hair" "${small[@]}"
+  cmp "$tmp/c2.hair" "$tmp/r/coupe.hair" || fail "interpolating PLY guides differs from .hair guides"
+  expect_rc 0 "$hairgen" convert "$tmp/r/coupe.hair" "$tmp/mm.data" -q
+  expect_rc 0 "$hairgen" render "$src/configs/thesis/coupe2/setup.txt" --hair "$tmp/mm.data" --units 1 -o "$tmp/i.exr" "${small[@]}"
+  expect_rc 0 "$hairgen" info "$tmp/i.exr"
+  for want in "48x48, 7 channels" "opacity.Y (float)" "shadow.Y (float)" "A (half)" "hairgen:alpha: premultiplied" \
+              "hairgen:fieldOfView: " "hairgen:configDigest: "; do
+    grep -q "$want" "$tmp/out" || fail "info of the EXR lacks '$want': $(cat "$tmp/out")"
+  done
+  # Bad units, an --ascii that is not PLY, and curves USD cannot hold are exit 2 with nothing written.
+  expect_rc 2 "$hairgen" convert "$tmp/d.data" "$tmp/x.ply" --units furlong
+  expect_rc 2 "$hairgen" convert "$tmp/d.data" "$tmp/x.glb" --ascii
+  printf '\1\0\0\0\1\0\0\0\0\0\0\0\0\0\0\0\0\0\0\0' > "$tmp/one.data"
+  expect_rc 2 "$hairgen" convert "$tmp/one.data" "$tmp/x.usda"
+  grep -q "strand 0 has 1 point" "$tmp/err" || fail "one-point curve: $(cat "$tmp/err")"
+  [ ! -e "$tmp/x.ply" ] && [ ! -e "$tmp/x.glb" ] && [ ! -e "$tmp/x.usda" ] || fail "a refused convert wrote output"
+  ;;
+real_hairutil)
+  # hairutil's test data: the same 100 strands as .hair, .data and ASCII and binary PLY read to the same
+  # points, bit for bit.
+  d="$real/hairutil"
+  [ -f "$d/Bangs_100.data" ] || { echo "shared/testdata/real is absent; skipped"; exit 0; }
+  for f in Bangs_100.hair Bangs_100_ascii.ply Bangs_100_binary.ply Bangs_100.data; do
+    expect_rc 0 "$hairgen" convert "$d/$f" "$tmp/$f.data" -q
+    cmp "$tmp/$f.data" "$d/Bangs_100.data" || fail "$f does not read to Bangs_100.data's points"
+  done
+  expect_rc 0 "$hairgen" info "$d/Curly_100.ply"
+  grep -q "100 strands, 2528 points" "$tmp/out" || fail "Curly: $(cat "$tmp/out")"
+  expect_rc 2 "$hairgen" info "$d/Bangs_head.ply"
+  grep -q "a mesh (it has faces), not strands" "$tmp/err" || fail "head mesh: $(cat "$tmp/err")"
   ;;
 wick_info)
   expect_rc 0 "$hairgen" info "$src/configs/assets/wick.obj"

@@ -13,7 +13,11 @@ rm -rf "$out" && mkdir -p "$out"
 source "$dir/case.sh"
 [ -f "$dir/reference.exr" ] || { echo "golden $case: no reference.exr; run scripts/update-golden.sh $case"; exit 1; }
 "$hairgen" "${args[@]}" || { echo "golden $case: the command failed"; exit 1; }
-if "$hairgen" diff "$dir/reference.exr" "$image" --quiet; then
+if report=$("$hairgen" diff "$dir/reference.exr" "$image"); then
+  # diff compares the reference's channels by name: it must have compared the beauty and every AOV layer.
+  for channel in R G B A Z opacity.Y shadow.Y; do
+    grep -q "^  $channel: mean" <<<"$report" || { echo "golden $case: the comparison did not cover $channel"; exit 1; }
+  done
   exit 0
 fi
 cp "$dir/reference.exr" "$out/reference.exr"

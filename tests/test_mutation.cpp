@@ -9,7 +9,9 @@
 #include "libcore/config/setup.h"
 #include "libcore/io/gltf_io.h"
 #include "libcore/io/hair_io.h"
+#include "libcore/io/hairsalon_io.h"
 #include "libcore/io/obj_io.h"
+#include "libcore/io/ply_io.h"
 #include "libcore/util/error.h"
 #include "tests/test_util.h"
 
@@ -113,6 +115,18 @@ TEST(Mutation, HairFilesOnlyGiveTypedErrors) {
 TEST(Mutation, GlbFilesOnlyGiveTypedErrors) {
   std::vector<uint8_t> glb = encodeGltf(test::sampleStrands(4), true);
   mutationLoop(glb, 7, [](const std::vector<uint8_t>& d) { decodeGltf(d.data(), d.size(), "m.glb"); });
+}
+
+TEST(Mutation, PlyFilesOnlyGiveTypedErrors) {
+  mutationLoop(encodePly(test::sampleStrands(4), false), 8,
+               [](const std::vector<uint8_t>& d) { decodePly(d.data(), d.size(), "m.ply"); });
+  mutationLoop(encodePly(test::sampleStrands(3), true), 9,
+               [](const std::vector<uint8_t>& d) { decodePly(d.data(), d.size(), "m.ply"); });
+}
+
+TEST(Mutation, HairSalonFilesOnlyGiveTypedErrors) {
+  mutationLoop(encodeHairSalon(test::sampleStrands(5)), 10,
+               [](const std::vector<uint8_t>& d) { decodeHairSalon(d.data(), d.size(), "m.data"); });
 }
 
 }  // namespace

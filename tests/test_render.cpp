@@ -69,10 +69,10 @@ int compareStrandWithCpu(RenderSettings r, const glm::dvec3& normal) {
   int checked = 0;
   for (int y = 0; y < r.resolution.y; ++y)
     for (int x = 0; x < r.resolution.x; ++x) {
-      if (out.beauty.at("opacity", x, y) < 1.0f) continue;
+      if (out.beauty.at(kChannelOpacity, x, y) < 1.0f) continue;
       glm::dvec3 p = onPlane(r, x, y);
       p.y = 0.0;  // shading is at the centreline
-      const float shadow = out.beauty.at("shadow", x, y);
+      const float shadow = out.beauty.at(kChannelShadow, x, y);
       glm::dvec3 expect = shadeHair(r.shadingModel, {1, 0, 0}, normal, glm::normalize(r.lightPosition - p),
                                     glm::normalize(r.cameraPosition - p), v, r, shadow);
       for (int c = 0; c < 3; ++c) {
@@ -144,17 +144,42 @@ TEST(Render, VolumetricWithBlendZeroIsKajiyaKay) {
   }
 }
 
+// DESIGN §6: R G B A premultiplied. A pixel nothing covers is 0 in all four, A is the covered fraction of
+// a pixel's sub-pixels (1 inside a strand, between 0 and 1 on its edges), and no channel exceeds what A
+// allows of the brightest colour drawn.
+TEST(Render, TheBeautyIsPremultiplied) {
+  Strands s;
+  addStraight(s, {-0.04f, -0.01f, 0}, {0.04f, 0.012f, 0});
+  RenderSettings r = frontCamera(64, 4);
+  r.strandWidth = 0.004;
+  RenderOutput out = renderStrands(s, r);
+  int edges = 0, inside = 0;
+  for (int y = 0; y < 64; ++y)
+    for (int x = 0; x < 64; ++x) {
+      const float a = out.beauty.at("A", x, y);
+      ASSERT_GE(a, 0.0f);
+      ASSERT_LE(a, 1.0f);
+      if (a == 0.0f) {
+        for (const char* c : {"R", "G", "B"}) ASSERT_EQ(out.beauty.at(c, x, y), 0.0f) << x << "," << y;
+      }
+      edges += a > 0.0f && a < 1.0f;
+      inside += a == 1.0f;
+    }
+  EXPECT_GT(edges, 20);
+  EXPECT_GT(inside, 20);
+}
+
 TEST(Render, BackgroundPixelsHaveNoOpacityAndTheBackgroundZ) {
   Strands s;
   addStraight(s, {-0.02f, 0, 0}, {0.02f, 0, 0});
   RenderSettings r = frontCamera(64, 4);
   RenderOutput out = renderStrands(s, r);
-  EXPECT_EQ(out.beauty.at("opacity", 0, 0), 0.0f);
+  EXPECT_EQ(out.beauty.at(kChannelOpacity, 0, 0), 0.0f);
   EXPECT_EQ(out.beauty.at("A", 0, 0), 0.0f);
   EXPECT_EQ(out.beauty.at("Z", 0, 0), kBackgroundZ);
-  EXPECT_EQ(out.beauty.at("shadow", 0, 0), 1.0f);
-  EXPECT_NEAR(out.beauty.at("R", 0, 0), r.background.x, 1e-3);
-  EXPECT_GT(out.beauty.at("opacity", 32, 31) + out.beauty.at("opacity", 32, 32), 0.0f);
+  EXPECT_EQ(out.beauty.at(kChannelShadow, 0, 0), 1.0f);
+  EXPECT_EQ(out.beauty.at("R", 0, 0), 0.0f);  // premultiplied: the background is the preview's
+  EXPECT_GT(out.beauty.at(kChannelOpacity, 32, 31) + out.beauty.at(kChannelOpacity, 32, 32), 0.0f);
   EXPECT_NEAR(std::min(out.beauty.at("Z", 32, 31), out.beauty.at("Z", 32, 32)), 0.3f, 1e-3f);
 }
 
@@ -172,12 +197,12 @@ TEST(Render, AStrandBetweenTheLightAndAnotherDarkensOnlyThatOne) {
   int aPixels = 0, bPixels = 0;
   for (int y = 0; y < 96; ++y)
     for (int x = 20; x < 76; ++x) {
-      if (a.beauty.at("opacity", x, y) == 1.0f && all.beauty.at("opacity", x, y) == 1.0f) {
+      if (a.beauty.at(kChannelOpacity, x, y) == 1.0f && all.beauty.at(kChannelOpacity, x, y) == 1.0f) {
         EXPECT_NEAR(all.beauty.at("R", x, y), a.beauty.at("R", x, y), 1e-3) << "A at " << x << "," << y;
         ++aPixels;
       }
-      if (b.beauty.at("opacity", x, y) == 1.0f && all.beauty.at("opacity", x, y) == 1.0f) {
-        EXPECT_LT(all.beauty.at("shadow", x, y), 0.7f);
+      if (b.beauty.at(kChannelOpacity, x, y) == 1.0f && all.beauty.at(kChannelOpacity, x, y) == 1.0f) {
+        EXPECT_LT(all.beauty.at(kChannelShadow, x, y), 0.7f);
         EXPECT_LT(all.beauty.at("R", x, y), 0.8f * b.beauty.at("R", x, y)) << "B at " << x << "," << y;
         ++bPixels;
       }
@@ -217,7 +242,7 @@ struct HairOverAPlane {
     int n = 0;
     for (int y = 54; y < 74; ++y)
       for (int x = 0; x < 128; ++x) {
-        if (out.beauty.at("opacity", x, y) != 0.0f || out.beauty.at("A", x, y) != 1.0f) continue;
+        if (out.beauty.at(kChannelOpacity, x, y) != 0.0f || out.beauty.at("A", x, y) != 1.0f) continue;
         double wx = (x + 0.5 - 64) / focal * 0.5;
         if (wx > fromX && wx < toX) sum += out.beauty.at("R", x, y), ++n;
       }
@@ -266,10 +291,12 @@ TEST(Render, SupersamplingChangesOnlyStrandEdges) {
   for (int y = 1; y < 79; ++y)
     for (int x = 1; x < 79; ++x) {
       // An edge pixel: partly covered when supersampled, or next to a coverage change without.
-      bool edge = nine.beauty.at("opacity", x, y) > 0.0f && nine.beauty.at("opacity", x, y) < 1.0f;
+      bool edge =
+          nine.beauty.at(kChannelOpacity, x, y) > 0.0f && nine.beauty.at(kChannelOpacity, x, y) < 1.0f;
       for (int dy = -1; dy <= 1; ++dy)
         for (int dx = -1; dx <= 1; ++dx)
-          edge = edge || one.beauty.at("opacity", x + dx, y + dy) != one.beauty.at("opacity", x, y);
+          edge =
+              edge || one.beauty.at(kChannelOpacity, x + dx, y + dy) != one.beauty.at(kChannelOpacity, x, y);
       double change = 0.0;
       for (const char* c : {"R", "G", "B", "A"})
         change = std::max(change, double(std::abs(one.beauty.at(c, x, y) - nine.beauty.at(c, x, y))));
@@ -314,15 +341,15 @@ TEST(Render, ACustomHairFragmentGivesItsColorWhereTheHairIs) {
   int hair = 0;
   for (int y = 0; y < 64; ++y)
     for (int x = 0; x < 64; ++x) {
-      if (out.beauty.at("opacity", x, y) < 1.0f) continue;
+      if (out.beauty.at(kChannelOpacity, x, y) < 1.0f) continue;
       EXPECT_EQ(out.beauty.at("R", x, y), 0.25f) << x << "," << y;
       EXPECT_EQ(out.beauty.at("G", x, y), 0.75f) << x << "," << y;
       EXPECT_EQ(out.beauty.at("B", x, y), 0.5f) << x << "," << y;
       ++hair;
     }
   EXPECT_GT(hair, 40);
-  EXPECT_EQ(out.beauty.at("opacity", 0, 0), 0.0f);
-  EXPECT_NEAR(out.beauty.at("R", 0, 0), r.background.x, 1e-3) << "the background is not the shader's";
+  EXPECT_EQ(out.beauty.at(kChannelOpacity, 0, 0), 0.0f);
+  EXPECT_EQ(out.beauty.at("R", 0, 0), 0.0f) << "the background is not the shader's, nor the image's";
 }
 
 TEST(Render, ABrokenCustomHairFragmentIsAnInputErrorAtItsFileAndLine) {

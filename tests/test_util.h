@@ -105,6 +105,11 @@ inline void expectSameStrands(const Strands& a, const Strands& b) {
   EXPECT_EQ(a.provenance.stage, b.provenance.stage);
   EXPECT_EQ(a.provenance.seed, b.provenance.seed);
   EXPECT_EQ(a.provenance.configDigest, b.provenance.configDigest);
+  EXPECT_EQ(a.provenance.source, b.provenance.source);
+  EXPECT_EQ(a.provenance.sourceInfo, b.provenance.sourceInfo);
+  EXPECT_EQ(a.provenance.conversion, b.provenance.conversion);
+  EXPECT_EQ(a.provenance.metres, b.provenance.metres);
+  EXPECT_EQ(a.provenance.yUp, b.provenance.yUp);
 }
 
 inline ConfigText text(const std::string& body, const std::string& name = "test.txt") {

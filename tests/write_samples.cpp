@@ -16,5 +16,10 @@ int main(int argc, char** argv) {
   hairgen::Strands bare;
   bare.addStrand({glm::vec3(0, 0, 0), glm::vec3(0, -0.01f, 0.001f), glm::vec3(0, -0.02f, 0.003f)});
   hairgen::writeGltf(dir / "bare.glb", bare, true);
+  // Converted from a file of unknown units: no thickness, no colours, the extras say what is unknown.
+  bare.provenance = {"hairgen test", "convert", 0, ""};
+  bare.provenance.source = "Bangs_100.data";
+  bare.provenance.metres = bare.provenance.yUp = false;
+  hairgen::writeGltf(dir / "converted.glb", bare, true);
   return 0;
 }

@@ -4,18 +4,21 @@
 
 #include <ImathMatrix.h>
 #include <OpenEXR/ImfChannelList.h>
+#include <OpenEXR/ImfFloatAttribute.h>
 #include <OpenEXR/ImfFrameBuffer.h>
 #include <OpenEXR/ImfHeader.h>
 #include <OpenEXR/ImfMatrixAttribute.h>
 #include <OpenEXR/ImfOutputFile.h>
 #include <OpenEXR/ImfStandardAttributes.h>
 #include <OpenEXR/ImfStringAttribute.h>
+#include <OpenEXR/ImfVecAttribute.h>
 #include <OpenImageIO/imageio.h>
 #include <half.h>
 
 #include "libcore/util/error.h"
 #include "libcore/util/file_util.h"
 #include "libcore/util/resources.h"
+#include "libcore/util/text.h"
 
 namespace hairgen {
 namespace {
@@ -45,6 +48,9 @@ void writeExr(const fs::path& file, const Image& image, const ExrMetadata& metad
   Imf::Header header(image.width, image.height);
   header.compression() = Imf::ZIP_COMPRESSION;
   for (const auto& [key, value] : metadata.strings) header.insert(key, Imf::StringAttribute(value));
+  for (const auto& [key, value] : metadata.floats) header.insert(key, Imf::FloatAttribute(value));
+  for (const auto& [key, value] : metadata.sizes)
+    header.insert(key, Imf::V2iAttribute(Imath::V2i(value.x, value.y)));
   if (metadata.camera) {
     Imf::addWorldToCamera(header, toImath(metadata.worldToCamera));
     Imf::addWorldToNDC(header, toImath(metadata.worldToNdc));
@@ -116,15 +122,33 @@ Image readImage(const fs::path& file) {
   return image;
 }
 
-void writePreview(const fs::path& file, const Image& image) {
+ImageHeader readImageHeader(const fs::path& file) {
+  requireRegularFile(file);
+  auto in = OIIO::ImageInput::open(file.string());
+  if (!in) throw InputError({file.string(), 0}, "cannot read image: " + oneLine(OIIO::geterror()));
+  const OIIO::ImageSpec& spec = in->spec();
+  ImageHeader header;
+  header.format = in->format_name();
+  header.width = spec.width;
+  header.height = spec.height;
+  for (int c = 0; c < spec.nchannels; ++c)
+    header.channels.emplace_back(spec.channelnames[c], spec.channelformat(c).c_str());
+  for (const OIIO::ParamValue& p : spec.extra_attribs)
+    header.attributes.emplace_back(p.name().string(), oneLine(p.get_string(16)));
+  return header;
+}
+
+void writePreview(const fs::path& file, const Image& image, const glm::dvec3& background) {
   const size_t pixels = size_t(image.width) * image.height;
   std::vector<unsigned char> rgb(pixels * 3);
   const char* names[3] = {"R", "G", "B"};
+  const std::vector<float>* alpha = image.has("A") ? &image.plane("A") : nullptr;
   for (int c = 0; c < 3; ++c) {
     const std::vector<float>& plane = image.plane(names[c]);
     for (size_t i = 0; i < pixels; ++i) {
-      double v = std::clamp(double(plane[i]), 0.0, 1.0);
-      double srgb = v <= 0.0031308 ? 12.92 * v : 1.055 * std::pow(v, 1.0 / 2.4) - 0.055;
+      const double over = alpha ? double(plane[i]) + (1.0 - double((*alpha)[i])) * background[c] : plane[i];
+      const double v = std::clamp(over, 0.0, 1.0);
+      const double srgb = v <= 0.0031308 ? 12.92 * v : 1.055 * std::pow(v, 1.0 / 2.4) - 0.055;
       rgb[i * 3 + c] = static_cast<unsigned char>(std::lround(srgb * 255.0));
     }
   }

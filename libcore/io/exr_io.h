@@ -5,6 +5,8 @@
 #include <filesystem>
 #include <map>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include <glm/glm.hpp>
 
@@ -14,6 +16,8 @@ namespace hairgen {
 
 struct ExrMetadata {
   std::map<std::string, std::string> strings;  // e.g. "producer", "hairgen:configDigest"
+  std::map<std::string, float> floats;         // e.g. "hairgen:fieldOfView"
+  std::map<std::string, glm::ivec2> sizes;     // V2i attributes, e.g. "hairgen:resolution"
   glm::dmat4 worldToCamera{1.0}, worldToNdc{1.0};
   bool camera = false;  // write worldToCamera / worldToNDC
 };
@@ -23,7 +27,17 @@ void writeExr(const std::filesystem::path& file, const Image& image, const ExrMe
 // Any image OpenImageIO reads, every channel as float. Throws InputError naming the file.
 Image readImage(const std::filesystem::path& file);
 
-// A tone-mapped 8-bit sRGB PNG of R G B (clamped to [0, 1]) for people to look at.
-void writePreview(const std::filesystem::path& file, const Image& image);
+// An image's header without its pixels, for `hairgen info`: size, channels and metadata.
+struct ImageHeader {
+  std::string format;  // OpenImageIO's name of the file format ("openexr")
+  int width = 0, height = 0;
+  std::vector<std::pair<std::string, std::string>> channels;    // name, type ("half", "float")
+  std::vector<std::pair<std::string, std::string>> attributes;  // name, value as text, file order
+};
+ImageHeader readImageHeader(const std::filesystem::path& file);
+
+// An 8-bit sRGB PNG for people to look at: premultiplied R G B A over `background` (R G B + (1 − A) ×
+// background), clamped to [0, 1]. An image without A is shown as it is.
+void writePreview(const std::filesystem::path& file, const Image& image, const glm::dvec3& background);
 
 }  // namespace hairgen

@@ -361,8 +361,11 @@ std::vector<uint8_t> encodeGltf(const Strands& s, bool binary) {
     prim.attributes["_TRANSPARENCY"] = b.add(s.transparency, kFloat, TINYGLTF_TYPE_SCALAR, kArray);
   if (!s.tangents.empty())
     prim.attributes["_TANGENT"] = b.add(s.tangents, kFloat, TINYGLTF_TYPE_VEC3, kArray);
-  if (!s.thickness.empty())
-    prim.attributes["_THICKNESS"] = b.add(s.thickness, kFloat, TINYGLTF_TYPE_SCALAR, kArray);
+  // Every vertex has a width, the default where the strands carry none, so an importer that reads
+  // _THICKNESS never sees zero; asset.extras.thicknessFromDefault tells hairgen to drop it again.
+  prim.attributes["_THICKNESS"] =
+      b.add(s.thickness.empty() ? std::vector<float>(s.pointCount(), s.defaultThickness) : s.thickness,
+            kFloat, TINYGLTF_TYPE_SCALAR, kArray);
   if (!s.strandId.empty())
     prim.attributes["_STRAND_ID"] =
         b.add(asFloat(perVertex(s, s.strandId), "strand id"), kFloat, TINYGLTF_TYPE_SCALAR, kArray);
@@ -381,6 +384,17 @@ std::vector<uint8_t> encodeGltf(const Strands& s, bool binary) {
     prim.attributes["_ROOT_BARY"] = b.add(perVertex(s, s.rootBary), kFloat, TINYGLTF_TYPE_VEC3, kArray);
 
   tinygltf::Model& m = b.model;
+  // The hair's colour as the material's, so a DCC shows it: the header's default colour, or white
+  // when COLOR_0 holds the colours (glTF multiplies the two).
+  tinygltf::Material material;
+  material.name = "hair";
+  const glm::vec3 base = s.colors.empty() ? glm::clamp(s.defaultColor, 0.0f, 1.0f) : glm::vec3(1.0f);
+  material.pbrMetallicRoughness.baseColorFactor = {double(base.x), double(base.y), double(base.z), 1.0};
+  material.pbrMetallicRoughness.metallicFactor = 0.0;
+  material.pbrMetallicRoughness.roughnessFactor = 0.6;
+  material.doubleSided = true;
+  m.materials.push_back(material);
+  prim.material = 0;
   tinygltf::Buffer buffer;
   buffer.data = std::move(b.buffer);
   m.buffers.push_back(std::move(buffer));
@@ -409,7 +423,15 @@ std::vector<uint8_t> encodeGltf(const Strands& s, bool binary) {
   extras["defaultThickness"] = Value(static_cast<double>(s.defaultThickness));
   extras["defaultTransparency"] = Value(static_cast<double>(s.defaultTransparency));
   extras["defaultColor"] = vec3Value(s.defaultColor);
-  extras["units"] = Value(std::string("metres, +y up; _THICKNESS is a diameter"));
+  // glTF's own units are metres with +y up; a file whose source did not say is not claimed to be.
+  const Provenance& p = s.provenance;
+  extras["units"] = Value(std::string(p.metres ? "metres" : "unknown: the source file's own, not metres"));
+  extras["upAxis"] = Value(std::string(p.yUp ? "+y" : "unknown: the source file's own"));
+  extras["thickness"] = Value(std::string("_THICKNESS is each vertex's diameter, in the units above"));
+  extras["thicknessFromDefault"] = Value(s.thickness.empty());
+  if (!p.source.empty()) extras["source"] = Value(p.source);
+  if (!p.sourceInfo.empty()) extras["sourceInfo"] = Value(p.sourceInfo);
+  if (!p.conversion.empty()) extras["conversion"] = Value(p.conversion);
   m.asset.extras = Value(std::move(extras));
 
   tinygltf::TinyGLTF writer;
@@ -441,6 +463,14 @@ Strands decodeGltf(const uint8_t* data, size_t size, const std::string& name,
   s.provenance.producer = stringOr(m.asset.extras, "producer");
   s.provenance.stage = stringOr(m.asset.extras, "stage");
   s.provenance.configDigest = stringOr(m.asset.extras, "configDigest");
+  s.provenance.source = stringOr(m.asset.extras, "source");
+  s.provenance.sourceInfo = stringOr(m.asset.extras, "sourceInfo");
+  s.provenance.conversion = stringOr(m.asset.extras, "conversion");
+  s.provenance.metres = stringOr(m.asset.extras, "units").rfind("unknown", 0) != 0;  // glTF's own: metres
+  s.provenance.yUp = stringOr(m.asset.extras, "upAxis").rfind("unknown", 0) != 0;    // and +y up
+  if (s.provenance.producer.empty())  // made elsewhere: what it says of itself
+    s.provenance.sourceInfo =
+        oneLine(m.asset.generator + (m.asset.copyright.empty() ? "" : "; " + m.asset.copyright));
   std::string seed = stringOr(m.asset.extras, "seed");
   if (!seed.empty()) s.provenance.seed = std::strtoull(seed.c_str(), nullptr, 10);
   s.defaultThickness = static_cast<float>(numberOr(m.asset.extras, "defaultThickness", s.defaultThickness));
@@ -566,6 +596,10 @@ Strands decodeGltf(const uint8_t* data, size_t size, const std::string& name,
     }
   }
   if (!found) throw InputError({name, 0}, "no mesh primitive in mode LINES: the file holds no hair strands");
+  if (m.asset.extras.IsObject() && m.asset.extras.Has("thicknessFromDefault") &&
+      m.asset.extras.Get("thicknessFromDefault").IsBool() &&
+      m.asset.extras.Get("thicknessFromDefault").Get<bool>())
+    s.thickness.clear();
   s.validate(name);
   return s;
 }

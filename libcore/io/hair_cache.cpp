@@ -2,30 +2,95 @@
 
 #include "libcore/io/gltf_io.h"
 #include "libcore/io/hair_io.h"
+#include "libcore/io/hairsalon_io.h"
+#include "libcore/io/ply_io.h"
+#include "libcore/io/usd_io.h"
 #include "libcore/util/error.h"
 #include "libcore/util/text.h"
 
 namespace hairgen {
+namespace {
+
+struct FormatEntry {
+  const char* extension;
+  HairFormat format;
+  const char* description;
+};
+constexpr FormatEntry kFormats[] = {
+    {".hair", HairFormat::kHair, "cyHair .hair"},        {".gltf", HairFormat::kGltf, "glTF"},
+    {".glb", HairFormat::kGlb, "binary glTF"},           {".ply", HairFormat::kPly, "PLY"},
+    {".data", HairFormat::kData, "USC-HairSalon .data"}, {".usda", HairFormat::kUsda, "USD (usda)"},
+};
+
+}  // namespace
 
 HairFormat hairFormatOf(const std::filesystem::path& file) {
-  std::string ext = toLower(file.extension().string());
-  if (ext == ".hair") return HairFormat::kHair;
-  if (ext == ".gltf") return HairFormat::kGltf;
-  if (ext == ".glb") return HairFormat::kGlb;
-  throw InputError({file.string(), 0}, "unknown hair file extension '" + file.extension().string() +
-                                           "'; use .hair, .gltf or .glb");
+  const std::string ext = toLower(file.extension().string());
+  std::string known;
+  for (const FormatEntry& f : kFormats) {
+    if (ext == f.extension) return f.format;
+    known += std::string(known.empty() ? "" : ", ") + f.extension;
+  }
+  throw InputError({file.string(), 0},
+                   "unknown hair file extension '" + file.extension().string() + "'; use " + known);
 }
 
-Strands readStrands(const std::filesystem::path& file) {
-  return hairFormatOf(file) == HairFormat::kHair ? readHair(file) : readGltf(file);
+const char* describe(HairFormat format) {
+  for (const FormatEntry& f : kFormats)
+    if (f.format == format) return f.description;
+  return "?";
 }
 
-void writeStrands(const std::filesystem::path& file, const Strands& strands) {
+void noteSource(Strands& strands, const std::filesystem::path& file) {
+  if (strands.provenance.producer.empty() && strands.provenance.source.empty())
+    strands.provenance.source = file.filename().string();
+}
+
+Strands readStrands(const std::filesystem::path& file, const UnitConversion& conversion) {
+  Strands strands;
   const HairFormat format = hairFormatOf(file);
-  if (format == HairFormat::kHair)
-    writeHair(file, strands);
-  else
-    writeGltf(file, strands, format == HairFormat::kGlb);
+  switch (format) {
+    case HairFormat::kHair:
+      strands = readHair(file);
+      break;
+    case HairFormat::kGltf:
+    case HairFormat::kGlb:
+      strands = readGltf(file);
+      break;
+    case HairFormat::kPly:
+      strands = readPly(file);
+      break;
+    case HairFormat::kData:
+      strands = readHairSalon(file);
+      break;
+    case HairFormat::kUsda:
+      throw InputError({file.string(), 0},
+                       "hairgen writes USD but does not read it; convert the strands to .hair, .ply or .glb "
+                       "where they were made");
+  }
+  noteSource(strands, file);
+  const bool statesDefaults =
+      format != HairFormat::kData && (format != HairFormat::kPly || !strands.provenance.producer.empty());
+  convertToHairgenFrame(strands, conversion);
+  if (!statesDefaults) strands.defaultThickness = Strands{}.defaultThickness;
+  return strands;
+}
+
+void writeStrands(const std::filesystem::path& file, const Strands& strands, const WriteOptions& options) {
+  switch (hairFormatOf(file)) {
+    case HairFormat::kHair:
+      return writeHair(file, strands);
+    case HairFormat::kGltf:
+      return writeGltf(file, strands, false);
+    case HairFormat::kGlb:
+      return writeGltf(file, strands, true);
+    case HairFormat::kPly:
+      return writePly(file, strands, options.asciiPly);
+    case HairFormat::kData:
+      return writeHairSalon(file, strands);
+    case HairFormat::kUsda:
+      return writeUsda(file, strands);
+  }
 }
 
 }  // namespace hairgen

@@ -1,18 +1,41 @@
-// Reading and writing strands by file extension: .hair, .gltf or .glb.
+// Reading and writing strands by file extension (DESIGN §6), the one place extensions are read:
+//   .hair        cyHair + hairgen's chunks (hair_io)        read, write
+//   .gltf .glb   glTF 2.0 LINES (gltf_io)                   read, write
+//   .ply         PLY strands, ASCII or binary (ply_io)     read, write
+//   .data        USC-HairSalon (hairsalon_io)               read, write
+//   .usda        USD BasisCurves (usd_io)                   write only
 #pragma once
 
 #include <filesystem>
+#include <string>
 
 #include "libcore/model/strands.h"
+#include "libcore/model/units.h"
 
 namespace hairgen {
 
-enum class HairFormat { kHair, kGltf, kGlb };
+enum class HairFormat { kHair, kGltf, kGlb, kPly, kData, kUsda };
 
 // The format a path's extension names (case-insensitive). Throws InputError for any other extension.
 HairFormat hairFormatOf(const std::filesystem::path& file);
 
-Strands readStrands(const std::filesystem::path& file);
-void writeStrands(const std::filesystem::path& file, const Strands& strands);  // atomic
+// "cyHair .hair", "PLY", ... for messages and `hairgen info`.
+const char* describe(HairFormat format);
+
+// Reads any format hairgen reads, then applies `conversion` (convertToHairgenFrame). A file hairgen did
+// not write (no hairgen provenance) gets its name as Provenance::source, so what is made from it can
+// say where it came from. PLY and .data files state no default width: theirs is hairgen's default, in
+// metres after the conversion (a cyHair header's own default is scaled with the file).
+Strands readStrands(const std::filesystem::path& file, const UnitConversion& conversion = {});
+
+// How formats with a choice are written.
+struct WriteOptions {
+  bool asciiPly = false;  // PLY as ASCII text instead of binary little-endian
+};
+void writeStrands(const std::filesystem::path& file, const Strands& strands,
+                  const WriteOptions& options = {});  // atomic
+
+// Records `file`'s name as the strands' source when they carry no hairgen provenance.
+void noteSource(Strands& strands, const std::filesystem::path& file);
 
 }  // namespace hairgen

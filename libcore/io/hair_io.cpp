@@ -118,10 +118,24 @@ std::vector<uint8_t> payload(Fn fill) {
   return std::move(w.out);
 }
 
+}  // namespace
+
 std::string provenanceText(const Provenance& p) {
   std::string text = "producer=" + p.producer + "\nstage=" + p.stage + "\nseed=" + std::to_string(p.seed) +
                      "\nconfig=" + p.configDigest + "\n";
   if (p.frame) text += "frame=" + std::to_string(*p.frame) + "\ntime=" + formatReal(p.time) + "\n";
+  // A file made elsewhere: written only when set, so hairgen's own files keep their bytes.
+  auto line = [](const std::string& value) {
+    std::string out = value;
+    for (char& c : out)
+      if (c == '\n' || c == '\r') c = ' ';
+    return out;
+  };
+  if (!p.source.empty()) text += "source=" + line(p.source) + "\n";
+  if (!p.sourceInfo.empty()) text += "sourceInfo=" + line(p.sourceInfo) + "\n";
+  if (!p.conversion.empty()) text += "conversion=" + line(p.conversion) + "\n";
+  if (!p.metres) text += "units=unknown\n";
+  if (!p.yUp) text += "up=unknown\n";
   return text;
 }
 
@@ -156,12 +170,19 @@ Provenance parseProvenance(const std::string& text, const std::string& name) {
       p.seed = std::strtoull(value.c_str(), &end2, 10);
       if (value.empty() || *end2 != '\0')
         throw InputError({name, 0}, "PROV chunk: seed '" + value + "' is not a number");
-    }
+    } else if (key == "source")
+      p.source = value;
+    else if (key == "sourceInfo")
+      p.sourceInfo = value;
+    else if (key == "conversion")
+      p.conversion = value;
+    else if (key == "units")
+      p.metres = value == "m";
+    else if (key == "up")
+      p.yUp = value == "y";
   }
   return p;
 }
-
-}  // namespace
 
 std::vector<uint8_t> encodeHair(const Strands& s) {
   s.validate("strands to write");
@@ -309,7 +330,8 @@ Strands decodeHair(const uint8_t* data, size_t size, const std::string& name, Ha
     for (glm::vec3& c : s.colors) c = r.vec();
   }
 
-  if (r.remaining() > 0) {
+  const bool blockFound = r.remaining() > 0;
+  if (blockFound) {
     r.need(12, "the hairgen chunk block header");
     if (std::memcmp(r.take(4), "HGEN", 4) != 0)
       throw InputError({name, 0},
@@ -394,6 +416,11 @@ Strands decodeHair(const uint8_t* data, size_t size, const std::string& name, Ha
     }
     if (r.remaining() > 0)
       throw InputError({name, 0}, std::to_string(r.remaining()) + " unexpected bytes after the last chunk");
+  }
+  if (!blockFound) {
+    // A cyHair file made elsewhere: its units and up axis are its own, and its info text describes it.
+    s.provenance.metres = s.provenance.yUp = false;
+    s.provenance.sourceInfo = header.info;
   }
   s.validate(name);
   if (headerOut) *headerOut = std::move(header);

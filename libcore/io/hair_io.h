@@ -11,8 +11,8 @@
 //                     char tag[4], uint64 payload bytes, payload, uint32 CRC-32 of tag+length+payload
 // Chunks: TANG/NORM float[3] per point; SIDS/RTRI uint32 per strand; RBAR float[3] per strand;
 // RUVS float[2] per strand; GIDS uint32[3] per strand; GWTS float[3] per strand; DYNS float64 per
-// segment × 4 (a simulated frame's restart state); PROV "key=value\n" text (producer, stage, seed,
-// config, and frame and time for a frame of a sequence).
+// segment × 4 (a simulated frame's restart state); PROV "key=value\n" text (provenanceText below:
+// producer, stage, seed, config, frame and time for a frame of a sequence, and what a conversion did).
 // cyHair readers stop after the arrays and never see the block. Unknown chunks are skipped (after
 // their CRC is checked), so newer files stay readable.
 #pragma once
@@ -40,7 +40,15 @@ std::vector<uint8_t> encodeHair(const Strands& strands);
 // truncated, corrupt or inconsistent file is an InputError naming `name`.
 Strands decodeHair(const uint8_t* data, size_t size, const std::string& name, HairHeader* header = nullptr);
 
+// A file without the chunk block was made elsewhere: its provenance says its units and up axis are
+// unknown, and its info text is the source's description.
 Strands readHair(const std::filesystem::path& file, HairHeader* header = nullptr);
 void writeHair(const std::filesystem::path& file, const Strands& strands);  // atomic
+
+// Provenance as the PROV chunk's "key=value\n" lines (PLY comments carry the same lines), and back.
+// Keys: producer, stage, seed, config; for a file made elsewhere also source, sourceInfo, conversion,
+// units=unknown, up=unknown (written only when set). Unknown keys are ignored.
+std::string provenanceText(const Provenance& provenance);
+Provenance parseProvenance(const std::string& text, const std::string& name);
 
 }  // namespace hairgen

@@ -152,7 +152,7 @@ void writeComparisonSheet(const std::filesystem::path& file, const Image& a, con
     sheet.channels.push_back(channel);
     sheet.planes.push_back(std::move(row));
   }
-  writePreview(file, sheet);
+  writePreview(file, sheet, glm::dvec3(0.0));  // differences and images as they are, over black
 }
 
 }  // namespace hairgen

@@ -3,10 +3,13 @@
 #include <cmath>
 #include <sstream>
 
+#include "libcore/io/exr_io.h"
 #include "libcore/io/gltf_io.h"
 #include "libcore/io/hair_cache.h"
 #include "libcore/io/hair_io.h"
 #include "libcore/io/obj_io.h"
+#include "libcore/io/ply_io.h"
+#include "libcore/io/usd_io.h"
 #include "libcore/util/error.h"
 #include "libcore/util/json.h"
 #include "libcore/util/text.h"
@@ -17,6 +20,22 @@ namespace {
 nlohmann::ordered_json boundsJson(const std::vector<glm::vec3>& points) {
   Bounds b = bounds(points);
   return {{"min", {b.min.x, b.min.y, b.min.z}}, {"max", {b.max.x, b.max.y, b.max.z}}};
+}
+
+nlohmann::ordered_json describeUsda(const std::filesystem::path& file) {
+  nlohmann::ordered_json j;
+  j["layer"] = nlohmann::ordered_json::object();
+  for (const auto& [key, value] : readUsdaSummary(file)) {
+    if (key == "strands" || key == "points") {
+      std::optional<uint64_t> count = parseUInt(value);
+      if (!count) throw InputError({file.string(), 0}, "the layer's " + key + " is not a count: " + value);
+      j[key] = *count;
+    } else if (key == "producer")
+      j[key] = value;
+    else
+      j["layer"][key] = value;
+  }
+  return j;
 }
 
 nlohmann::ordered_json describeStrands(const Strands& s) {
@@ -53,14 +72,17 @@ nlohmann::ordered_json describeStrands(const Strands& s) {
   j["defaults"] = {{"thickness", s.defaultThickness},
                    {"transparency", s.defaultTransparency},
                    {"color", {s.defaultColor.x, s.defaultColor.y, s.defaultColor.z}}};
-  if (!s.provenance.empty())
-    j["provenance"] = {{"producer", s.provenance.producer},
-                       {"stage", s.provenance.stage},
-                       {"seed", s.provenance.seed},
-                       {"configDigest", s.provenance.configDigest}};
-  if (s.provenance.frame) {
-    j["provenance"]["frame"] = *s.provenance.frame;
-    j["provenance"]["time"] = s.provenance.time;
+  const Provenance& p = s.provenance;
+  j["provenance"] = {
+      {"producer", p.producer}, {"stage", p.stage}, {"seed", p.seed}, {"configDigest", p.configDigest}};
+  if (!p.source.empty()) j["provenance"]["source"] = p.source;
+  if (!p.sourceInfo.empty()) j["provenance"]["sourceInfo"] = p.sourceInfo;
+  if (!p.conversion.empty()) j["provenance"]["conversion"] = p.conversion;
+  j["units"] = p.metres ? "metres" : "unknown";
+  j["upAxis"] = p.yUp ? "+y" : "unknown";
+  if (p.frame) {
+    j["provenance"]["frame"] = *p.frame;
+    j["provenance"]["time"] = p.time;
   }
   if (!s.simulationState.empty()) j["restartState"] = s.simulationState.size() / 4;
   return j;
@@ -94,20 +116,49 @@ nlohmann::ordered_json describeFile(const std::filesystem::path& file) {
     j["unreferencedVerticesDropped"] = stats.unreferencedDropped;
     return j;
   }
-  HairFormat format = hairFormatOf(file);
-  if (format == HairFormat::kHair) {
-    HairHeader header;
-    Strands s = readHair(file, &header);
-    j["format"] = "hair";
-    j.update(describeStrands(s));
-    j["cyHair"] = {
-        {"flags", header.flags}, {"defaultSegments", header.defaultSegments}, {"info", header.info}};
-    j["chunks"] = header.chunks;
+  if (ext == ".exr") {
+    const ImageHeader header = readImageHeader(file);
+    j["format"] = "exr";
+    j["width"] = header.width;
+    j["height"] = header.height;
+    j["channels"] = nlohmann::ordered_json::array();
+    for (const auto& [name, type] : header.channels)
+      j["channels"].push_back({{"name", name}, {"type", type}});
+    j["metadata"] = nlohmann::ordered_json::object();
+    for (const auto& [name, value] : header.attributes) j["metadata"][name] = value;
     return j;
   }
-  Strands s = readGltf(file);
-  j["format"] = format == HairFormat::kGlb ? "glb" : "gltf";
+  const HairFormat format = hairFormatOf(file);
+  Strands s;
+  nlohmann::ordered_json details = nlohmann::ordered_json::object();
+  switch (format) {
+    case HairFormat::kHair: {
+      HairHeader header;
+      s = readHair(file, &header);
+      details["cyHair"] = {
+          {"flags", header.flags}, {"defaultSegments", header.defaultSegments}, {"info", header.info}};
+      details["chunks"] = header.chunks;
+      break;
+    }
+    case HairFormat::kPly: {
+      PlyHeader header;
+      s = readPly(file, &header);
+      details["ply"] = {
+          {"format", header.format}, {"elements", header.elements}, {"strandsFrom", header.strandsFrom}};
+      break;
+    }
+    case HairFormat::kUsda:
+      j["format"] = "usda";
+      j.update(describeUsda(file));
+      return j;
+    default:
+      s = readStrands(file);
+  }
+  noteSource(s, file);
+  static const char* kNames[] = {"hair", "gltf", "glb", "ply", "data", "usda"};
+  j["format"] = kNames[static_cast<int>(format)];
   j.update(describeStrands(s));
+  j.update(details);
   return j;
 }
 
@@ -126,6 +177,22 @@ std::string formatDescription(const nlohmann::ordered_json& j) {
            num(b["max"][0]) + ", " + num(b["max"][1]) + ", " + num(b["max"][2]) + ")";
   };
   out << j["file"].get<std::string>() << ": " << j["format"].get<std::string>() << "\n";
+  if (j["format"] == "exr") {
+    out << "  " << j["width"] << "x" << j["height"] << ", " << j["channels"].size() << " channels:";
+    for (const auto& c : j["channels"])
+      out << " " << c["name"].get<std::string>() << " (" << c["type"].get<std::string>() << ")";
+    out << "\n";
+    for (const auto& [key, value] : j["metadata"].items())
+      out << "  " << key << ": " << value.get<std::string>() << "\n";
+    return out.str();
+  }
+  if (j["format"] == "usda") {
+    out << "  USD layer written by " << j["producer"].get<std::string>() << ": " << j["strands"]
+        << " curves, " << j["points"] << " points\n";
+    for (const auto& [key, value] : j["layer"].items())
+      out << "  " << key << ": " << value.get<std::string>() << "\n";
+    return out.str();
+  }
   if (j["format"] == "obj") {
     out << "  " << j["vertices"] << " vertices, " << j["triangles"] << " triangles, area "
         << num(j["area_cm2"]) << " cm² (" << num(j["area_m2"]) << " m²), mean edge "
@@ -148,12 +215,27 @@ std::string formatDescription(const nlohmann::ordered_json& j) {
   if (j.contains("cyHair"))
     out << "  cyHair flags " << j["cyHair"]["flags"] << ", default segments "
         << j["cyHair"]["defaultSegments"] << ", info \"" << j["cyHair"]["info"].get<std::string>() << "\"\n";
-  if (j.contains("provenance"))
-    out << "  made by " << j["provenance"]["producer"].get<std::string>() << " ("
-        << j["provenance"]["stage"].get<std::string>() << "), seed " << j["provenance"]["seed"] << ", config "
-        << j["provenance"]["configDigest"].get<std::string>() << "\n";
-  if (j.contains("provenance") && j["provenance"].contains("frame"))
-    out << "  frame " << j["provenance"]["frame"] << " at " << j["provenance"]["time"].get<double>() << " s"
+  if (j.contains("ply"))
+    out << "  PLY " << j["ply"]["format"].get<std::string>() << ", strands from "
+        << j["ply"]["strandsFrom"].get<std::string>() << "\n";
+  const nlohmann::ordered_json& p = j["provenance"];
+  auto text = [&](const char* key) { return p.contains(key) ? p[key].get<std::string>() : std::string(); };
+  const std::string producer = text("producer"), source = text("source");
+  if (!producer.empty() && p["stage"] == "convert" && !source.empty())
+    out << "  converted from " << source << " by " << producer << "\n";
+  else if (!producer.empty())
+    out << "  made by " << producer << " (" << text("stage") << "), seed " << p["seed"] << ", config "
+        << text("configDigest") << (source.empty() ? "" : ", from " + source) << "\n";
+  else
+    out << "  made elsewhere, not by hairgen\n";
+  if (!text("sourceInfo").empty()) out << "  the source says: \"" << text("sourceInfo") << "\"\n";
+  if (!text("conversion").empty()) out << "  converted with " << text("conversion") << "\n";
+  const bool metres = j["units"] == "metres", yUp = j["upAxis"] == "+y";
+  out << "  units: " << (metres ? "metres" : "unknown (the file's own)") << ", "
+      << (yUp ? "+y up" : "up axis unknown")
+      << (metres && yUp ? "" : "; convert with --units and --up-axis to bring it to metres, +y up") << "\n";
+  if (p.contains("frame"))
+    out << "  frame " << p["frame"] << " at " << p["time"].get<double>() << " s"
         << (j.contains("restartState") ? ", with the state a restart needs" : "") << "\n";
   return out.str();
 }

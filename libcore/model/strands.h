@@ -19,8 +19,17 @@ struct Provenance {
   std::string configDigest;  // hex digest of the effective configuration, or ""
   std::optional<int> frame;  // the frame of a sequence this cache is (DESIGN §8); none for a still
   double time = 0.0;         // seconds from the sequence's first frame, when `frame` is set
+  // A file made elsewhere: what it was, what it said of itself and what hairgen did to it.
+  std::string source;  // the name of the file this was read or converted from, when hairgen did not write it
+  std::string sourceInfo;  // what that file said of itself, one line (cyHair info text, PLY comments, ...)
+  std::string conversion;  // what hairgen applied ("units mm (x0.001); up axis z turned to +y"), or ""
+  bool metres = true;      // positions and widths are metres; false: the file's own, unknown units
+  bool yUp = true;         // +y is up; false: the file's own, unknown axis
 
-  bool empty() const { return producer.empty() && stage.empty() && configDigest.empty() && seed == 0; }
+  bool empty() const {
+    return producer.empty() && stage.empty() && configDigest.empty() && seed == 0 && source.empty() &&
+           sourceInfo.empty() && conversion.empty() && metres && yUp;
+  }
   bool operator==(const Provenance&) const = default;
 };
 

@@ -171,7 +171,8 @@ ShadedImage shadingPass(const Scene& scene, const LightDepth& depth, const Textu
   ShadedImage image{Texture(GL_RGBA16F, w, h), Texture(GL_RGBA32F, w, h)};
   Framebuffer fb({&image.color, &image.data}, w, h, true);
   fb.bind();
-  const float background[4] = {float(r.background.x), float(r.background.y), float(r.background.z), 0.0f};
+  // Premultiplied: what nothing covers is 0 in every channel; the background belongs to the preview.
+  const float background[4] = {0.0f, 0.0f, 0.0f, 0.0f};
   const float nothing[4] = {kBackgroundZ, 0.0f, 1.0f, 0.0f};
   const float one = 1.0f;
   glClearBufferfv(GL_COLOR, 0, background);
@@ -232,7 +233,7 @@ void readBack(const ShadedImage& image, const LightDepth* depth, const Texture* 
   Image& b = out.beauty;
   b.width = image.color.width;
   b.height = image.color.height;
-  b.channels = {"R", "G", "B", "A", "Z", "opacity", "shadow"};
+  b.channels = {"R", "G", "B", "A", "Z", kChannelOpacity, kChannelShadow};
   b.planes.resize(b.channels.size());
   readPlanes(image.color, {&b.planes[0], &b.planes[1], &b.planes[2], &b.planes[3]});
   readPlanes(image.data, {&b.planes[4], &b.planes[5], &b.planes[6]});

@@ -51,7 +51,7 @@ struct LightDepth {
 
 // An image the shading pass draws and the resolve averages.
 struct ShadedImage {
-  Texture color;  // R G B over the background, A coverage
+  Texture color;  // R G B of what was drawn (0 where nothing was), A unused (the resolve counts coverage)
   Texture data;   // Z (metres along the camera's axis), hair opacity, shadow (the light arriving)
 };
 

@@ -15,20 +15,25 @@
 #include "libcore/model/mesh.h"
 #include "libcore/model/strands.h"
 #include "libcore/render/custom_shaders.h"
+#include "libcore/render/shader_interface.h"
 
 namespace hairgen {
 
 class GlContext;
 
-// Camera depth (Z) of a pixel where nothing was drawn, metres.
-inline constexpr float kBackgroundZ = 1.0e10f;
+// The beauty image's channels (DESIGN §6): R G B A premultiplied (a pixel nothing covers is 0 in all
+// four; A is the fraction of its sub-pixels the hair or the head covers), Z, and the AOVs as layers a
+// compositor sorts, each a single grey channel: OpenEXR names a layer's channels LAYER.CHANNEL and a
+// grey channel Y, so Nuke shows them as the layers opacity and shadow.
+inline constexpr const char* kChannelOpacity = "opacity.Y";  // hair coverage, 0-1
+inline constexpr const char* kChannelShadow = "shadow.Y";    // the light that arrives, 1 in the open
 
 struct RenderTimings {
   double upload = 0.0, lightDepth = 0.0, opacity = 0.0, shading = 0.0, readback = 0.0;  // seconds
 };
 
 struct RenderOutput {
-  Image beauty;  // R G B A (A: coverage of hair and head), Z, opacity (hair coverage), shadow
+  Image beauty;  // R G B A (premultiplied), Z, kChannelOpacity, kChannelShadow
   Image dom;     // the light's view: Z (distance along the light's axis where hair begins), layer1-4
   glm::dmat4 worldToCamera{1.0}, worldToNdc{1.0};
   glm::dmat4 worldToLight{1.0};

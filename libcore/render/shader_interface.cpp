@@ -67,6 +67,7 @@ std::string glslConstants() {
   out += "const float kShadowFloor = " + glslFloat(kShadowFloor) + ";\n";
   out += "const float kShadowOffsetHead = " + glslFloat(kShadowOffsetHead) + ";\n";
   out += "const float kShadowBiasHeadDepth = " + glslFloat(kShadowBiasHeadDepth) + ";\n";
+  out += "const float kBackgroundZ = " + glslFloat(kBackgroundZ) + ";\n";
   return out;
 }
 

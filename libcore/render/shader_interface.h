@@ -33,6 +33,10 @@ inline constexpr float kShadowOffsetHead = 0.002f;
 // the scalp and the roots on it are not cut off by the map's resolution.
 inline constexpr float kShadowBiasHeadDepth = 0.003f;
 
+// Camera depth (Z) of a pixel where nothing was drawn, metres; the resolve counts a sub-pixel as covered
+// where its Z is nearer.
+inline constexpr float kBackgroundZ = 1.0e10f;
+
 // The light that still arrives behind opaque hair or the head: the thesis maps opacity [0, 1] to a
 // shadow factor [1, 0.25], so nothing in shadow is ever black.
 inline constexpr float kShadowFloor = 0.25f;

@@ -1,4 +1,6 @@
-// Box-filters each k×k block of sub-pixels: color, hair opacity and shadow averaged, Z the nearest.
+// Box-filters each k×k block of sub-pixels: color, hair opacity and shadow averaged, Z the nearest, and
+// A the fraction of sub-pixels something was drawn in (its Z nearer than kBackgroundZ), so R G B A are
+// premultiplied: R G B + (1 − A) × background is the picture over a background.
 layout(binding = kUnitSubpixelColor) uniform sampler2D uColor;
 layout(binding = kUnitSubpixelData) uniform sampler2D uData;
 uniform int uBlock;  // k: sub-pixels per pixel side
@@ -6,17 +8,18 @@ layout(location = 0) out vec4 oColor;
 layout(location = 1) out vec4 oData;
 void main() {
   ivec2 p = ivec2(gl_FragCoord.xy) * uBlock;
-  vec4 color = vec4(0.0);
-  float z = 3.0e38, opacity = 0.0, shadow = 0.0;
+  vec3 color = vec3(0.0);
+  float z = 3.0e38, covered = 0.0, opacity = 0.0, shadow = 0.0;
   for (int y = 0; y < uBlock; ++y)
     for (int x = 0; x < uBlock; ++x) {
-      color += texelFetch(uColor, p + ivec2(x, y), 0);
+      color += texelFetch(uColor, p + ivec2(x, y), 0).rgb;
       vec4 data = texelFetch(uData, p + ivec2(x, y), 0);
       z = min(z, data.x);
+      covered += data.x < kBackgroundZ ? 1.0 : 0.0;
       opacity += data.y;
       shadow += data.z;
     }
   float n = float(uBlock * uBlock);
-  oColor = color / n;
+  oColor = vec4(color / n, covered / n);
   oData = vec4(z, opacity / n, shadow / n, 0.0);
 }
