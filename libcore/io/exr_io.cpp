@@ -1,5 +1,6 @@
 #include "libcore/io/exr_io.h"
 
+#include <algorithm>
 #include <cmath>
 
 #include <ImathMatrix.h>
@@ -49,7 +50,9 @@ std::string imageFormatOf(const fs::path& file) {
 
 // Refuses a declared image hairgen does not read or that cannot fit in memory. The header is the
 // attacker's: a 12 kB file can declare a 7 GB image, so this runs before anything is allocated.
-void checkDeclaredSize(const FileLoc& where, int64_t width, int64_t height, int64_t channels) {
+// `chunkRows`: the reader decodes whole chunks of that many scanlines, so a shorter image costs a chunk.
+void checkDeclaredSize(const FileLoc& where, int64_t width, int64_t height, int64_t channels,
+                       int64_t chunkRows = 1) {
   const std::string pixels = std::to_string(width) + "x" + std::to_string(height) + " pixels";
   if (width <= 0 || height <= 0 || channels <= 0)
     throw InputError(where, "declares an image of " + pixels + " and " + std::to_string(channels) +
@@ -59,18 +62,21 @@ void checkDeclaredSize(const FileLoc& where, int64_t width, int64_t height, int6
                                 " channels; hairgen reads at most " + std::to_string(kMaxImageSide) +
                                 " pixels a side and " + std::to_string(kMaxImageChannels) + " channels");
   // Read interleaved, then split into planes: twice the float image at the peak.
-  const uint64_t bytes = 2ull * uint64_t(width) * uint64_t(height) * uint64_t(channels) * 4ull;
+  const int64_t rows = std::max(height, chunkRows);
+  const uint64_t bytes = 2ull * uint64_t(width) * uint64_t(rows) * uint64_t(channels) * 4ull;
   if (bytes > memoryBudget())
-    throw InputError(where, "declares " + pixels + " of " + std::to_string(channels) + " channels, " +
-                                formatBytes(bytes) + " to read, more than the " +
-                                formatBytes(memoryBudget()) + " this machine has free");
+    throw InputError(
+        where, "declares " + pixels + " of " + std::to_string(channels) + " channels, " + formatBytes(bytes) +
+                   " to read" +
+                   (rows > height ? " in chunks of " + std::to_string(rows) + " scanlines" : "") +
+                   ", more than the " + formatBytes(memoryBudget()) + " this machine has free");
 }
 
 // OpenEXR 3.1's C++ reader, which OpenImageIO uses, allocates what a header declares before it reads
-// it: a 300-byte file made it zero 1.9 GB for one string attribute, and a wide data window sizes its
-// line buffers when the file is opened (found by tests/fuzz/fuzz_exr). OpenEXRCore's parser checks
-// every size against the file, so it reads an EXR's header first, and each part's declared size is
-// checked, before OpenImageIO opens the file.
+// it: a 300-byte file made it zero 1.9 GB for one string attribute, and a 6-million-pixel-wide data
+// window made it allocate 1.9 GB of line buffers when the file was opened (found by tests/fuzz/fuzz_exr).
+// OpenEXRCore's parser checks every size against the file, so it reads an EXR's header first, and each
+// part's declared size, chunks of scanlines included, is checked before OpenImageIO opens the file.
 void checkExrHeader(const fs::path& file, const FileLoc& where) {
   std::string message;
   exr_context_initializer_t init = EXR_DEFAULT_CONTEXT_INITIALIZER;
@@ -100,8 +106,14 @@ void checkExrHeader(const fs::path& file, const FileLoc& where) {
       throw refuse(r);
     if (const exr_result_t r = exr_get_channels(context, part, &channels); r != EXR_ERR_SUCCESS)
       throw refuse(r);
+    exr_storage_t storage{};
+    int32_t chunkRows = 1;  // up to 256 (DWAB); a tiled part decodes tiles
+    if (exr_get_storage(context, part, &storage) == EXR_ERR_SUCCESS && storage == EXR_STORAGE_SCANLINE &&
+        exr_get_scanlines_per_chunk(context, part, &chunkRows) != EXR_ERR_SUCCESS)
+      chunkRows = 1;
     checkDeclaredSize(where, int64_t(window.max.x) - window.min.x + 1,
-                      int64_t(window.max.y) - window.min.y + 1, channels ? channels->num_channels : 0);
+                      int64_t(window.max.y) - window.min.y + 1, channels ? channels->num_channels : 0,
+                      chunkRows);
   }
 }
 
