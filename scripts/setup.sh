@@ -12,6 +12,7 @@ packages=(
   libopenvdb-dev libopenvdb-tools libboost-dev  # OpenVDB's headers include Boost's; its package does not pull them
   libegl-dev libgl-dev libopengl-dev libegl1 libopengl0 libegl-mesa0 libgl1-mesa-dri libgbm1
   libgtest-dev libgmock-dev libbenchmark-dev
+  clang libclang-rt-14-dev llvm  # the fuzz build (scripts/fuzz.sh): libFuzzer, ASan, UBSan, llvm-symbolizer
 )
 # Node.js with npm runs the glTF validator; the image may ship its own Node (then Debian's npm conflicts).
 command -v npm >/dev/null 2>&1 || packages+=(nodejs npm)

@@ -190,6 +190,14 @@ render_diff)
   # Moving the light changes the shading, not the geometry.
   expect_rc 0 "$hairgen" diff "$tmp/a.exr" "$tmp/b.exr" --channels Z,opacity.Y
   expect_rc 2 "$hairgen" diff "$tmp/a.exr" "$tmp/missing.exr"
+  # An image is read by the reader its extension names (in any case), and by no other.
+  cp "$tmp/a.exr" "$tmp/A.EXR" && cp "$tmp/a.exr" "$tmp/mislabelled.png"
+  expect_rc 0 "$hairgen" diff "$tmp/A.EXR" "$tmp/a.exr"
+  expect_rc 0 "$hairgen" diff "$tmp/a.png" "$tmp/a.png"
+  expect_rc 2 "$hairgen" diff "$tmp/mislabelled.png" "$tmp/a.exr"
+  # An EXR header's sizes are checked against the file before OpenEXR allocates what they declare.
+  expect_rc 2 "$hairgen" diff "$src/tests/fuzz/corpus/fuzz_exr/string-attribute-declares-1.9GB.exr" "$tmp/a.exr"
+  grep -q "not a readable OpenEXR file: .*Invalid size" "$tmp/err" || fail "bad EXR header: $(cat "$tmp/err")"
   ;;
 run_default)
   # With no Setup, run finds configs/default beside an installed executable, or through HAIRGEN_DATA.

@@ -1,6 +1,10 @@
 // glTF caches: round trips through .glb and .gltf, and files hairgen must refuse.
 #include <gtest/gtest.h>
 
+#include <cstring>
+
+#include <nlohmann/json.hpp>
+
 #include "libcore/io/gltf_io.h"
 #include "libcore/io/hair_io.h"
 #include "libcore/util/error.h"
@@ -74,6 +78,26 @@ TEST(Gltf, GarbageIsAnInputError) {
   std::vector<uint8_t> glb = encodeGltf(test::sampleStrands(2), true);
   glb.resize(glb.size() / 2);
   EXPECT_THROW(decodeGltf(glb.data(), glb.size(), "half.glb"), InputError);
+}
+
+TEST(Gltf, AnExternalBufferBesideAFileNamedWithoutAFolderIsRead) {
+  // x.gltf names its buffer x.bin; read as "x.gltf" from its own folder, its folder is ".", not none.
+  const std::vector<uint8_t> glb = encodeGltf(test::sampleStrands(3), true);
+  uint32_t jsonLength, binLength;
+  std::memcpy(&jsonLength, glb.data() + 12, 4);
+  std::memcpy(&binLength, glb.data() + 20 + jsonLength, 4);
+  nlohmann::json json = nlohmann::json::parse(glb.begin() + 20, glb.begin() + 20 + jsonLength);
+  json["buffers"][0]["uri"] = "x.bin";
+  test::TempDir dir("gltf-external");
+  writeFileAtomic(dir / "x.gltf", json.dump());
+  const uint8_t* bin = glb.data() + 28 + jsonLength;
+  writeFileAtomic(dir / "x.bin", bin, binLength);
+  const std::filesystem::path before = std::filesystem::current_path();
+  std::filesystem::current_path(dir.path());
+  Strands read;
+  EXPECT_NO_THROW(read = readGltf("x.gltf"));
+  std::filesystem::current_path(before);
+  EXPECT_EQ(read.points, test::sampleStrands(3).points);
 }
 
 TEST(Gltf, EmptyStrandsCannotBeWritten) {

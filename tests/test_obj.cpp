@@ -78,6 +78,19 @@ TEST(Obj, BadNumbersAndIndicesNameTheLine) {
   EXPECT_EQ(message("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1//2 2 3\n").rfind("bad.obj:4:", 0), 0u);
 }
 
+TEST(Obj, StatementsHairgenDoesNotReadChangeNothing) {
+  // Objects, groups, materials, lines, skin weights and tags never reach tinyobjloader, whose parser
+  // converted this 'vw' joint id of 7.8e32 to int (undefined behaviour; tests/fuzz found it).
+  const Mesh plain = parseObj("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n", "plain.obj");
+  const Mesh extra = parseObj(
+      "mtllib m.mtl\no head\ng scalp\nusemtl skin\ns 1\nv 0 0 0\nv 1 0 0\nv 0 1 0\nl 1 2\n"
+      "vw 0 777777777777777777777777777777777 1\nt crease 2/1/0 1 2 3.5\nf 1 2 3\n",
+      "extra.obj");
+  EXPECT_EQ(extra.positions, plain.positions);
+  EXPECT_EQ(extra.normals, plain.normals);
+  EXPECT_EQ(extra.triangles, plain.triangles);
+}
+
 TEST(Obj, NegativeIndicesCountBack) {
   Mesh m = parseObj("v 0 0 0\nv 1 0 0\nv 0 1 0\nf -3 -2 -1\n", "neg.obj");
   EXPECT_EQ(m.triangleCount(), 1u);

@@ -1,5 +1,6 @@
 #include "libcore/io/exr_io.h"
 
+#include <algorithm>
 #include <cmath>
 
 #include <ImathMatrix.h>
@@ -12,6 +13,7 @@
 #include <OpenEXR/ImfStandardAttributes.h>
 #include <OpenEXR/ImfStringAttribute.h>
 #include <OpenEXR/ImfVecAttribute.h>
+#include <OpenEXR/openexr.h>
 #include <OpenImageIO/imageio.h>
 #include <half.h>
 
@@ -37,6 +39,85 @@ Imath::M44f toImath(const glm::dmat4& m) {
 // cannot make the reader allocate without bound.
 constexpr int kMaxImageSide = 65536;
 constexpr int kMaxImageChannels = 1024;
+
+// The OpenImageIO format whose extensions include `file`'s (case-insensitively), or "" when none does.
+std::string imageFormatOf(const fs::path& file) {
+  const std::string extension = toLower(file.extension().string());
+  if (extension.size() < 2) return {};
+  for (const auto& [format, extensions] : OIIO::get_extension_map())
+    for (const std::string& e : extensions)
+      if ("." + e == extension) return format;
+  return {};
+}
+
+// Refuses a declared image hairgen does not read or that cannot fit in memory. The header is the
+// attacker's: a 12 kB file can declare a 7 GB image, so this runs before anything is allocated.
+// `chunkRows`: the reader decodes whole chunks of that many scanlines, so a shorter image costs a chunk.
+void checkDeclaredSize(const FileLoc& where, int64_t width, int64_t height, int64_t channels,
+                       int64_t chunkRows = 1) {
+  const std::string pixels = std::to_string(width) + "x" + std::to_string(height) + " pixels";
+  if (width <= 0 || height <= 0 || channels <= 0)
+    throw InputError(where, "declares an image of " + pixels + " and " + std::to_string(channels) +
+                                " channels; expected a 2D image");
+  if (width > kMaxImageSide || height > kMaxImageSide || channels > kMaxImageChannels)
+    throw InputError(where, "declares " + pixels + " and " + std::to_string(channels) +
+                                " channels; hairgen reads at most " + std::to_string(kMaxImageSide) +
+                                " pixels a side and " + std::to_string(kMaxImageChannels) + " channels");
+  // Read interleaved, then split into planes: twice the float image at the peak.
+  const int64_t rows = std::max(height, chunkRows);
+  const uint64_t bytes = 2ull * uint64_t(width) * uint64_t(rows) * uint64_t(channels) * 4ull;
+  if (bytes > memoryBudget())
+    throw InputError(
+        where, "declares " + pixels + " of " + std::to_string(channels) + " channels, " + formatBytes(bytes) +
+                   " to read" +
+                   (rows > height ? " in chunks of " + std::to_string(rows) + " scanlines" : "") +
+                   ", more than the " + formatBytes(memoryBudget()) + " this machine has free");
+}
+
+// OpenEXR 3.1's C++ reader, which OpenImageIO uses, allocates what a header declares before it reads
+// it: a 300-byte file made it zero 1.9 GB for one string attribute, and a 6-million-pixel-wide data
+// window made it allocate 1.9 GB of line buffers when the file was opened (found by tests/fuzz/fuzz_exr).
+// OpenEXRCore's parser checks every size against the file, so it reads an EXR's header first, and each
+// part's declared size, chunks of scanlines included, is checked before OpenImageIO opens the file.
+void checkExrHeader(const fs::path& file, const FileLoc& where) {
+  std::string message;
+  exr_context_initializer_t init = EXR_DEFAULT_CONTEXT_INITIALIZER;
+  init.flags = EXR_CONTEXT_FLAG_STRICT_HEADER;  // else a bad attribute's size is reported, then skipped
+  init.user_data = &message;
+  init.error_handler_fn = [](exr_const_context_t context, exr_result_t, const char* text) {
+    void* user = nullptr;  // the library prints nothing: the message goes into the error
+    if (exr_get_user_data(context, &user) == EXR_ERR_SUCCESS && user) *static_cast<std::string*>(user) = text;
+  };
+  exr_context_t context = nullptr;
+  const exr_result_t started = exr_start_read(&context, file.c_str(), &init);
+  struct Finish {
+    exr_context_t& context;
+    ~Finish() { exr_finish(&context); }
+  } finish{context};
+  auto refuse = [&](exr_result_t result) {
+    return InputError(where, "not a readable OpenEXR file: " +
+                                 oneLine(message.empty() ? exr_get_default_error_message(result) : message));
+  };
+  if (started != EXR_ERR_SUCCESS) throw refuse(started);
+  int parts = 0;
+  if (const exr_result_t r = exr_get_count(context, &parts); r != EXR_ERR_SUCCESS) throw refuse(r);
+  for (int part = 0; part < parts; ++part) {
+    exr_attr_box2i_t window{};
+    const exr_attr_chlist_t* channels = nullptr;
+    if (const exr_result_t r = exr_get_data_window(context, part, &window); r != EXR_ERR_SUCCESS)
+      throw refuse(r);
+    if (const exr_result_t r = exr_get_channels(context, part, &channels); r != EXR_ERR_SUCCESS)
+      throw refuse(r);
+    exr_storage_t storage{};
+    int32_t chunkRows = 1;  // up to 256 (DWAB); a tiled part decodes tiles
+    if (exr_get_storage(context, part, &storage) == EXR_ERR_SUCCESS && storage == EXR_STORAGE_SCANLINE &&
+        exr_get_scanlines_per_chunk(context, part, &chunkRows) != EXR_ERR_SUCCESS)
+      chunkRows = 1;
+    checkDeclaredSize(where, int64_t(window.max.x) - window.min.x + 1,
+                      int64_t(window.max.y) - window.min.y + 1, channels ? channels->num_channels : 0,
+                      chunkRows);
+  }
+}
 
 bool isHalf(const std::string& c) {
   return c == "R" || c == "G" || c == "B" || c == "A";
@@ -84,35 +165,30 @@ void writeExr(const fs::path& file, const Image& image, const ExrMetadata& metad
 
 Image readImage(const fs::path& file) {
   requireRegularFile(file);
-  auto in = OIIO::ImageInput::open(file.string());
-  if (!in) throw InputError({file.string(), 0}, "cannot read image: " + OIIO::geterror());
-  const OIIO::ImageSpec& spec = in->spec();
-  // The header is the attacker's: a 12 kB file can declare a 7 GB image. Size it before allocating.
   const FileLoc where{file.string(), 0};
-  if (spec.width <= 0 || spec.height <= 0 || spec.nchannels <= 0 || spec.depth > 1)
-    throw InputError(where, "declares an image of " + std::to_string(spec.width) + "x" +
-                                std::to_string(spec.height) + " pixels and " +
-                                std::to_string(spec.nchannels) + " channels; expected a 2D image");
-  if (spec.width > kMaxImageSide || spec.height > kMaxImageSide || spec.nchannels > kMaxImageChannels)
-    throw InputError(where, "declares " + std::to_string(spec.width) + "x" + std::to_string(spec.height) +
-                                " pixels and " + std::to_string(spec.nchannels) +
-                                " channels; hairgen reads at most " + std::to_string(kMaxImageSide) +
-                                " pixels a side and " + std::to_string(kMaxImageChannels) + " channels");
-  // Read interleaved, then split into planes: twice the float image at the peak.
-  const uint64_t bytes =
-      2ull * uint64_t(spec.width) * uint64_t(spec.height) * uint64_t(spec.nchannels) * 4ull;
-  if (bytes > memoryBudget())
-    throw InputError(where, "declares " + std::to_string(spec.width) + "x" + std::to_string(spec.height) +
-                                " pixels of " + std::to_string(spec.nchannels) + " channels, " +
-                                formatBytes(bytes) + " to read, more than the " +
-                                formatBytes(memoryBudget()) + " this machine has free");
+  // Only the reader the extension names reads the file. OpenImageIO's open() would otherwise hand a
+  // file its own reader refused to every reader it has (DICOM, FFmpeg, camera RAW, ...): a 1.6 kB
+  // mangled .exr then cost gigabytes (found by tests/fuzz/fuzz_exr).
+  const std::string format = imageFormatOf(file);
+  if (format.empty())
+    throw InputError(where, "no image format has the extension '" + file.extension().string() +
+                                "'; name an image by its format (.exr, .png, .tif, ...)");
+  if (format == "openexr") checkExrHeader(file, where);
+  auto in = OIIO::ImageInput::create(format);
+  if (!in) throw InputError(where, "cannot read image: " + OIIO::geterror());
+  OIIO::ImageSpec spec;
+  if (!in->open(file.string(), spec)) throw InputError(where, "cannot read image: " + in->geterror());
+  if (spec.depth > 1)
+    throw InputError(where,
+                     "declares a volume " + std::to_string(spec.depth) + " pixels deep; expected a 2D image");
+  checkDeclaredSize(where, spec.width, spec.height, spec.nchannels);
   Image image;
   image.width = spec.width;
   image.height = spec.height;
   const size_t pixels = size_t(spec.width) * spec.height;
   std::vector<float> interleaved(pixels * spec.nchannels);
   if (!in->read_image(0, 0, 0, spec.nchannels, OIIO::TypeDesc::FLOAT, interleaved.data()))
-    throw InputError({file.string(), 0}, "cannot read image: " + in->geterror());
+    throw InputError(where, "cannot read image: " + in->geterror());
   for (int c = 0; c < spec.nchannels; ++c) {
     image.channels.push_back(spec.channelnames[c]);
     std::vector<float> plane(pixels);

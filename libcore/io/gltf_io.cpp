@@ -606,7 +606,9 @@ Strands decodeGltf(const uint8_t* data, size_t size, const std::string& name,
 
 Strands readGltf(const std::filesystem::path& file) {
   std::vector<uint8_t> bytes = readFileBytes(file);
-  return decodeGltf(bytes.data(), bytes.size(), file.string(), file.parent_path());
+  // "x.gltf" lies in the working directory: its folder is ".", where an empty one would mean none.
+  const std::filesystem::path folder = file.has_parent_path() ? file.parent_path() : ".";
+  return decodeGltf(bytes.data(), bytes.size(), file.string(), folder);
 }
 
 void writeGltf(const std::filesystem::path& file, const Strands& strands, bool binary) {

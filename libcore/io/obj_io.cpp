@@ -1,5 +1,6 @@
 // OBJ reading on top of tinyobjloader. tinyobjloader parses leniently (a malformed number becomes 0),
-// so a validating pass runs first and names the file:line of anything hairgen would misread.
+// so a validating pass runs first and names the file:line of anything hairgen would misread; only the
+// statements it checked reach tinyobjloader.
 #include "libcore/io/obj_io.h"
 
 #include <cmath>
@@ -53,7 +54,12 @@ void checkCorner(std::string_view corner, const FileLoc& where, const size_t cou
   }
 }
 
-void validate(std::string_view text, const std::string& name) {
+// Checks every statement hairgen reads (v, vt, vn, f) and returns them, one a line, for tinyobjloader.
+// The rest (objects, groups, materials, lines, skin weights, tags) hairgen does not use, and
+// tinyobjloader's parsers of them are lenient to the point of undefined behaviour: a 'vw' joint id of
+// 7e32 was converted to int (found by tests/fuzz/fuzz_obj).
+std::string validate(std::string_view text, const std::string& name) {
+  std::string checked;
   size_t counts[3] = {0, 0, 0};  // v, vt, vn
   forEachLine(text, [&](std::string_view line, int lineNumber) {
     FileLoc where{name, lineNumber};
@@ -92,22 +98,27 @@ void validate(std::string_view text, const std::string& name) {
     } else if (tag == "f") {
       if (words.size() < 4) throw InputError(where, "a face needs at least three corners");
       for (size_t i = 1; i < words.size(); ++i) checkCorner(words[i], where, counts);
+    } else {
+      return;
     }
+    checked.append(line);
+    checked += '\n';
   });
+  return checked;
 }
 
 }  // namespace
 
 Mesh parseObj(std::string_view text, const std::string& name, MeshReadStats* statsOut) {
   text = withoutBom(text);  // tinyobjloader would read "\xEF\xBB\xBFv" as an unknown tag and drop the vertex
-  validate(text, name);
+  const std::string checked = validate(text, name);
   MeshReadStats stats;
 
   tinyobj::attrib_t attrib;
   std::vector<tinyobj::shape_t> shapes;
   std::vector<tinyobj::material_t> materials;
   std::string warn, err;
-  std::istringstream stream{std::string(text)};
+  std::istringstream stream{checked};
   if (!tinyobj::LoadObj(&attrib, &shapes, &materials, &warn, &err, &stream, nullptr, /*triangulate=*/true))
     throw InputError({name, 0}, "cannot parse OBJ: " + err);
 
