@@ -73,7 +73,7 @@ void runShot(const CommonOptions& common, const Config& config, const Mesh& wick
   simOptions.configDigest = config.digest();
   simOptions.frames = frames;
   simOptions.force = common.force;
-  simulate(guides, config, simOptions, [&](int f, Strands&& frameGuides) {
+  simulate(guides, config, simOptions, [&](int f, const Strands& frameGuides) {
     stats.add("simulate", clock.lap());
     writeStrands(framePath(simPattern, f), frameGuides);
     stats.add("write", clock.lap());

@@ -61,7 +61,7 @@ void registerSimulate(CLI::App& app, int& exitCode) {
       SimulateOptions simOptions{config.digest(), frames,    restart ? &*restart : nullptr,
                                  restartName,     &progress, options->common.force};
       double writing = 0.0;
-      simulate(rest, config, simOptions, [&](int frame, Strands&& guides) {
+      simulate(rest, config, simOptions, [&](int frame, const Strands& guides) {
         Stopwatch write;
         writeStrands(framePath(options->output, frame), guides);
         writing += write.lap();

@@ -14,8 +14,9 @@ case "$group" in
   interpolate) filter='InterpolateCoupe3' ;;
   shade) filter='ShadeCoupe3' ;;
   render) filter='Render' ;;
+  simulate) filter='SimulateAnjyo' ;;
   all) filter='.' ;;
-  *) echo "bench.sh: unknown group '$group' (grow, cantilever, interpolate, shade, render, all)" >&2; exit 2 ;;
+  *) echo "bench.sh: unknown group '$group' (grow, cantilever, interpolate, shade, render, simulate, all)" >&2; exit 2 ;;
 esac
 echo "machine: $(nproc) cores, $(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2 | sed 's/^ //')"
 exec build/tests/hairgen_bench --benchmark_filter="$filter" "$@"

@@ -14,7 +14,7 @@ HeadMotion headMotionOf(const Config& config) {
 }
 
 void simulate(const Strands& restGuides, const Config& config, const SimulateOptions& options,
-              const std::function<void(int frame, Strands&& guides)>& frameDone) {
+              const std::function<void(int frame, const Strands& guides)>& frameDone) {
   const Dynamics& d = config.dynamics;
   if (!d.given)
     throw InputError(config.setup.file.string() +
@@ -34,13 +34,14 @@ void simulate(const Strands& restGuides, const Config& config, const SimulateOpt
 
   const HeadMotion head = headMotionOf(config);
   AnjyoHair hair(restGuides, config.hairstyle, d, config.collision, config.hairstyle.seed);
+  Strands guides;  // every frame's, reused: no fresh pages to fault in per frame
   auto emit = [&](int frame) {
-    Strands guides = hair.posed(head.pose(frame));
-    guides.simulationState = hair.state();
+    hair.posedInto(head.pose(frame), guides);
+    hair.stateInto(guides.simulationState);
     guides.provenance = madeByHairgen("simulate", config.hairstyle.seed, options.configDigest);
     guides.provenance.frame = frame;
     guides.provenance.time = double(frame - d.firstFrame) / d.frameRate;
-    frameDone(frame, std::move(guides));
+    frameDone(frame, guides);
     if (options.progress) options.progress->advance();
   };
 

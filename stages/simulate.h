@@ -29,10 +29,11 @@ struct SimulateOptions {
   bool force = false;                // run work estimated to take absurdly long
 };
 
-// Calls `frameDone(frame, guides)` for every frame of options.frames, in order. Throws InputError for
-// frames outside Dynamics Frames, a missing or foreign restart cache, or guides that cannot move.
+// Calls `frameDone(frame, guides)` for every frame of options.frames, in order; `guides` is valid until
+// the call returns (one buffer serves every frame). Throws InputError for frames outside Dynamics
+// Frames, a missing or foreign restart cache, or guides that cannot move.
 void simulate(const Strands& restGuides, const Config& config, const SimulateOptions& options,
-              const std::function<void(int frame, Strands&& guides)>& frameDone);
+              const std::function<void(int frame, const Strands& guides)>& frameDone);
 
 // The head's pose at `frame` for a job: its keys about its centre (Dynamics Info, Collision Info).
 HeadMotion headMotionOf(const Config& config);

@@ -45,7 +45,8 @@ TEST(AnjyoDynamics, ASingleSegmentSwingsWithTheCompoundPendulumsPeriodAndKeepsIt
   Hairstyle style;
   style.gravity = 0.0;
   AnjyoHair hair(chain(glm::dvec3(0.0), {{0, -1, 0}}, length), style, still(), Collision{}, 0);
-  hair.restore({amplitude, 0.0, amplitude, 0.0}, "start");  // displaced and let go
+  // Displaced and let go: θ, φ, the previous step's θ, φ, and the sin and cos they carry.
+  hair.restore({amplitude, 0.0, amplitude, 0.0, std::sin(amplitude), std::cos(amplitude), 0.0, 1.0}, "start");
   AccelerationField field;
   field.base = {0.0, -g, 0.0};
   const double expected = 2.0 * M_PI * std::sqrt(2.0 * length / (3.0 * g));
@@ -210,7 +211,7 @@ TEST(Simulate, StillHairStaysStill) {
   const Config config = dynamicJob({}, {}, 240);
   const Strands rest = someGuides(config, 7);
   double worst = 0.0;
-  simulate(rest, config, frames(config, {1, 240}), [&](int, Strands&& guides) {
+  simulate(rest, config, frames(config, {1, 240}), [&](int, const Strands& guides) {
     for (size_t p = 0; p < rest.pointCount(); ++p)
       worst = std::max(worst, double(glm::length(guides.points[p] - rest.points[p])));
   });
@@ -226,7 +227,7 @@ TEST(Simulate, RootsFollowTheHead) {
   const Strands rest = someGuides(config, 11);
   const HeadMotion head = headMotionOf(config);
   double worst = 0.0;
-  simulate(rest, config, frames(config, {1, 20}), [&](int frame, Strands&& guides) {
+  simulate(rest, config, frames(config, {1, 20}), [&](int frame, const Strands& guides) {
     const Pose pose = head.pose(frame);
     for (size_t s = 0; s < rest.strandCount(); ++s) {
       const uint32_t root = rest.firstPoint[s];
@@ -250,7 +251,7 @@ TEST(Simulate, ThreadsAndRestartsChangeNoBit) {
     tbb::global_control limit(tbb::global_control::max_allowed_parallelism, threads);
     std::vector<Strands> out;
     simulate(rest, fluctuating, frames(fluctuating, range, restart),
-             [&](int, Strands&& guides) { out.push_back(std::move(guides)); });
+             [&](int, const Strands& guides) { out.push_back(guides); });
     return out;
   };
   const std::vector<Strands> one = run(1, {1, 16}, nullptr);

@@ -84,7 +84,7 @@ nlohmann::ordered_json describeStrands(const Strands& s) {
     j["provenance"]["frame"] = *p.frame;
     j["provenance"]["time"] = p.time;
   }
-  if (!s.simulationState.empty()) j["restartState"] = s.simulationState.size() / 4;
+  if (!s.simulationState.empty()) j["restartState"] = s.simulationState.size();
   return j;
 }
 

@@ -66,8 +66,9 @@ struct Strands {
 
   Provenance provenance;
 
-  // What `hairgen simulate` needs to resume from this frame (4 doubles per segment: the angles of the
-  // last step and the step before); empty for anything else. Opaque to every other stage.
+  // What `hairgen simulate` needs to resume from this frame (a fixed number of doubles per segment:
+  // the angles of the last step and the step before, and what the steps carried with them); empty for
+  // anything else. Opaque to every other stage.
   std::vector<double> simulationState;
 
   size_t strandCount() const { return firstPoint.empty() ? 0 : firstPoint.size() - 1; }

@@ -24,36 +24,42 @@ SegmentFrame frameFor(const glm::dvec3& rest) {
   return {rest, pole, glm::cross(pole, rest)};
 }
 
-// sin and cos of a segment's θ and φ: its direction and the two perpendicular unit vectors of the
-// paper's θ and φ planes follow from them without further trigonometry.
-struct Trig {
-  double sl, cl, sp, cp;  // sin and cos of the latitude θ and the longitude φ
-};
-Trig trig(double theta, double phi) {
-  return {std::sin(theta), std::cos(theta), std::sin(phi), std::cos(phi)};
+// sin and cos of a + δ from those of a: for the small turns of a step by a series (exact to rounding
+// below 0.02 rad), else by the library; what every step does instead of two new sin/cos pairs.
+inline void turn(double& s, double& c, double delta) {
+  double sd, cd;
+  if (std::abs(delta) < 0.02) {
+    const double d2 = delta * delta;
+    sd = delta * (1.0 - d2 / 6.0 * (1.0 - d2 / 20.0 * (1.0 - d2 / 42.0)));
+    cd = 1.0 - d2 / 2.0 * (1.0 - d2 / 12.0 * (1.0 - d2 / 30.0));
+  } else {
+    sd = std::sin(delta);
+    cd = std::cos(delta);
+  }
+  const double s2 = s * cd + c * sd;
+  c = c * cd - s * sd;
+  s = s2;
 }
-glm::dvec3 direction(const SegmentFrame& b, const Trig& t) {
-  return t.cl * (t.cp * b.rest + t.sp * b.side) + t.sl * b.pole;
-}
-glm::dvec3 thetaVector(const SegmentFrame& b, const Trig& t) {  // ∂direction/∂θ
-  return -t.sl * (t.cp * b.rest + t.sp * b.side) + t.cl * b.pole;
-}
-glm::dvec3 phiVector(const SegmentFrame& b, const Trig& t) {
-  return -t.sp * b.rest + t.cp * b.side;
-}  // ⊥ projection
 
-// The (θ, φ) of unit `dir` nearest to a segment's previous angles: past the pole the same direction is
-// (±π − θ, φ + π), and φ is unwrapped, so the recurrences see no jump.
-void anglesNear(const SegmentFrame& b, const glm::dvec3& dir, double& theta, double& phi) {
-  const double lat = std::asin(std::clamp(glm::dot(dir, b.pole), -1.0, 1.0));
-  const double x = glm::dot(dir, b.rest), y = glm::dot(dir, b.side);
-  const double lon = std::hypot(x, y) > 1e-12 ? std::atan2(y, x) : phi;
+// The (θ, φ) of unit `dir` nearest to a segment's previous angles, and their sin and cos (read off
+// `dir`, no more trigonometry): past the pole the same direction is (±π − θ, φ + π), and φ is
+// unwrapped, so the recurrences see no jump.
+void anglesNear(const SegmentFrame& b, const glm::dvec3& dir, double& theta, double& phi, double& st,
+                double& ct, double& sp, double& cp) {
+  const double sinLat = std::clamp(glm::dot(dir, b.pole), -1.0, 1.0);
+  const double x = glm::dot(dir, b.rest), y = glm::dot(dir, b.side), h = std::hypot(x, y);
+  const double lat = std::asin(sinLat), lon = h > 1e-12 ? std::atan2(y, x) : phi;
   auto unwrap = [&](double p) { return p + 2.0 * M_PI * std::round((phi - p) / (2.0 * M_PI)); };
   const double t1 = lat, p1 = unwrap(lon);
   const double t2 = (lat >= 0.0 ? M_PI : -M_PI) - lat, p2 = unwrap(lon + M_PI);
   const bool first = std::abs(t1 - theta) + std::abs(p1 - phi) <= std::abs(t2 - theta) + std::abs(p2 - phi);
+  const double sign = first ? 1.0 : -1.0;  // the far branch flips cos θ and the longitude's direction
   theta = first ? t1 : t2;
   phi = first ? p1 : p2;
+  st = sinLat;
+  ct = sign * h;
+  cp = h > 1e-12 ? sign * x / h : std::cos(phi);
+  sp = h > 1e-12 ? sign * y / h : std::sin(phi);
 }
 
 // The gradient of a shape's inside-outside function at p: the ellipsoid's (the paper's D_i), the
@@ -79,23 +85,47 @@ glm::dvec3 outward(const CollisionShape& s, const glm::dvec3& p) {
 }
 
 // The segment from `node` along `dir` turned out of `shape` until its end is at most `depth` deep: in the
-// plane of the segment and the shape's outward direction at `node`, by bisection on the turn, so it
-// ends as near its place as possible (as the cantilever styling turns its nodes out).
+// plane of the segment and the shape's outward direction at `node`, by bisection between the two, so it
+// ends as near its place as possible (as the cantilever styling turns its nodes out). The bisection is
+// on the blend of the two directions (monotone in the angle, no trigonometry), to 1e-6 of the turn.
 glm::dvec3 turnOut(const CollisionShape& shape, const glm::dvec3& node, const glm::dvec3& dir, double length,
                    double depth) {
-  const glm::dvec3 out = glm::normalize(outward(shape, node));
-  const double cosAngle = std::clamp(glm::dot(dir, out), -1.0, 1.0), angle = std::acos(cosAngle);
-  glm::dvec3 across = out - cosAngle * dir;
-  if (glm::length(across) < 1e-12) return out;  // pointing straight in: straight out
-  across = glm::normalize(across);
-  auto turned = [&](double t) { return std::cos(t) * dir + std::sin(t) * across; };
-  if (penetration(shape, node + length * turned(angle)) > depth) return out;
-  double lo = 0.0, hi = angle;
-  for (int i = 0; i < 40; ++i) {
-    const double mid = 0.5 * (lo + hi);
-    (penetration(shape, node + length * turned(mid)) > depth ? lo : hi) = mid;
+  // Grazing contact, the usual case: the segment toward its end moved radially out to the allowed depth,
+  // a few times over (each turn shortens the reach a little), is enough.
+  if (shape.kind != ShapeKind::kCuboid) {
+    glm::dvec3 toward = dir;
+    for (int i = 0; i < 3; ++i) {
+      const glm::dvec3 end = node + length * toward, v = end - shape.centre;
+      const double inside = penetration(shape, end), dist = glm::length(v);
+      if (inside <= depth) return toward;
+      if (!(dist > 0.0)) break;
+      toward = glm::normalize(shape.centre + v * ((dist - inside - depth) / dist) - node);
+    }
   }
-  return turned(hi);
+  const glm::dvec3 out = glm::normalize(outward(shape, node));
+  if (glm::dot(dir, out) < -0.999) return out;  // pointing straight in: straight out
+  auto blend = [&](double u) { return glm::normalize(dir + u * (out - dir)); };
+  auto excess = [&](double u) { return penetration(shape, node + length * blend(u)) - depth; };
+  // The Illinois variant of regula falsi on the blend: a few evaluations where bisection takes twenty,
+  // and the bracket keeps `hi` outside, which is what is returned.
+  double lo = 0.0, hi = 1.0, flo = excess(lo), fhi = excess(hi);
+  if (fhi > 0.0) return out;
+  int side = 0;
+  for (int i = 0; i < 30 && hi - lo > 1e-7; ++i) {
+    const double u = std::clamp((lo * fhi - hi * flo) / (fhi - flo), lo + 1e-9, hi - 1e-9), f = excess(u);
+    if (f > 0.0) {
+      lo = u;
+      flo = f;
+      if (side == -1) fhi *= 0.5;
+      side = -1;
+    } else {
+      hi = u;
+      fhi = f;
+      if (side == 1) flo *= 0.5;
+      side = 1;
+    }
+  }
+  return blend(hi);
 }
 
 }  // namespace
@@ -151,6 +181,7 @@ AnjyoHair::AnjyoHair(const Strands& rest, const Hairstyle& style, const Dynamics
   coefficient_.resize(segments);
   restTurn_.assign(segments, 0.0);
   restForward_.resize(rest.pointCount());
+  restTangents_ = tangentsOf(rest);
   shapes_ = collision.shapes;
   for (size_t c = 0; c < shapes_.size() && head_ < 0; ++c)
     if (shapes_[c].kind == ShapeKind::kEllipsoid) head_ = int(c);
@@ -186,9 +217,33 @@ AnjyoHair::AnjyoHair(const Strands& rest, const Hairstyle& style, const Dynamics
   }
   thetaPrev_ = theta_;
   phiPrev_ = phi_;
+  sinTheta_.assign(segments, 0.0);
+  cosTheta_.assign(segments, 1.0);
+  sinPhi_.assign(segments, 0.0);
+  cosPhi_.assign(segments, 1.0);
   const double frequency =
       dynamics.restFrequencyAuto ? firstBendingFrequency(style, longest) : dynamics.restFrequency;
   springOmega2_ = std::pow(2.0 * M_PI * frequency, 2);
+  springOverC_.resize(segments);
+  for (size_t i = 0; i < segments; ++i) springOverC_[i] = springOmega2_ / coefficient_[i];
+  for (const CollisionShape& c : shapes_) {
+    const double r = c.kind == ShapeKind::kSphere ? c.halfExtents.x
+                     : c.kind == ShapeKind::kEllipsoid
+                         ? std::max({c.halfExtents.x, c.halfExtents.y, c.halfExtents.z})
+                         : glm::length(c.halfExtents);
+    // Nothing farther than this from the centre is inside, or within the pseudo-force's reach.
+    shapeReach2_.push_back(std::pow(r + std::max(dynamics.pseudoReach, 0.0), 2));
+    // An ellipsoid's point p is inside when |A (p − centre)|² < 1, A its axes over its semi-axes; it is
+    // beyond `reach` outside when that exceeds (1 + reach / smallest semi-axis)² (a bound, no roots).
+    ShapeTest test;
+    if (c.kind == ShapeKind::kEllipsoid) {
+      for (int k = 0; k < 3; ++k) test.scaled[k] = c.axes[k] / c.halfExtents[k];
+      const double smallest = std::min({c.halfExtents.x, c.halfExtents.y, c.halfExtents.z});
+      test.near2 = std::pow(1.0 + std::max(dynamics.pseudoReach, 0.0) / smallest, 2);
+      test.ellipsoid = true;
+    }
+    shapeTests_.push_back(test);
+  }
   // The rest nodes as the recurrence will compute them, the turn at each node and each node's depth in
   // each shape: what the motion is measured from.
   restDepth_.assign(shapes_.size(), std::vector<double>(rest.pointCount(), 0.0));
@@ -199,8 +254,13 @@ AnjyoHair::AnjyoHair(const Strands& rest, const Hairstyle& style, const Dynamics
     glm::dvec3 before(0.0);
     for (uint32_t j = 0; j < k; ++j) {
       const size_t i = firstSegment_[s] + j;
-      const glm::dvec3 dir = direction(basisOf(i), trig(0.0, 0.0));
+      const glm::dvec3 dir = directionOf(i);  // at rest
       if (j > 0) restTurn_[i] = std::acos(std::clamp(glm::dot(before, dir), -1.0, 1.0));
+      // The turn allowed at the node before segment i: JointAngleLimit from its node on, or the rest's.
+      const bool limited = j > 0 && int(j) >= jointFrom_ && jointLimit_ < M_PI;
+      const double allowed = limited ? std::max(jointLimit_, restTurn_[i]) : M_PI;
+      cosAllowed_.push_back(limited ? std::cos(allowed) : -2.0);
+      sinAllowed_.push_back(std::sin(allowed));
       node += length_[i] * dir;
       restForward_[p0 + j + 1] = node;
       before = dir;
@@ -222,34 +282,46 @@ void AnjyoHair::stepStrand(size_t s, const AccelerationField& field, double dt, 
   const double keep = std::max(0.0, 1.0 - damping_ * dt), dt2 = dt * dt;
   const uint64_t block = fluctuate ? uint64_t((frame - firstFrame_) / fluctuationEvery_) : 0;
   const CollisionShape* head = head_ >= 0 ? &shapes_[size_t(head_)] : nullptr;
-  glm::dvec3 node = restForward_[p0], nodeBefore = node;  // this substep's and the last one's
-  glm::dvec3 newBefore(0.0);                              // the direction just placed before this one
+  glm::dvec3 node = restForward_[p0];  // the node this segment starts from, already placed this substep
+  glm::dvec3 nodeVelocity(0.0);        // its velocity in the head's frame, for Coriolis
+  glm::dvec3 newBefore(0.0);           // the direction just placed before this one
   for (uint32_t j = 0; j < k; ++j) {
     const size_t i = first + j;
     const SegmentFrame basis = basisOf(i);
-    const Trig now = trig(theta_[i], phi_[i]);
-    const glm::dvec3 dir = direction(basis, now);
-    const glm::dvec3 mid = node + 0.5 * length_[i] * dir;
-    glm::dvec3 velocity(0.0);
-    if (field.rotating) {  // the segment's midpoint's velocity in the head's frame, for Coriolis
-      const glm::dvec3 before = direction(basis, trig(thetaPrev_[i], phiPrev_[i]));
-      velocity = (mid - (nodeBefore + 0.5 * length_[i] * before)) / dt;
-      nodeBefore += length_[i] * before;
+    const double st = sinTheta_[i], ct = cosTheta_[i], sp = sinPhi_[i], cp = cosPhi_[i];
+    const glm::dvec3 across = cp * basis.rest + sp * basis.side;  // the longitude's horizontal direction
+    const glm::dvec3 dir = ct * across + st * basis.pole;
+    const glm::dvec3 thetaDir = -st * across + ct * basis.pole, phiDir = -sp * basis.rest + cp * basis.side;
+    const double d = length_[i];
+    glm::dvec3 departure = field.base - restAcceleration_;
+    if (field.rotating) {
+      // The segment's turn over the last step, to first order, gives its midpoint's velocity.
+      const glm::dvec3 turnRate =
+          ((theta_[i] - thetaPrev_[i]) * thetaDir + (phi_[i] - phiPrev_[i]) * ct * phiDir) / dt;
+      const glm::dvec3 mid = node + 0.5 * d * dir;
+      departure = field.at(mid, nodeVelocity + 0.5 * d * turnRate) - restAcceleration_;
+      nodeVelocity += d * turnRate;
     }
     // The departure from the styling load, scaled by ε near the head when it points into it (§3.2.2).
-    glm::dvec3 departure = field.at(mid, velocity) - restAcceleration_;
-    if (head && pseudoEpsilon_ < 1.0 && departure != glm::dvec3(0.0) &&
-        penetration(*head, node) > -pseudoReach_) {
-      const glm::dvec3 d = outward(*head, node);
-      if (glm::dot(d, departure) < pseudoAlpha_ * glm::length(d) * glm::length(departure))
-        departure *= pseudoEpsilon_;
+    if (head && pseudoEpsilon_ < 1.0 && departure != glm::dvec3(0.0)) {
+      // Near: within the reach of the head's surface, measured along the ray from its centre in units of
+      // its smallest semi-axis (|A v| < 1 + reach / smallest). D is the ellipsoid's gradient, Aᵀ A v.
+      const ShapeTest& test = shapeTests_[size_t(head_)];
+      const glm::dvec3 v = node - head->centre;
+      const glm::dvec3 r(glm::dot(v, test.scaled[0]), glm::dot(v, test.scaled[1]),
+                         glm::dot(v, test.scaled[2]));
+      if (glm::dot(r, r) < test.near2) {
+        const glm::dvec3 grad = r.x * test.scaled[0] + r.y * test.scaled[1] + r.z * test.scaled[2];
+        if (glm::dot(grad, departure) < pseudoAlpha_ * glm::length(grad) * glm::length(departure))
+          departure *= pseudoEpsilon_;
+      }
     }
     // The spring toward the rest direction, as an acceleration the projective equations turn into
     // θ'' = −ω²θ for a small departure θ.
     const double c = coefficient_[i];
-    const glm::dvec3 push = departure + (springOmega2_ / c) * (basis.rest - dir);
-    const double thetaAcc = c * glm::dot(push, thetaVector(basis, now));
-    const double phiAcc = c * now.cl * glm::dot(push, phiVector(basis, now));
+    const glm::dvec3 push = departure + springOverC_[i] * (basis.rest - dir);
+    const double thetaAcc = c * glm::dot(push, thetaDir);
+    const double phiAcc = c * ct * glm::dot(push, phiDir);
     // (4)' and (5)', with the damping as a loss of the last step's motion.
     double theta = theta_[i] + keep * (theta_[i] - thetaPrev_[i]) + dt2 * thetaAcc;
     double phi = phi_[i] + keep * (phi_[i] - phiPrev_[i]) + dt2 * phiAcc;
@@ -258,78 +330,98 @@ void AnjyoHair::stepStrand(size_t s, const AccelerationField& field, double dt, 
       theta += scale * (2.0 * counterUniform(seed_, s, kFluctuationKey ^ block, 2 * j) - 1.0);
       phi += scale * (2.0 * counterUniform(seed_, s, kFluctuationKey ^ block, 2 * j + 1) - 1.0);
     }
-    glm::dvec3 placed = direction(basis, trig(theta, phi));
+    double nst = st, nct = ct, nsp = sp, ncp = cp;
+    turn(nst, nct, theta - theta_[i]);
+    turn(nsp, ncp, phi - phi_[i]);
+    glm::dvec3 placed = nct * (ncp * basis.rest + nsp * basis.side) + nst * basis.pole;
     bool adjusted = false;
     // Out of every collision shape (no deeper than the node sat at rest), then the joint angle at the
     // node before this segment at most JointAngleLimit (or the rest's turn, §3.2.3). Where the two
     // disagree the limit wins: a hair does not kink to stay out.
-    const bool limited = j > 0 && int(j) >= jointFrom_ && jointLimit_ < M_PI;
     for (int pass = 0; pass < 3; ++pass) {
       bool moved = false;
       for (size_t c2 = 0; c2 < shapes_.size(); ++c2) {
         if (!(shapes_[c2].penalty > 0.0)) continue;  // a shape without penalty does not collide, as in grow
-        const glm::dvec3 next = node + length_[i] * placed;
+        const glm::dvec3 next = node + d * placed, v = next - shapes_[c2].centre;
+        if (glm::dot(v, v) >= shapeReach2_[c2] || !shapeTests_[c2].mayBeInside(v)) continue;
         const double allowedDepth = std::max(restDepth_[c2][p0 + j + 1], 0.0);
         if (penetration(shapes_[c2], next) <= allowedDepth + 1e-9) continue;
-        placed = turnOut(shapes_[c2], node, placed, length_[i], allowedDepth);
+        placed = turnOut(shapes_[c2], node, placed, d, allowedDepth);
         moved = true;
       }
-      if (limited) {
-        const double allowed = std::max(jointLimit_, restTurn_[i]);
-        const double cosTurn = std::clamp(glm::dot(newBefore, placed), -1.0, 1.0);
-        if (std::acos(cosTurn) > allowed + 1e-12) {
-          glm::dvec3 across = placed - cosTurn * newBefore;
-          const double len = glm::length(across);
-          across = len > 1e-12 ? across / len : basis.pole;
-          placed = std::cos(allowed) * newBefore + std::sin(allowed) * across;
-          moved = true;
-        }
+      const double cosTurn = glm::dot(newBefore, placed);
+      if (cosTurn < cosAllowed_[i] - 1e-12) {
+        glm::dvec3 side = placed - cosTurn * newBefore;
+        const double len = glm::length(side);
+        side = len > 1e-12 ? side / len : basis.pole;
+        placed = cosAllowed_[i] * newBefore + sinAllowed_[i] * side;
+        moved = true;
       }
       adjusted = adjusted || moved;
       if (!moved) break;
     }
-    const glm::dvec3 next = node + length_[i] * placed;
-    if (adjusted) anglesNear(basis, placed, theta, phi);
+    if (adjusted) anglesNear(basis, placed, theta, phi, nst, nct, nsp, ncp);
     thetaPrev_[i] = theta_[i];
     phiPrev_[i] = phi_[i];
     theta_[i] = theta;
     phi_[i] = phi;
-    node = next;
+    sinTheta_[i] = nst;
+    cosTheta_[i] = nct;
+    sinPhi_[i] = nsp;
+    cosPhi_[i] = ncp;
+    node += d * (nct * (ncp * basis.rest + nsp * basis.side) + nst * basis.pole);
     newBefore = placed;
   }
 }
 
+glm::dvec3 AnjyoHair::directionOf(size_t i) const {
+  return cosTheta_[i] * (cosPhi_[i] * restDir_[i] + sinPhi_[i] * side_[i]) + sinTheta_[i] * pole_[i];
+}
+
 std::vector<glm::dvec3> AnjyoHair::nodes() const {
   std::vector<glm::dvec3> out(rest_.pointCount());
-  for (size_t s = 0; s < rest_.strandCount(); ++s) {
+  tbb::parallel_for(size_t(0), rest_.strandCount(), [&](size_t s) {
     const uint32_t p0 = rest_.firstPoint[s], first = firstSegment_[s], k = firstSegment_[s + 1] - first;
     glm::dvec3 node = restForward_[p0];
     out[p0] = node;
     for (uint32_t j = 0; j < k; ++j) {
       const size_t i = first + j;
-      node += length_[i] * direction(basisOf(i), trig(theta_[i], phi_[i]));
+      node += length_[i] * directionOf(i);
       out[p0 + j + 1] = node;
     }
-  }
+  });
   return out;
 }
 
 Strands AnjyoHair::posed(const Pose& pose) const {
-  Strands out = rest_;
+  Strands out;
+  posedInto(pose, out);
+  return out;
+}
+
+void AnjyoHair::posedInto(const Pose& pose, Strands& out) const {
+  // Every attribute but the points and tangents is the rest's; assigning into existing arrays of the
+  // same size copies without allocating.
+  std::vector<glm::vec3> points = std::move(out.points), tangents = std::move(out.tangents);
+  std::vector<double> state = std::move(out.simulationState);
+  out = rest_;
+  out.points = std::move(points);
+  out.tangents = std::move(tangents);
+  out.simulationState = std::move(state);
+  out.points.resize(rest_.pointCount());
   const std::vector<glm::dvec3> now = nodes();
-  const std::vector<glm::vec3> restTangents = tangentsOf(rest_);
   out.tangents.resize(out.pointCount());
-  for (size_t s = 0; s < rest_.strandCount(); ++s) {
+  tbb::parallel_for(size_t(0), rest_.strandCount(), [&](size_t s) {
     const uint32_t p0 = rest_.firstPoint[s], first = firstSegment_[s], k = firstSegment_[s + 1] - first;
     for (uint32_t j = 0; j <= k; ++j) {
       const uint32_t p = p0 + j;
       // The input point plus the motion: at rest exactly the input.
       out.points[p] = glm::vec3(pose.apply(glm::dvec3(rest_.points[p]) + (now[p] - restForward_[p])));
-      glm::dvec3 t(restTangents[p]);
+      glm::dvec3 t(restTangents_[p]);
       const size_t i = first + std::min(j, k - 1);
       if (k > 0 && (theta_[i] != 0.0 || phi_[i] != 0.0)) {
         // Turned with its segment: the minimal rotation from the rest direction to the current one.
-        const glm::dvec3 a = restDir_[i], b = direction(basisOf(i), trig(theta_[i], phi_[i]));
+        const glm::dvec3 a = restDir_[i], b = directionOf(i);
         const glm::dvec3 axis = glm::cross(a, b);
         const double sinAngle = glm::length(axis), cosAngle = glm::dot(a, b);
         if (sinAngle > 1e-15) {
@@ -339,30 +431,48 @@ Strands AnjyoHair::posed(const Pose& pose) const {
       }
       out.tangents[p] = pose.isIdentity() ? glm::vec3(t) : glm::vec3(glm::normalize(pose.rotation * t));
     }
-  }
-  return out;
+  });
 }
 
 std::vector<double> AnjyoHair::state() const {
   std::vector<double> out;
-  out.reserve(theta_.size() * 4);
-  for (size_t i = 0; i < theta_.size(); ++i)
-    out.insert(out.end(), {theta_[i], phi_[i], thetaPrev_[i], phiPrev_[i]});
+  stateInto(out);
   return out;
 }
 
+void AnjyoHair::stateInto(std::vector<double>& out) const {
+  out.resize(theta_.size() * kStateValues);
+  tbb::parallel_for(size_t(0), theta_.size(), [&](size_t i) {
+    double* v = &out[kStateValues * i];
+    v[0] = theta_[i];
+    v[1] = phi_[i];
+    v[2] = thetaPrev_[i];
+    v[3] = phiPrev_[i];
+    v[4] = sinTheta_[i];
+    v[5] = cosTheta_[i];
+    v[6] = sinPhi_[i];
+    v[7] = cosPhi_[i];
+  });
+}
+
 void AnjyoHair::restore(const std::vector<double>& state, const std::string& source) {
-  if (state.size() != theta_.size() * 4)
-    throw InputError({source, 0}, "its simulation state has " + std::to_string(state.size() / 4) +
+  if (state.size() != theta_.size() * kStateValues)
+    throw InputError({source, 0}, "its simulation state has " + std::to_string(state.size() / kStateValues) +
                                       " segments, the guides " + std::to_string(theta_.size()) +
                                       "; restart from a frame of the same guides");
   for (size_t i = 0; i < theta_.size(); ++i) {
-    theta_[i] = state[4 * i];
-    phi_[i] = state[4 * i + 1];
-    thetaPrev_[i] = state[4 * i + 2];
-    phiPrev_[i] = state[4 * i + 3];
-    if (!std::isfinite(theta_[i] + phi_[i] + thetaPrev_[i] + phiPrev_[i]))
-      throw InputError({source, 0}, "its simulation state holds a non-finite angle");
+    const double* v = &state[kStateValues * i];
+    for (size_t j = 0; j < kStateValues; ++j)
+      if (!std::isfinite(v[j]))
+        throw InputError({source, 0}, "its simulation state holds a non-finite value");
+    theta_[i] = v[0];
+    phi_[i] = v[1];
+    thetaPrev_[i] = v[2];
+    phiPrev_[i] = v[3];
+    sinTheta_[i] = v[4];
+    cosTheta_[i] = v[5];
+    sinPhi_[i] = v[6];
+    cosPhi_[i] = v[7];
   }
 }
 

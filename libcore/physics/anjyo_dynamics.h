@@ -83,10 +83,14 @@ class AnjyoHair {
   // The current hair in world coordinates: the head frame moved by `pose`. Points at rest are the input
   // points exactly; tangents are the input's, turned with their segment.
   Strands posed(const Pose& pose) const;
+  void posedInto(const Pose& pose, Strands& out) const;  // the same into `out`, reusing its arrays
 
-  // What a restart needs: θ, φ and the previous substep's θ, φ of every segment, in that order per
-  // segment (4 × segments doubles), and the inverse.
+  // What a restart needs, kStateValues doubles per segment: θ, φ, the previous substep's θ, φ, and the
+  // sin and cos of θ and φ as the steps carried them (turned by each step's increment, not recomputed,
+  // so a resumed run computes exactly what the unbroken one did); and the inverse.
+  static constexpr size_t kStateValues = 8;
   std::vector<double> state() const;
+  void stateInto(std::vector<double>& out) const;
   void restore(const std::vector<double>& state, const std::string& source);
 
   size_t segmentCount() const { return theta_.size(); }
@@ -96,13 +100,33 @@ class AnjyoHair {
  private:
   void stepStrand(size_t strand, const AccelerationField& field, double dt, int frame, bool fluctuate);
   SegmentFrame basisOf(size_t segment) const;
+  glm::dvec3 directionOf(size_t segment) const;  // from the carried sin and cos
 
   Strands rest_;
-  std::vector<uint32_t> firstSegment_;                     // per strand, + 1
-  std::vector<double> theta_, phi_, thetaPrev_, phiPrev_;  // 0 at rest
-  std::vector<glm::dvec3> restDir_, pole_, side_;          // each segment's frame (README, Dynamics)
-  std::vector<double> length_, coefficient_;               // d_i and c_i u_i m_i (1/m)
-  std::vector<double> restTurn_;                // radians: the turn at the node before segment i at rest
+  std::vector<uint32_t> firstSegment_;                         // per strand, + 1
+  std::vector<double> theta_, phi_, thetaPrev_, phiPrev_;      // 0 at rest
+  std::vector<double> sinTheta_, cosTheta_, sinPhi_, cosPhi_;  // carried with θ and φ by every step
+  std::vector<glm::dvec3> restDir_, pole_, side_;              // each segment's frame (README, Dynamics)
+  std::vector<double> length_, coefficient_;                   // d_i and c_i u_i m_i (1/m)
+  std::vector<double> restTurn_;                 // radians: the turn at the node before segment i at rest
+  std::vector<double> cosAllowed_, sinAllowed_;  // the turn allowed there (cos −2 where there is no limit)
+  std::vector<double> springOverC_;              // ω² / c_i: the spring as an acceleration
+  std::vector<double> shapeReach2_;              // per shape: beyond this squared distance nothing reaches it
+  // Per shape, a test cheaper than penetration() that rules out most points (exact for ellipsoids,
+  // always "maybe" for the other shapes). `v` is the point less the shape's centre.
+  struct ShapeTest {
+    bool ellipsoid = false;
+    glm::dvec3 scaled[3] = {};  // the axes over the semi-axes
+    double near2 = 0.0;  // (1 + PseudoForce reach / smallest semi-axis)²: within the pseudo-force's reach
+    double ratio2(const glm::dvec3& v) const {
+      const glm::dvec3 r(glm::dot(v, scaled[0]), glm::dot(v, scaled[1]), glm::dot(v, scaled[2]));
+      return glm::dot(r, r);
+    }
+    bool mayBeInside(const glm::dvec3& v) const { return !ellipsoid || ratio2(v) < 1.0; }
+    bool mayBeWithin(const glm::dvec3& v) const { return !ellipsoid || ratio2(v) < near2; }
+  };
+  std::vector<ShapeTest> shapeTests_;
+  std::vector<glm::vec3> restTangents_;
   std::vector<glm::dvec3> restForward_;         // the rest nodes as the forward recurrence computes them
   std::vector<std::vector<double>> restDepth_;  // per shape, per node: the depth it sat at in the shape
   std::vector<CollisionShape> shapes_;

@@ -7,6 +7,7 @@
 //                       distance, normals), every core; counters give the grid's size and each part's
 //                       seconds.
 //   CantileverStyling:  Anjyo's figures, 20,000 hairs of 20 segments bent around the head ellipsoid.
+//   SimulateAnjyo:      those hairs through 25 frames of the gust shot while the head turns.
 //   Render/strands/width/height/samples: the render stage on coupe 3 with the head and shadows,
 //                       through whatever EGL opens (llvmpipe here); counters give each pass's seconds.
 #include <benchmark/benchmark.h>
@@ -24,6 +25,7 @@
 #include "stages/interpolate.h"
 #include "stages/render.h"
 #include "stages/shade.h"
+#include "stages/simulate.h"
 
 namespace hairgen {
 namespace {
@@ -131,12 +133,18 @@ void ShadeCoupe3(benchmark::State& state) {
 }
 BENCHMARK(ShadeCoupe3)->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(3.0);
 
-void CantileverStyling(benchmark::State& state) {
-  // 20,000 pores spread evenly over the upper head ellipsoid (a Fibonacci lattice), normals outward.
-  const CollisionShape head{
+// Anjyo's figures: 20,000 hairs of 20 segments on the head ellipsoid, styled as a cantilever beam.
+struct AnjyoHairs {
+  CollisionShape head{
       ShapeKind::kEllipsoid, 0.0, 10.0, glm::dvec3(-0.001, 0.068, 0.010), glm::dvec3(0.08, 0.08, 0.11),
       glm::dmat3(1.0),       {}};
   Mesh wick;
+  Hairstyle style;
+  Collision collision;
+  AnjyoHairs();
+};
+
+AnjyoHairs::AnjyoHairs() {
   const int n = 20000;
   for (int i = 0; i < n; ++i) {
     double y = 1.0 - double(i) / (n - 1) * 1.2, r = std::sqrt(std::max(0.0, 1.0 - y * y)),
@@ -145,19 +153,59 @@ void CantileverStyling(benchmark::State& state) {
     wick.positions.push_back(glm::vec3(head.centre + unit * head.halfExtents));
     wick.normals.push_back(glm::vec3(glm::normalize(unit / head.halfExtents)));
   }
-  Hairstyle style;
   style.model = StylingModel::kCantilever;
   style.hairLengths = {0.22};
   style.segments = 20;
   style.forces.push_back(
       {glm::dvec3(6, 0, 0), ForceField::Region::kSide, 0.0, glm::dvec3(1, 0, 0), {}, {}, {}});
-  Collision collision;
   collision.shapes.push_back(head);
-  for (auto _ : state) benchmark::DoNotOptimize(grow(wick, style, collision, {}).guides.points.data());
-  state.counters["hairs/s"] =
-      benchmark::Counter(double(n) * double(state.iterations()), benchmark::Counter::kIsRate);
+}
+
+void CantileverStyling(benchmark::State& state) {
+  const AnjyoHairs hairs;
+  for (auto _ : state)
+    benchmark::DoNotOptimize(grow(hairs.wick, hairs.style, hairs.collision, {}).guides.points.data());
+  state.counters["hairs/s"] = benchmark::Counter(
+      double(hairs.wick.vertexCount()) * double(state.iterations()), benchmark::Counter::kIsRate);
 }
 BENCHMARK(CantileverStyling)->Unit(benchmark::kMillisecond)->UseRealTime();
+
+// Anjyo's dynamics on those 20,000 hairs of 20 segments through a second of the gust shot
+// (configs/anjyo/gust: a side wind, one substep a frame, the paper's inertia, the pseudo-force field,
+// collisions and joint limits) while the head turns, so the rotating frame's terms are computed too; frames/s
+// is frames of the shot simulated per second of wall time (Anjyo reports 40 s a frame).
+void SimulateAnjyo(benchmark::State& state) {
+  const AnjyoHairs hairs;
+  const Strands guides = grow(hairs.wick, hairs.style, hairs.collision, {}).guides;
+  Config config;
+  config.hairstyle = hairs.style;
+  config.hairstyle.jointLimit = 40.0;
+  config.hairstyle.jointLimitFrom = 3;
+  config.collision = hairs.collision;
+  config.dynamics.given = true;
+  config.dynamics.firstFrame = 1;
+  config.dynamics.lastFrame = 25;
+  config.dynamics.wind = {{1, {-14.0, 0.0, 0.0}, false, {}}, {16, {-1.4, -17.6, 0.0}, false, {}}};
+  HeadKey still, turned;
+  still.frame = 1;
+  turned.frame = 25;
+  turned.rotation = {0.0, 40.0, 0.0};
+  config.dynamics.headKeys = {still, turned};
+  config.dynamics.substeps = 1;        // the gust shot's: 1 and 4 substeps look the same there
+  config.dynamics.rootInertia = 20.0;  // its inertia, the paper's: Inertia 1 20 20
+  config.dynamics.rootSegments = 20;
+  SimulateOptions options;
+  options.frames = {1, 25};
+  size_t frames = 0;
+  for (auto _ : state)
+    simulate(guides, config, options, [&](int, const Strands& g) {
+      benchmark::DoNotOptimize(g.points.data());
+      ++frames;
+    });
+  state.counters["frames/s"] = benchmark::Counter(double(frames), benchmark::Counter::kIsRate);
+  state.counters["segments"] = double(guides.pointCount() - guides.strandCount());
+}
+BENCHMARK(SimulateAnjyo)->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(3.0);
 
 // Coupe 3 at about `strands` strands (64 vertices each), made once per size.
 const Strands& coupe3Strands(int strands) {
