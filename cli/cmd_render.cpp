@@ -29,17 +29,19 @@ void requireExtension(const std::string& file, const char* extension, const char
 }  // namespace
 
 RenderOutput renderStage(const CommonOptions& common, const Config& config, GlContext& gl,
-                         const Strands& hair, const Mesh* head, const RenderOptions& options, Stats& stats) {
+                         const Strands& hair, const Mesh* head, const RenderOptions& options, Stats& stats,
+                         const FrameBefore* before) {
   Stopwatch clock;
   const CustomShaders shaders = readCustomShaders(config.setup);
   stats.add("read", clock.lap());
   RenderOptions withForce = options;
   withForce.force = common.force;
-  RenderOutput out = render(gl, hair, head, config.visuality, config.render, shaders, withForce);
+  RenderOutput out = render(gl, hair, head, config.visuality, config.render, shaders, withForce, before);
   stats.add("upload", out.timings.upload);
   stats.add("lightDepth", out.timings.lightDepth);
   stats.add("opacity", out.timings.opacity);
   stats.add("shading", out.timings.shading);
+  if (before) stats.add("motion", out.timings.motion);
   stats.add("readback", out.timings.readback);
   stats.counts()["strands"] = hair.strandCount();
   stats.counts()["points"] = hair.pointCount();
@@ -97,7 +99,7 @@ void registerRender(CLI::App& app, int& exitCode) {
     std::string setup, hair, output, dom, preview, frames;
     UnitOptions units;
     double scale = 1.0;
-    bool frame = false, listDevices = false;
+    bool frame = false, listDevices = false, motion = false;
   };
   auto options = std::make_shared<Options>();
   CLI::App* cmd = app.add_subcommand(
@@ -124,6 +126,9 @@ void registerRender(CLI::App& app, int& exitCode) {
          "Render these frames of a sequence in one process, one device: --hair, -o, --dom and --preview "
          "are patterns with ####, and the head moves with the Setup's HeadKeys")
       ->type_name("A-B");
+  cmd->add_flag("--motion", options->motion,
+                "With --frames, motion vectors too: the layer motion.u, motion.v, pixels moved since the "
+                "frame before (from the --hair pattern's previous frame while it is in the shot)");
   cmd->add_flag("--list-devices", options->listDevices, "List the EGL devices and platforms found, and exit");
   addCommonFlags(*cmd, options->common, true);
   cmd->footer(exitCodeHelp());
@@ -146,6 +151,8 @@ void registerRender(CLI::App& app, int& exitCode) {
       Stopwatch clock;
       Config config = loadStageConfig(options->setup, options->common, SetupUse::kRender, stats);
       const bool sequence = !options->frames.empty();
+      if (options->motion && !sequence)
+        throw InputError("--motion needs --frames: motion vectors are the movement since the frame before");
       const FrameRange frames = sequence ? parseFrameRange(options->frames, "--frames") : FrameRange{0, 0};
       if (sequence)
         for (const std::string* pattern :
@@ -167,10 +174,35 @@ void registerRender(CLI::App& app, int& exitCode) {
       renderOptions.keepDom = !options->dom.empty();
       const std::unique_ptr<GlContext> gl =
           openDevice(options->common, config, stats);  // one for every frame
+      // Motion vectors of frame f are the movement from frame f - 1 whenever that frame is in the shot
+      // (Dynamics Info's Frames; without one, the frames rendered), so a range split across jobs gives
+      // the same vectors as one job; the shot's first frame has nothing before it and moves by 0.
+      const int shotStart = config.dynamics.given ? config.dynamics.firstFrame : frames.first;
+      std::optional<Strands> hairBefore;
+      std::optional<Mesh> headBefore;
+      std::string hairFileBefore;
+      auto poseHead = [&](int f) -> std::optional<Mesh> {
+        if (head && sequence && !motion.still()) return posedMesh(*head, motion.pose(f));
+        return std::nullopt;
+      };
+      if (options->motion && frames.first - 1 >= shotStart) {
+        hairFileBefore = frameFile(options->hair, frames.first - 1);
+        hairBefore = readStrands(hairFileBefore);
+        headBefore = poseHead(frames.first - 1);
+      }
       Progress progress("render", "frames", size_t(frames.count()), sequence && !options->common.quiet);
       for (int f = frames.first; f <= frames.last; ++f) {
         const std::string hairFile = frameFile(options->hair, f);
-        const Strands hair = readStrands(hairFile);
+        Strands hair = readStrands(hairFile);
+        if (options->motion && !hairBefore) {
+          hairBefore = hair;  // nothing before the shot: no motion
+          hairFileBefore = hairFile;
+          headBefore = poseHead(f);
+        }
+        if (hairBefore && !sameStrands(hair, *hairBefore))
+          throw InputError({hairFile, 0}, "has other strands than " + hairFileBefore +
+                                              " (frames of a sequence have the same strands and points), so "
+                                              "no motion vectors can be drawn between them");
         if (config.render.shadingModel == ShadingModel::kVolumetric && config.render.volumetricBlend > 0.0 &&
             hair.normals.empty())
           throw InputError({hairFile, 0},
@@ -178,14 +210,16 @@ void registerRender(CLI::App& app, int& exitCode) {
                            "has none; run `hairgen shade SETUP --hair " +
                                hairFile + " -o shaded.hair` and render that");
         // In a sequence the head moves with its keys (Dynamics Info), as the hair's roots did.
-        std::optional<Mesh> posedHead;
-        if (head && sequence && !motion.still()) posedHead = posedMesh(*head, motion.pose(f));
+        std::optional<Mesh> posedHead = poseHead(f);
         stats.add("read", clock.lap());
+        FrameBefore before{hairBefore ? &*hairBefore : nullptr, headBefore ? &*headBefore
+                                                                : head     ? &*head
+                                                                           : nullptr};
         RenderOutput out = renderStage(options->common, config, *gl, hair,
                                        posedHead ? &*posedHead
                                        : head    ? &*head
                                                  : nullptr,
-                                       renderOptions, stats);
+                                       renderOptions, stats, options->motion ? &before : nullptr);
         clock.lap();
         // The image's config digest is that of the camera and light it was rendered with (--frame aims them).
         Config rendered = config;
@@ -193,6 +227,11 @@ void registerRender(CLI::App& app, int& exitCode) {
         writeRenderOutputs(rendered, out, frameFile(options->output, f), frameFile(options->dom, f),
                            frameFile(options->preview, f));
         stats.add("write", clock.lap());
+        if (options->motion) {
+          hairBefore = std::move(hair);
+          hairFileBefore = hairFile;
+          headBefore = std::move(posedHead);
+        }
         progress.advance();
       }
       progress.finish();

@@ -52,9 +52,10 @@ fs::path defaultSetup() {
 // A shot (the Setup names a Dynamics Info): the guides simulated frame by frame into DIR/sim, and each
 // frame interpolated, shaded like the rest coupe (its normals re-posed, its colours kept) and rendered
 // to DIR/beauty.####.exr and .png, then the preview movies DIR/beauty.mp4 and DIR/beauty.gif. The
-// per-frame coupes stay in memory: a shot of a full coupe would write gigabytes of them.
+// per-frame coupes stay in memory: a shot of a full coupe would write gigabytes of them. With
+// `motionVectors`, each frame's EXR has the motion layer (the first frame's is 0: nothing came before).
 void runShot(const CommonOptions& common, const Config& config, const Mesh& wick, const Strands& guides,
-             const Strands& restCoupe, const fs::path& out, bool render, Stats& stats) {
+             const Strands& restCoupe, const fs::path& out, bool render, bool motionVectors, Stats& stats) {
   const Dynamics& d = config.dynamics;
   const FrameRange frames{d.firstFrame, d.lastFrame};
   const HeadMotion motion = headMotionOf(config);
@@ -69,6 +70,8 @@ void runShot(const CommonOptions& common, const Config& config, const Mesh& wick
                    " at " + formatReal(d.frameRate) + " fps");
   Progress progress("run", "frames", size_t(frames.count()), !common.quiet);
   Stopwatch clock;
+  std::optional<Strands> coupeBefore;
+  std::optional<Mesh> headBefore;
   SimulateOptions simOptions;
   simOptions.configDigest = config.digest();
   simOptions.frames = frames;
@@ -85,8 +88,11 @@ void runShot(const CommonOptions& common, const Config& config, const Mesh& wick
     stats.add("interpolate", clock.lap());
     std::optional<Mesh> posedHead;
     if (head) posedHead = motion.still() ? *head : posedMesh(*head, motion.pose(f));
-    RenderOutput image =
-        renderStage(common, config, *gl, coupe, posedHead ? &*posedHead : nullptr, {}, stats);
+    if (motionVectors && !coupeBefore) coupeBefore = coupe, headBefore = posedHead;
+    const FrameBefore before{coupeBefore ? &*coupeBefore : nullptr, headBefore ? &*headBefore : nullptr};
+    RenderOutput image = renderStage(common, config, *gl, coupe, posedHead ? &*posedHead : nullptr, {}, stats,
+                                     motionVectors ? &before : nullptr);
+    if (motionVectors) coupeBefore = std::move(coupe), headBefore = std::move(posedHead);
     clock.lap();
     writeRenderOutputs(config, image, framePath(exrPattern, f).string(), "",
                        framePath(pngPattern, f).string());
@@ -113,7 +119,7 @@ void registerRun(CLI::App& app, int& exitCode) {
   struct Options {
     CommonOptions common;
     std::string setup, outDir;
-    bool noRender = false;
+    bool noRender = false, motion = false;
   };
   auto options = std::make_shared<Options>();
   CLI::App* cmd = app.add_subcommand("run",
@@ -127,6 +133,9 @@ void registerRun(CLI::App& app, int& exitCode) {
                   "Output folder (default: out/NAME, NAME the Setup's folder)")
       ->type_name("DIR");
   cmd->add_flag("--no-render", options->noRender, "Stop after the coupe (no EXR, no preview)");
+  cmd->add_flag("--motion", options->motion,
+                "On a shot, motion vectors in every frame's EXR (the layer motion.u, motion.v, pixels "
+                "moved since the frame before)");
   addCommonFlags(*cmd, options->common, true);
   cmd->footer(exitCodeHelp());
   cmd->callback([options, &exitCode] {
@@ -138,6 +147,10 @@ void registerRun(CLI::App& app, int& exitCode) {
       Stopwatch clock;
       Config config = loadStageConfig(setup, options->common, SetupUse::kRun, stats);
       stats.time("read", clock.lap());
+      if (options->motion && (!config.dynamics.given || options->noRender))
+        throw InputError(setup.string() + ": --motion renders motion vectors of a shot, and " +
+                         (options->noRender ? "--no-render renders nothing"
+                                            : "this Setup names no Dynamics Info (DynamicsInfo FILE)"));
       std::error_code made;
       fs::create_directories(out, made);
       if (made) {
@@ -190,7 +203,8 @@ void registerRun(CLI::App& app, int& exitCode) {
         note(options->common, "run: saved the coupe to " + config.setup.saveFile.path.string());
       }
       if (config.dynamics.given) {
-        runShot(options->common, config, wick, grown.guides, coupe, out, !options->noRender, stats);
+        runShot(options->common, config, wick, grown.guides, coupe, out, !options->noRender, options->motion,
+                stats);
       } else if (!options->noRender) {
         std::optional<Mesh> head;
         if (config.setup.headModel.given()) head = readObj(config.setup.headModel.path);

@@ -38,7 +38,8 @@ ShadeResult shadeStage(const CommonOptions& common, const Config& config, Strand
 // Opens the rendering device (once per command) and names it on stderr.
 std::unique_ptr<GlContext> openDevice(const CommonOptions& common, const Config& config, Stats& stats);
 RenderOutput renderStage(const CommonOptions& common, const Config& config, GlContext& gl,
-                         const Strands& hair, const Mesh* head, const RenderOptions& options, Stats& stats);
+                         const Strands& hair, const Mesh* head, const RenderOptions& options, Stats& stats,
+                         const FrameBefore* before = nullptr);
 // Writes the EXR, and the light's maps and the preview where named (empty: not wanted).
 void writeRenderOutputs(const Config& config, const RenderOutput& out, const std::string& exr,
                         const std::string& dom, const std::string& preview);

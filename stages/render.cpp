@@ -66,25 +66,52 @@ void requireFinite(const Image& image) {
   }
 }
 
+// Hair made elsewhere is conformed in a copy, as is hair with colours past what a pixel can hold;
+// hairgen's own is rendered as it is. Returns what to render.
+const Strands& conformed(const Strands& hair, const RenderOptions& options, std::optional<Strands>& copy) {
+  if (!options.zUp && options.scale == 1.0 && colorsInRange(hair)) return hair;
+  copy = hair;
+  conform(*copy, options.zUp, options.scale);
+  for (glm::vec3& c : copy->colors) c = glm::clamp(c, glm::vec3(0.0f), glm::vec3(kMaxHairColor));
+  return *copy;
+}
+
 }  // namespace
+
+bool sameStrands(const Strands& a, const Strands& b) {
+  return a.firstPoint == b.firstPoint && a.points.size() == b.points.size();
+}
 
 RenderOutput render(GlContext& gl, const Strands& hair, const Mesh* head, const Visuality& visuality,
                     const RenderSettings& settings, const CustomShaders& shaders,
-                    const RenderOptions& options) {
-  // Hair made elsewhere is conformed in a copy, as is hair with colours past what a pixel can hold;
-  // hairgen's own is rendered as it is.
-  std::optional<Strands> conformed;
-  if (options.zUp || options.scale != 1.0 || !colorsInRange(hair)) {
-    conformed = hair;
-    conform(*conformed, options.zUp, options.scale);
-    for (glm::vec3& c : conformed->colors) c = glm::clamp(c, glm::vec3(0.0f), glm::vec3(kMaxHairColor));
-  }
+                    const RenderOptions& options, const FrameBefore* before) {
+  std::optional<Strands> copy, copyBefore;
   RenderInput input;
-  input.hair = conformed ? &*conformed : &hair;
+  input.hair = &conformed(hair, options, copy);
   input.head = head;
   input.visuality = visuality;
   input.settings = settings;
   if (options.frame) frameHair(input.settings, *input.hair);
+  if (before) {
+    const std::optional<CustomStage>& vertex = shaders.hairVert ? shaders.hairVert : shaders.headVert;
+    if (shaders.hairVert || (head && shaders.headVert))
+      throw InputError(vertex->file +
+                       ": motion vectors are drawn with hairgen's own vertex stages, and this "
+                       "custom " +
+                       (shaders.hairVert ? "HairVert" : "HeadVert") + " (named at " + vertex->namedAt +
+                       ") may move what they cannot follow; render without --motion");
+    if (!before->hair || !sameStrands(hair, *before->hair))
+      throw InputError(
+          "motion vectors need the frame before to have the same strands, each with as many points");
+    if (head && (!before->head || before->head->positions.size() != head->positions.size()))
+      throw InputError("motion vectors need the frame before to have the same head mesh");
+    PreviousFrame previous;
+    previous.hair = &conformed(*before->hair, options, copyBefore);
+    previous.head = head ? before->head : nullptr;
+    previous.settings = settings;
+    if (options.frame) frameHair(previous.settings, *previous.hair);
+    input.previous = previous;
+  }
   input.shaders = shaders;
   input.domResolution =
       options.domResolution > 0 ? options.domResolution : domResolutionFor(settings.resolution);

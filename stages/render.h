@@ -71,11 +71,24 @@ void conform(Strands& hair, bool zUp, double scale);
 // view (5% spare). No hair: `render` unchanged.
 void frameHair(RenderSettings& render, const Strands& hair);
 
+// The frame before the one rendered, for motion vectors: its hair as read (conformed and framed as this
+// frame's is) and its head as posed (null when there is no head).
+struct FrameBefore {
+  const Strands* hair = nullptr;
+  const Mesh* head = nullptr;
+};
+
+// Whether `a` and `b` are the same strands (as many, each with as many points), as every frame of a
+// sequence is, so a point of one is the same point of the other.
+bool sameStrands(const Strands& a, const Strands& b);
+
 // Renders `hair` (and `head`, which may be null) with the current context of `gl`: conformed, framed
-// when asked, with the Setup's custom shaders in place of hairgen's stages. Throws InputError for a
-// custom shader that does not compile or link, Error (exit 1) when the device fails.
+// when asked, with the Setup's custom shaders in place of hairgen's stages; with the frame before
+// (same strands, same head), the motion layer too. Throws InputError for a custom shader that does not
+// compile or link, or for motion vectors asked of a custom HairVert or HeadVert (they move what the
+// motion pass cannot follow); Error (exit 1) when the device fails.
 RenderOutput render(GlContext& gl, const Strands& hair, const Mesh* head, const Visuality& visuality,
                     const RenderSettings& settings, const CustomShaders& shaders,
-                    const RenderOptions& options);
+                    const RenderOptions& options, const FrameBefore* before = nullptr);
 
 }  // namespace hairgen

@@ -12,6 +12,9 @@ expect_rc() { # expected-rc command...
   "$@" >"$tmp/out" 2>"$tmp/err"; local rc=$?
   [ "$rc" -eq "$want" ] || { cat "$tmp/out" "$tmp/err"; fail "'$*' exited $rc, expected $want"; }
 }
+expect_err() { # text the last expect_rc's stderr must hold
+  grep -qF -- "$1" "$tmp/err" || fail "stderr lacks '$1': $(cat "$tmp/err")"
+}
 
 case "$case" in
 help)
@@ -462,11 +465,39 @@ shot_run_equals_stages)
     cmp "$tmp/run/sim/guides.$f.hair" "$tmp/sim/g.$f.hair" || fail "run's simulated frame $f differs"
     cmp "$tmp/run/beauty.$f.exr" "$tmp/b.$f.exr" || fail "run's frame $f differs from the stages'"
   done
-  if command -v ffmpeg >/dev/null; then
-    [ -s "$tmp/run/beauty.mp4" ] && [ -s "$tmp/run/beauty.gif" ] || fail "no preview movie"
-  else
-    echo "ffmpeg is not installed: the movie is not checked"
-  fi
+  # With motion vectors too: the same frames, and the same vectors as render --motion.
+  expect_rc 0 "$hairgen" run "$setup" -o "$tmp/runm" --motion "${small[@]}"
+  expect_rc 0 "$hairgen" render "$setup" --hair "$tmp/s.####.hair" -o "$tmp/m.####.exr" --frames 1-4 --motion "${small[@]}"
+  for f in 0001 0004; do
+    cmp "$tmp/runm/beauty.$f.exr" "$tmp/m.$f.exr" || fail "run --motion's frame $f differs from the stages'"
+  done
+  expect_rc 2 "$hairgen" run "$src/configs/default/setup.txt" -o "$tmp/still" --motion --quiet
+  expect_err "names no Dynamics Info"
+  # scripts/setup.sh installs ffmpeg, so the movie is always checked.
+  [ -s "$tmp/run/beauty.mp4" ] && [ -s "$tmp/run/beauty.gif" ] || fail "no preview movie"
+  ffprobe -v error -count_frames -select_streams v:0 -show_entries stream=nb_read_frames -of csv=p=0 \
+    "$tmp/run/beauty.mp4" | grep -qx 4 || fail "the movie does not hold the shot's 4 frames"
+  ;;
+render_motion)
+  # Motion vectors of a frame are the move since the frame before, read from the sequence whenever it
+  # is in the shot: a range rendered in two jobs gives the bytes of one job.
+  setup="$src/configs/anjyo/gust/setup.txt"
+  small=(--quiet --set Hairstyle.HairDensity=5 --set "Dynamics.Frames=1 4" --set "Render.Resolution=40 40")
+  expect_rc 0 "$hairgen" grow "$setup" -o "$tmp/g.hair" "${small[@]}"
+  expect_rc 0 "$hairgen" simulate "$setup" --guides "$tmp/g.hair" -o "$tmp/sim/g.####.hair" "${small[@]}"
+  expect_rc 0 "$hairgen" render "$setup" --hair "$tmp/sim/g.####.hair" -o "$tmp/one/b.####.exr" --frames 1-4 --motion "${small[@]}"
+  expect_rc 0 "$hairgen" render "$setup" --hair "$tmp/sim/g.####.hair" -o "$tmp/two/b.####.exr" --frames 1-2 --motion "${small[@]}"
+  expect_rc 0 "$hairgen" render "$setup" --hair "$tmp/sim/g.####.hair" -o "$tmp/two/b.####.exr" --frames 3-4 --motion "${small[@]}"
+  for f in 0001 0002 0003 0004; do
+    cmp "$tmp/one/b.$f.exr" "$tmp/two/b.$f.exr" || fail "frame $f's motion differs when the range is split"
+  done
+  "$hairgen" info "$tmp/one/b.0003.exr" | grep -q "motion.u" || fail "no motion layer"
+  expect_rc 2 "$hairgen" render "$setup" --hair "$tmp/sim/g.0001.hair" -o "$tmp/x.exr" --motion "${small[@]}"
+  expect_err "needs --frames"
+  rm "$tmp/sim/g.0002.hair"
+  expect_rc 2 "$hairgen" render "$setup" --hair "$tmp/sim/g.####.hair" -o "$tmp/y/b.####.exr" --frames 3-4 --motion "${small[@]}"
+  expect_err "g.0002.hair"
+  [ ! -e "$tmp/y" ] || [ -z "$(ls -A "$tmp/y")" ] || fail "a failed render left frames behind"
   ;;
 *) fail "unknown case" ;;
 esac

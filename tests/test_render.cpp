@@ -408,6 +408,87 @@ TEST(Render, ConformTurnsZUpCentimetresIntoYUpMetres) {
   EXPECT_NEAR(s.thickness[0], 8e-5f, 1e-10f);
 }
 
+// The hair over its plane a frame after `before`: the hair 2 mm toward +x (image right) and 1 mm toward
+// −z (image up), the plane 1 mm toward +z (image down). Their motion vectors are those moves over their
+// depth (0.45 m and 0.5 m) in pixels; where nothing is drawn, 0. Lines and ribbons alike.
+TEST(Render, MotionVectorsAreTheMoveOnTheImageInPixels) {
+  HairOverAPlane before, after;
+  for (glm::vec3& p : after.hair.points) p += glm::vec3(0.002f, 0.0f, -0.001f);
+  for (glm::vec3& p : after.head.positions) p += glm::vec3(0.0f, 0.0f, 0.001f);
+  const double focal = 0.5 * 128 / std::tan(glm::radians(15.0));
+  for (int samples : {1, 4}) {
+    after.settings.samples = samples;
+    after.settings.strandOpacity = 1.0;
+    RenderOptions options;
+    options.domResolution = 512;
+    const FrameBefore frameBefore{&before.hair, &before.head};
+    RenderOutput out =
+        render(gl(), after.hair, &after.head, Visuality{}, after.settings, {}, options, &frameBefore);
+    ASSERT_EQ(out.beauty.channels.back(), kChannelMotionV);
+    int hair = 0, head = 0;
+    for (int y = 0; y < 128; ++y)
+      for (int x = 0; x < 128; ++x) {
+        const float u = out.beauty.at(kChannelMotionU, x, y), v = out.beauty.at(kChannelMotionV, x, y);
+        if (out.beauty.at(kChannelOpacity, x, y) == 1.0f) {
+          ASSERT_NEAR(u, 0.002 * focal / 0.45, 2e-3) << samples << " samples, hair at " << x << "," << y;
+          ASSERT_NEAR(v, 0.001 * focal / 0.45, 2e-3) << samples << " samples, hair at " << x << "," << y;
+          ++hair;
+        } else if (out.beauty.at(kChannelOpacity, x, y) == 0.0f && out.beauty.at("A", x, y) == 1.0f) {
+          ASSERT_NEAR(u, 0.0, 2e-3) << samples << " samples, head at " << x << "," << y;
+          ASSERT_NEAR(v, -0.001 * focal / 0.5, 2e-3) << samples << " samples, head at " << x << "," << y;
+          ++head;
+        } else if (out.beauty.at("A", x, y) == 0.0f) {
+          ASSERT_EQ(u, 0.0f);
+          ASSERT_EQ(v, 0.0f);
+        }
+      }
+    EXPECT_GT(hair, 500) << samples << " samples";
+    EXPECT_GT(head, 2000) << samples << " samples";
+  }
+}
+
+// The motion pass draws after the shading pass and changes none of its channels; a frame with nothing
+// moved has motion vectors of exactly 0.
+TEST(Render, MotionVectorsChangeNothingElseAndAreZeroForAStill) {
+  HairOverAPlane scene;
+  scene.settings.samples = 4;
+  RenderOptions options;
+  options.domResolution = 512;
+  const FrameBefore still{&scene.hair, &scene.head};
+  RenderOutput plain = render(gl(), scene.hair, &scene.head, Visuality{}, scene.settings, {}, options);
+  RenderOutput moving =
+      render(gl(), scene.hair, &scene.head, Visuality{}, scene.settings, {}, options, &still);
+  ASSERT_EQ(moving.beauty.channels.size(), plain.beauty.channels.size() + 2);
+  for (size_t c = 0; c < plain.beauty.channels.size(); ++c) {
+    EXPECT_EQ(moving.beauty.channels[c], plain.beauty.channels[c]);
+    EXPECT_EQ(moving.beauty.planes[c], plain.beauty.planes[c]) << plain.beauty.channels[c];
+  }
+  for (size_t c = plain.beauty.channels.size(); c < moving.beauty.channels.size(); ++c)
+    for (float m : moving.beauty.planes[c]) ASSERT_EQ(m, 0.0f) << moving.beauty.channels[c];
+}
+
+// A custom HairVert may move the strands in ways the motion pass (hairgen's own vertex stage) cannot
+// follow, so motion vectors with one are refused rather than wrong; so are frames of other strands.
+TEST(Render, MotionVectorsRefuseACustomHairVertexAndOtherStrands) {
+  test::TempDir dir("motionvert");
+  writeFileAtomic(dir / "hairvert.glsl",
+                  readFileText(test::sourceDir() / "libcore/render/glsl/hair_vertex.glsl"));
+  hairgen::Setup setup;
+  setup.hairVert = {dir / "hairvert.glsl", {"setup.txt", 8}};
+  HairOverAPlane scene;
+  RenderOptions options;
+  const FrameBefore still{&scene.hair, &scene.head};
+  EXPECT_THROW(render(gl(), scene.hair, &scene.head, Visuality{}, scene.settings, readCustomShaders(setup),
+                      options, &still),
+               InputError);
+  Strands fewer = scene.hair;
+  fewer.firstPoint.pop_back();
+  fewer.points.resize(fewer.firstPoint.back());
+  const FrameBefore other{&fewer, &scene.head};
+  EXPECT_THROW(render(gl(), scene.hair, &scene.head, Visuality{}, scene.settings, {}, options, &other),
+               InputError);
+}
+
 // After framing, the camera looks at the hair's centre from the same direction, and the hair's
 // bounding sphere lies inside the narrower field of view.
 TEST(Render, FrameHairAimsAtTheHairAndFitsItInTheView) {

@@ -200,13 +200,19 @@ Buffer::~Buffer() {
 
 // ------------------------------------------------------------------------------------------ geometry
 
-HairGeometry::HairGeometry(const Strands& s, const std::vector<glm::vec3>& tangentData)
+HairGeometry::HairGeometry(const Strands& s, const std::vector<glm::vec3>& tangentData, const Strands* before)
     : points(s.points.data(), s.points.size() * sizeof(glm::vec3)),
       tangents(tangentData.data(), tangentData.size() * sizeof(glm::vec3)),
       colors(s.colors.data(), s.colors.size() * sizeof(glm::vec3)),
       normals(s.normals.data(), s.normals.size() * sizeof(glm::vec3)),
+      previous(before ? before->points.data() : nullptr,
+               before ? before->points.size() * sizeof(glm::vec3) : 0),
       hasColors(!s.colors.empty()),
-      hasNormals(!s.normals.empty()) {
+      hasNormals(!s.normals.empty()),
+      hasPrevious(before != nullptr) {
+  if (before && before->points.size() != s.points.size())
+    renderFailure("the previous frame's hair has " + std::to_string(before->points.size()) + " points, not " +
+                  std::to_string(s.points.size()));
   for (size_t i = 0; i < s.strandCount(); ++i) {
     if (s.pointsOf(i) < 2) continue;
     lineFirsts.push_back(static_cast<GLint>(s.firstPoint[i]));
@@ -219,8 +225,10 @@ HairGeometry::HairGeometry(const Strands& s, const std::vector<glm::vec3>& tange
   glVertexArrayVertexBuffer(vao, 1, tangents.id, 0, sizeof(glm::vec3));
   glVertexArrayVertexBuffer(vao, 2, colors.id, 0, sizeof(glm::vec3));
   glVertexArrayVertexBuffer(vao, 3, normals.id, 0, sizeof(glm::vec3));
-  for (GLuint a = 0; a < 4; ++a) {
-    if ((a == 2 && !hasColors) || (a == 3 && !hasNormals)) continue;  // constant attributes, set in draw()
+  glVertexArrayVertexBuffer(vao, 4, previous.id, 0, sizeof(glm::vec3));
+  for (GLuint a = 0; a < 5; ++a) {
+    if ((a == 2 && !hasColors) || (a == 3 && !hasNormals) || (a == 4 && !hasPrevious))
+      continue;  // constant attributes, set in draw()
     glEnableVertexArrayAttrib(vao, a);
     glVertexArrayAttribFormat(vao, a, 3, GL_FLOAT, GL_FALSE, 0);
     glVertexArrayAttribBinding(vao, a, a);
@@ -237,6 +245,7 @@ void HairGeometry::draw(bool ribbon) const {
   glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, tangents.id);
   glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 2, colors.id);
   glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 3, normals.id);
+  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 4, previous.id);
   if (!hasColors) glVertexAttrib3f(2, 1.0f, 1.0f, 1.0f);
   if (!hasNormals) glVertexAttrib3f(3, 0.0f, 0.0f, 0.0f);
   if (lineFirsts.empty()) return;
@@ -248,7 +257,10 @@ void HairGeometry::draw(bool ribbon) const {
                       static_cast<GLsizei>(lineFirsts.size()));
 }
 
-HeadGeometry::HeadGeometry(const Mesh& m) {
+HeadGeometry::HeadGeometry(const Mesh& m, const Mesh* before) {
+  if (before && before->positions.size() != m.positions.size())
+    renderFailure("the previous frame's head has " + std::to_string(before->positions.size()) +
+                  " vertices, not " + std::to_string(m.positions.size()));
   std::vector<float> interleaved;
   interleaved.reserve(m.positions.size() * 6);
   for (size_t i = 0; i < m.positions.size(); ++i) {
@@ -272,12 +284,23 @@ HeadGeometry::HeadGeometry(const Mesh& m) {
   glVertexArrayAttribFormat(vao, 1, 3, GL_FLOAT, GL_FALSE, 3 * sizeof(float));
   glVertexArrayAttribBinding(vao, 0, 0);
   glVertexArrayAttribBinding(vao, 1, 0);
+  if (before) {
+    glCreateBuffers(1, &previousVbo);
+    glNamedBufferStorage(previousVbo,
+                         static_cast<GLsizeiptr>(std::max<size_t>(before->positions.size() * 12, 4)),
+                         before->positions.data(), 0);
+    glVertexArrayVertexBuffer(vao, 1, previousVbo, 0, 3 * sizeof(float));
+    glEnableVertexArrayAttrib(vao, 2);
+    glVertexArrayAttribFormat(vao, 2, 3, GL_FLOAT, GL_FALSE, 0);
+    glVertexArrayAttribBinding(vao, 2, 1);
+  }
 }
 
 HeadGeometry::~HeadGeometry() {
   glDeleteVertexArrays(1, &vao);
   glDeleteBuffers(1, &vbo);
   glDeleteBuffers(1, &ebo);
+  if (previousVbo) glDeleteBuffers(1, &previousVbo);
 }
 
 void HeadGeometry::draw() const {

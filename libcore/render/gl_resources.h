@@ -98,33 +98,36 @@ struct Buffer {
 // Hair on the GPU: points, tangents, colors and normals (where the strands have them) both as vertex
 // attributes 0-3 and as storage buffers 0-3 (glsl/hair_vertex.glsl reads one or the other); per strand
 // a line strip (one vertex per point) or a triangle strip (two). Strands of fewer than 2 points are
-// not drawn.
+// not drawn. With the previous frame's points (the motion pass), those too, as attribute 4 and storage
+// buffer 4.
 struct HairGeometry {
-  // `tangents`: one per point.
-  HairGeometry(const Strands& strands, const std::vector<glm::vec3>& tangents);
+  // `tangents`: one per point. `previous`: null, or the same strands a frame before (as many points).
+  HairGeometry(const Strands& strands, const std::vector<glm::vec3>& tangents,
+               const Strands* previous = nullptr);
   ~HairGeometry();
   HairGeometry(const HairGeometry&) = delete;
   HairGeometry& operator=(const HairGeometry&) = delete;
   // Binds the buffers and draws every strand as lines, or as ribbons.
   void draw(bool ribbon) const;
 
-  Buffer points, tangents, colors, normals;
-  bool hasColors, hasNormals;
+  Buffer points, tangents, colors, normals, previous;
+  bool hasColors, hasNormals, hasPrevious;
   std::vector<GLint> lineFirsts, ribbonFirsts;
   std::vector<GLsizei> lineCounts, ribbonCounts;
   GLuint vao = 0;
 };
 
 // The head on the GPU: positions as attribute 0, normals as attribute 1 ((0, 1, 0) where the mesh has
-// none), triangles indexed.
+// none), triangles indexed; for the motion pass, the previous frame's positions as attribute 2.
 struct HeadGeometry {
-  explicit HeadGeometry(const Mesh& mesh);
+  // `previous`: null, or the same mesh a frame before (as many vertices).
+  explicit HeadGeometry(const Mesh& mesh, const Mesh* previous = nullptr);
   ~HeadGeometry();
   HeadGeometry(const HeadGeometry&) = delete;
   HeadGeometry& operator=(const HeadGeometry&) = delete;
   void draw() const;
 
-  GLuint vao = 0, vbo = 0, ebo = 0;
+  GLuint vao = 0, vbo = 0, ebo = 0, previousVbo = 0;
   GLsizei indexCount = 0;
 };
 

@@ -78,7 +78,7 @@ StageSource stage(const char* own, const std::optional<CustomStage>& custom = st
 
 }  // namespace
 
-Programs::Programs(bool ribbons, const CustomShaders& custom)
+Programs::Programs(bool ribbons, const CustomShaders& custom, bool motion)
     : hairDepth(stage(glsl::kHairVertex, custom.hairVert, "HairVert"), stage(glsl::kDepthFragment),
                 "hair depth"),
       headDepth(stage(glsl::kHeadVertex, custom.headVert, "HeadVert"), stage(glsl::kDepthFragment),
@@ -92,7 +92,16 @@ Programs::Programs(bool ribbons, const CustomShaders& custom)
       headShade(stage(glsl::kHeadVertex, custom.headVert, "HeadVert"),
                 stage(glsl::kHeadFragment, custom.headFrag, "HeadFrag", {.shadowFunction = true}),
                 "head shading"),
-      resolve(stage(glsl::kFullscreenVertex), stage(glsl::kResolveFragment), "resolve") {}
+      resolve(stage(glsl::kFullscreenVertex), stage(glsl::kResolveFragment), "resolve") {
+  if (!motion) return;
+  hairMotion.emplace(stage(glsl::kHairVertex, std::nullopt, "", {.ribbon = ribbons, .motion = true}),
+                     stage(glsl::kMotionFragment, std::nullopt, "", {.ribbon = ribbons, .screenDoor = true}),
+                     "hair motion");
+  headMotion.emplace(stage(glsl::kHeadVertex, std::nullopt, "", {.motion = true}),
+                     stage(glsl::kMotionFragment), "head motion");
+  motionResolve.emplace(stage(glsl::kFullscreenVertex), stage(glsl::kMotionResolveFragment),
+                        "motion resolve");
+}
 
 Scene::Scene(const RenderInput& in)
     : settings(in.settings),
@@ -103,9 +112,19 @@ Scene::Scene(const RenderInput& in)
       subpixel(subpixelView(camera, block)),
       light(lightView(in.settings, sphere, in.domResolution)),
       ribbons(drawsRibbons(in.settings, sphere, camera, block)),
-      hair(*in.hair, tangentsOf(*in.hair)),
-      head(in.head && !in.head->triangles.empty() ? std::make_unique<HeadGeometry>(*in.head) : nullptr),
-      programs(ribbons, in.shaders) {
+      motion(in.previous.has_value()),
+      hair(*in.hair, tangentsOf(*in.hair), motion ? in.previous->hair : nullptr),
+      head(in.head && !in.head->triangles.empty()
+               ? std::make_unique<HeadGeometry>(*in.head, motion ? in.previous->head : nullptr)
+               : nullptr),
+      programs(ribbons, in.shaders, motion) {
+  if (motion) {
+    // The projection's x and y do not depend on the near and far planes, so the previous camera is
+    // the Render Info camera on this frame's sphere.
+    const View before = cameraView(in.previous->settings, sphere);
+    previousViewProj = before.proj * before.view;
+    viewProj = camera.proj * camera.view;
+  }
   checkGl("setting up");
 }
 
@@ -229,14 +248,70 @@ ShadedImage resolvePass(const Scene& scene, const ShadedImage& subpixels) {
   return image;
 }
 
-void readBack(const ShadedImage& image, const LightDepth* depth, const Texture* opacity, RenderOutput& out) {
+Texture motionPass(const Scene& scene) {
+  const RenderSettings& r = scene.settings;
+  const int w = scene.subpixel.width, h = scene.subpixel.height;
+  Texture motion(GL_RGBA32F, w, h);
+  Framebuffer fb({&motion}, w, h, true);
+  fb.bind();
+  const float nothing[4] = {0.0f, 0.0f, 0.0f, 0.0f};
+  const float one = 1.0f;
+  glClearBufferfv(GL_COLOR, 0, nothing);
+  glClearBufferfv(GL_DEPTH, 0, &one);
+  glEnable(GL_DEPTH_TEST);
+  const glm::vec2 imageSize(scene.camera.width, scene.camera.height);
+  if (scene.head) {
+    const Program& p = *scene.programs.headMotion;
+    p.use();
+    setView(p, scene.subpixel);
+    p.set("uViewProj", glm::mat4(scene.viewProj));
+    p.set("uPreviousViewProj", glm::mat4(scene.previousViewProj));
+    p.set("uImageSize", imageSize);
+    scene.head->draw();
+  }
+  // As the shading pass draws the hair, so each sub-pixel's nearest kept fragment is the same strand's.
+  const Program& p = *scene.programs.hairMotion;
+  p.use();
+  setView(p, scene.subpixel);
+  setHairWidth(p, scene.subpixel, r);
+  p.set("uMinWidth", float(scene.block));
+  p.set("uBlock", scene.block);
+  p.set("uOrder", ditherOrder(scene.block));
+  p.set("uViewProj", glm::mat4(scene.viewProj));
+  p.set("uPreviousViewProj", glm::mat4(scene.previousViewProj));
+  p.set("uImageSize", imageSize);
+  scene.hair.draw(scene.ribbons);
+  checkGl("the motion pass");
+  return motion;
+}
+
+Texture motionResolvePass(const Scene& scene, const Texture& subpixels) {
+  const int w = scene.camera.width, h = scene.camera.height;
+  Texture motion(GL_RGBA32F, w, h);
+  Framebuffer fb({&motion}, w, h, false);
+  fb.bind();
+  glDisable(GL_DEPTH_TEST);
+  const Program& p = *scene.programs.motionResolve;
+  p.use();
+  p.set("uBlock", scene.block);
+  glBindTextureUnit(kUnitSubpixelMotion, subpixels.id);
+  glBindVertexArray(scene.hair.vao);
+  glDrawArrays(GL_TRIANGLES, 0, 3);
+  checkGl("the motion resolve");
+  return motion;
+}
+
+void readBack(const ShadedImage& image, const Texture* motion, const LightDepth* depth,
+              const Texture* opacity, RenderOutput& out) {
   Image& b = out.beauty;
   b.width = image.color.width;
   b.height = image.color.height;
   b.channels = {"R", "G", "B", "A", "Z", kChannelOpacity, kChannelShadow};
+  if (motion) b.channels.insert(b.channels.end(), {kChannelMotionU, kChannelMotionV});
   b.planes.resize(b.channels.size());
   readPlanes(image.color, {&b.planes[0], &b.planes[1], &b.planes[2], &b.planes[3]});
   readPlanes(image.data, {&b.planes[4], &b.planes[5], &b.planes[6]});
+  if (motion) readPlanes(*motion, {&b.planes[7], &b.planes[8]});
   if (depth && opacity) {
     Image& d = out.dom;
     d.width = d.height = depth->hairStart.width;

@@ -7,11 +7,15 @@
 //   3. shadingPass:     from the camera on the sub-pixel grid, the head and the hair lit and shadowed
 //                       through both maps;
 //   4. resolvePass:     each block of sub-pixels box-filtered to a pixel;
+//   (with the previous frame) motionPass and motionResolvePass: the same sub-pixel grid, what is seen
+//                       in each sub-pixel drawn again with its screen motion since the previous frame,
+//                       then averaged over each block's covered sub-pixels;
 //   5. readBack:        the images into RenderOutput's planes, rows top to bottom.
 // Each pass sets the GL state it needs and throws renderFailure when OpenGL reports an error.
 #pragma once
 
 #include <memory>
+#include <optional>
 
 #include "libcore/render/gl_resources.h"
 #include "libcore/render/renderer.h"
@@ -22,8 +26,9 @@ namespace hairgen {
 // The programs of one render: hairgen's stages (libcore/render/glsl/), or the Setup's custom ones in
 // their place (HairVert in every program that draws hair, HeadVert in every one that draws the head).
 struct Programs {
-  Programs(bool ribbons, const CustomShaders& custom);
+  Programs(bool ribbons, const CustomShaders& custom, bool motion);
   Program hairDepth, headDepth, opacity, hairShade, headShade, resolve;
+  std::optional<Program> hairMotion, headMotion, motionResolve;  // with the previous frame
 };
 
 // What every pass reads: the settings, the views, the geometry on the GPU and the programs. Building
@@ -38,6 +43,8 @@ struct Scene {
   View camera, subpixel;  // the camera on pixels and on sub-pixels
   View light;             // domResolution texels per side
   bool ribbons;           // the shading pass draws ribbons, not lines
+  bool motion;            // the previous frame was given: motion vectors too
+  glm::dmat4 viewProj{1.0}, previousViewProj{1.0};  // world to clip: this frame's camera, the previous one's
   HairGeometry hair;
   std::unique_ptr<HeadGeometry> head;  // null when there is no head to draw
   Programs programs;
@@ -62,8 +69,14 @@ Texture deepOpacityPass(const Scene& scene, const LightDepth& depth);
 ShadedImage shadingPass(const Scene& scene, const LightDepth& depth, const Texture& opacity);
 // At the image's resolution.
 ShadedImage resolvePass(const Scene& scene, const ShadedImage& subpixels);
-// Into `out.beauty`, and `out.dom` when the light's maps are passed.
-void readBack(const ShadedImage& image, const LightDepth* depth, const Texture* opacity, RenderOutput& out);
+// At sub-pixel resolution, RGBA32F: motion u, v (pixels of the image), 1 where something was drawn.
+Texture motionPass(const Scene& scene);
+// At the image's resolution: u, v.
+Texture motionResolvePass(const Scene& scene, const Texture& subpixels);
+// Into `out.beauty` (with the motion layer when `motion` is passed), and `out.dom` when the light's
+// maps are passed.
+void readBack(const ShadedImage& image, const Texture* motion, const LightDepth* depth,
+              const Texture* opacity, RenderOutput& out);
 
 // Threshold ranks for a k×k block of the screen door (k ≤ 8), row by row.
 std::vector<int> ditherOrder(int k);

@@ -48,7 +48,13 @@ RenderOutput renderHair(GlContext&, const RenderInput& in) {
   out.timings.opacity = seconds(clock);
   const ShadedImage image = resolvePass(scene, shadingPass(scene, depth, opacity));
   out.timings.shading = seconds(clock);
-  readBack(image, in.keepDom ? &depth : nullptr, in.keepDom ? &opacity : nullptr, out);
+  std::optional<Texture> motion;
+  if (scene.motion) {
+    motion.emplace(motionResolvePass(scene, motionPass(scene)));
+    out.timings.motion = seconds(clock);
+  }
+  readBack(image, motion ? &*motion : nullptr, in.keepDom ? &depth : nullptr, in.keepDom ? &opacity : nullptr,
+           out);
   out.timings.readback = seconds(clock);
   return out;
 }

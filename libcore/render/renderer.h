@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -27,13 +28,17 @@ class GlContext;
 // grey channel Y, so Nuke shows them as the layers opacity and shadow.
 inline constexpr const char* kChannelOpacity = "opacity.Y";  // hair coverage, 0-1
 inline constexpr const char* kChannelShadow = "shadow.Y";    // the light that arrives, 1 in the open
+// With the previous frame (render --motion), Nuke's motion layer: how far what covers the pixel moved on
+// the image since the previous frame, in pixels, u to the right and v up; 0 where nothing is drawn.
+inline constexpr const char* kChannelMotionU = "motion.u";
+inline constexpr const char* kChannelMotionV = "motion.v";
 
 struct RenderTimings {
-  double upload = 0.0, lightDepth = 0.0, opacity = 0.0, shading = 0.0, readback = 0.0;  // seconds
+  double upload = 0.0, lightDepth = 0.0, opacity = 0.0, shading = 0.0, motion = 0.0, readback = 0.0;  // s
 };
 
 struct RenderOutput {
-  Image beauty;  // R G B A (premultiplied), Z, kChannelOpacity, kChannelShadow
+  Image beauty;  // R G B A (premultiplied), Z, kChannelOpacity, kChannelShadow[, kChannelMotionU, V]
   Image dom;     // the light's view: Z (distance along the light's axis where hair begins), layer1-4
   glm::dmat4 worldToCamera{1.0}, worldToNdc{1.0};
   glm::dmat4 worldToLight{1.0};
@@ -41,6 +46,14 @@ struct RenderOutput {
   int samples = 1;          // the samples used (Samples, clamped to what the device offers)
   RenderSettings settings;  // what was rendered: the input's, with the camera and light the render stage
                             // aimed when asked to frame the hair
+};
+
+// The frame before this one, for motion vectors: the same strands (as many points) and head (as many
+// vertices) a frame earlier, and the camera they were seen with.
+struct PreviousFrame {
+  const Strands* hair = nullptr;
+  const Mesh* head = nullptr;  // required when RenderInput has a head
+  RenderSettings settings;     // its camera (CameraPosition, CameraTarget, CameraUp, FieldOfView)
 };
 
 struct RenderInput {
@@ -51,6 +64,7 @@ struct RenderInput {
   CustomShaders shaders;
   int domResolution = 1024;  // texels per side of the light's maps
   bool keepDom = false;
+  std::optional<PreviousFrame> previous;  // motion vectors in the beauty image when given
 };
 
 // The light's maps for an image: half the image's larger side, at least 1024 and at most 4096 texels
@@ -59,9 +73,10 @@ inline int domResolutionFor(const glm::ivec2& resolution) {
   return std::clamp(std::max(resolution.x, resolution.y) / 2, 1024, 4096);
 }
 
-// Renders with the current context of `gl`. Deterministic for a given device and driver. A custom
-// stage that does not compile or link throws InputError at the file and line the GLSL compiler names;
-// anything else that fails throws Error (exit code 1).
+// Renders with the current context of `gl`; with the previous frame, a motion pass and its resolve
+// after the shading pass (drawing hairgen's own vertex stages, never custom ones). Deterministic for a given
+// device and driver. A custom stage that does not compile or link throws InputError at the file and line the
+// GLSL compiler names; anything else that fails throws Error (exit code 1).
 RenderOutput renderHair(GlContext& gl, const RenderInput& input);
 
 }  // namespace hairgen

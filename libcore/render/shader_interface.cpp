@@ -10,7 +10,7 @@
 
 namespace hairgen {
 
-static_assert(kUnitSubpixelData + 1 == kTextureUnitCount, "kTextureUnitCount counts every TextureUnit");
+static_assert(kUnitSubpixelMotion + 1 == kTextureUnitCount, "kTextureUnitCount counts every TextureUnit");
 
 const char* name(TextureUnit unit) {
   switch (unit) {
@@ -23,9 +23,11 @@ const char* name(TextureUnit unit) {
     case kUnitSubpixelColor:
       return "kUnitSubpixelColor";
     case kUnitSubpixelData:
+      return "kUnitSubpixelData";
+    case kUnitSubpixelMotion:
       break;
   }
-  return "kUnitSubpixelData";
+  return "kUnitSubpixelMotion";
 }
 
 namespace {
@@ -74,9 +76,10 @@ std::string glslConstants() {
 std::string assembleStage(const StagePrelude& prelude, const std::string& body) {
   std::string text = "#version 450 core\n";
   if (prelude.ribbon) text += "#define RIBBON\n";
+  if (prelude.motion) text += "#define MOTION\n";
   text += glslConstants();
   if (prelude.shadowFunction) text += glsl::kShadow;
-  if (prelude.screenDoor) text += glsl::kScreenDoor;
+  if (prelude.screenDoor) text += std::string("#define SCREEN_DOOR\n") + glsl::kScreenDoor;
   return text + "#line 1\n" + body;
 }
 

@@ -16,8 +16,9 @@ enum TextureUnit : int {
   kUnitOpacityMap = 2,     // RGBA32F, the light's view: the 4 deep opacity layers
   kUnitSubpixelColor = 3,  // RGBA16F, the shading pass's sub-pixels: color and opacity
   kUnitSubpixelData = 4,   // RGBA32F, the shading pass's sub-pixels: Z, hair opacity, shadow
+  kUnitSubpixelMotion = 5,  // RGBA32F, the motion pass's sub-pixels: motion u, v (pixels), covered
 };
-inline constexpr int kTextureUnitCount = 5;
+inline constexpr int kTextureUnitCount = 6;
 
 // The unit's name as C++ and GLSL spell it ("kUnitHairStart").
 const char* name(TextureUnit unit);
@@ -45,15 +46,18 @@ inline constexpr float kShadowFloor = 0.25f;
 struct StagePrelude {
   bool ribbon = false;          // `#define RIBBON`: the hair is drawn as ribbons in this program
   bool shadowFunction = false;  // lightArriving() (glsl/shadow.glsl): the shading fragment stages
-  bool screenDoor = false;      // screenDoor() (glsl/screen_door.glsl): the hair shading fragment stage
+  bool screenDoor = false;      // screenDoor() (glsl/screen_door.glsl) and `#define SCREEN_DOOR`: the
+                                // hair's shading and motion fragment stages
+  bool motion = false;          // `#define MOTION`: hairgen's own vertex stages in the motion pass also
+                                // write vMotion, the screen motion since the previous frame
 };
 
 // The GLSL constants: `const int kShading<Name> = <value>;` for every ShadingModel (the name from
 // name(ShadingModel) in camel case, e.g. kShadingKajiyaKay), every TextureUnit, and the shadow biases.
 std::string glslConstants();
 
-// `#version 450 core`, RIBBON where asked, glslConstants(), the functions asked for, then `#line 1`, so
-// the compiler numbers the stage's own lines from 1; `body` follows.
+// `#version 450 core`, RIBBON and MOTION where asked, glslConstants(), the functions asked for, then `#line
+// 1`, so the compiler numbers the stage's own lines from 1; `body` follows.
 std::string assembleStage(const StagePrelude& prelude, const std::string& body);
 
 // The first error of a GLSL compiler's or linker's log, on one line: its line number (0 when the log

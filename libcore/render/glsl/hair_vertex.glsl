@@ -5,6 +5,10 @@
 // Lines: one vertex per point, the point's data as vertex attributes. Ribbons: two vertices per point
 // (gl_VertexID 2i and 2i + 1 for point i), the data read from storage buffers, the pair pushed apart
 // across the strand on screen.
+//
+// MOTION is defined only in hairgen's motion pass (render --motion), never for a custom HairVert: the
+// point's position in the previous frame (attribute 4, storage buffer 4) is projected by that frame's
+// camera, and vMotion is how far the point moved on the image since, in pixels.
 #ifdef RIBBON
 layout(std430, binding = 0) readonly buffer Points { float pointData[]; };
 layout(std430, binding = 1) readonly buffer Tangents { float tangentData[]; };
@@ -12,11 +16,23 @@ layout(std430, binding = 2) readonly buffer Colors { float colorData[]; };
 layout(std430, binding = 3) readonly buffer Normals { float normalData[]; };
 uniform int uHasColor;
 uniform int uHasNormal;
+#ifdef MOTION
+layout(std430, binding = 4) readonly buffer PreviousPoints { float previousData[]; };
+#endif
 #else
 layout(location = 0) in vec3 aPosition;
 layout(location = 1) in vec3 aTangent;
 layout(location = 2) in vec3 aColor;   // (1, 1, 1) when the cache has no colors
 layout(location = 3) in vec3 aNormal;  // (0, 0, 0) when the cache has no normals
+#ifdef MOTION
+layout(location = 4) in vec3 aPrevious;  // the point in the previous frame
+#endif
+#endif
+#ifdef MOTION
+uniform mat4 uViewProj;          // world to clip, this frame's camera (as uPreviousViewProj is made)
+uniform mat4 uPreviousViewProj;  // world to clip, the previous frame's camera
+uniform vec2 uImageSize;         // the image's pixels (not the sub-pixels')
+out vec2 vMotion;                // pixels, x right and y up, since the previous frame
 #endif
 uniform mat4 uView;       // world to view (the camera's or the light's)
 uniform mat4 uProj;       // view to clip
@@ -35,11 +51,17 @@ void main() {
 #ifdef RIBBON
   int i = gl_VertexID >> 1;
   vec3 p = vec3(pointData[3 * i], pointData[3 * i + 1], pointData[3 * i + 2]);
+#ifdef MOTION
+  vec3 previous = vec3(previousData[3 * i], previousData[3 * i + 1], previousData[3 * i + 2]);
+#endif
   vec3 t = vec3(tangentData[3 * i], tangentData[3 * i + 1], tangentData[3 * i + 2]);
   vColor = uHasColor != 0 ? vec3(colorData[3 * i], colorData[3 * i + 1], colorData[3 * i + 2]) : vec3(1.0);
   vNormal = uHasNormal != 0 ? vec3(normalData[3 * i], normalData[3 * i + 1], normalData[3 * i + 2]) : vec3(0.0);
 #else
   vec3 p = aPosition;
+#ifdef MOTION
+  vec3 previous = aPrevious;
+#endif
   vec3 t = aTangent;
   vColor = aColor;
   vNormal = aNormal;
@@ -47,6 +69,11 @@ void main() {
   vec4 view = uView * vec4(p, 1.0);
   vec4 clip = uProj * view;
   float depth = -view.z;
+#ifdef MOTION
+  // Both ends the same way, so what did not move moved by exactly 0.
+  vec4 now = uViewProj * vec4(p, 1.0), before = uPreviousViewProj * vec4(previous, 1.0);
+  vMotion = (now.xy / now.w - before.xy / before.w) * 0.5 * uImageSize;
+#endif
 #ifdef RIBBON
   float side = (gl_VertexID & 1) == 0 ? -1.0 : 1.0;
   vec4 ahead = uProj * (view + uView * vec4(1e-3 * t, 0.0));
