@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Remakes the README gallery: docs/coupe1-4.png, docs/coupe3-volumetric.png, docs/bob.png and
-# docs/default.png, each `hairgen run` of a bundled coupe at 320x320 with its own density. Look at them
-# before committing.
+# docs/default.png, each `hairgen run` of a bundled coupe at 320x320 with its own density, and the shots'
+# GIFs docs/gust.gif and docs/headturn.gif at 240x240 (the head turn at half density: 72 frames of the
+# full coupe take too long for a picture this small). Look at them before committing.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/setup.sh
@@ -24,4 +25,18 @@ for entry in "${entries[@]}"; do
   ./build/hairgen run "configs/$name/setup.txt" -o "$out" --quiet --set "Render.Resolution=320 320" "${extra[@]}"
   cp "$out/beauty.png" "docs/$picture.png"
   echo "gallery: docs/$picture.png" >&2
+done
+# Shots: the Setup's folder, the movie's name, and any --set for the run.
+shots=(
+  "anjyo/gust gust"
+  "shots/headturn headturn Hairstyle.HairDensity=50"
+)
+for entry in "${shots[@]}"; do
+  read -r name movie sets <<<"$entry"
+  out="build/gallery/$movie"
+  extra=()
+  for s in $sets; do extra+=(--set "$s"); done
+  ./build/hairgen run "configs/$name/setup.txt" -o "$out" --quiet --set "Render.Resolution=240 240" "${extra[@]}"
+  cp "$out/beauty.gif" "docs/$movie.gif"
+  echo "gallery: docs/$movie.gif" >&2
 done

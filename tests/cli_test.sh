@@ -478,6 +478,26 @@ shot_run_equals_stages)
   ffprobe -v error -count_frames -select_streams v:0 -show_entries stream=nb_read_frames -of csv=p=0 \
     "$tmp/run/beauty.mp4" | grep -qx 4 || fail "the movie does not hold the shot's 4 frames"
   ;;
+shot_headturn)
+  # The bundled head turn, small: the shot runs end to end, the head has turned by its last frame (the
+  # pictures differ) and the hair settles once the head stops.
+  setup="$src/configs/shots/headturn/setup.txt"
+  small=(--quiet --set Hairstyle.HairDensity=3 --set "Render.Resolution=48 48")
+  expect_rc 0 "$hairgen" run "$setup" -o "$tmp/run" "${small[@]}"
+  for f in 0001 0036 0072; do [ -s "$tmp/run/beauty.$f.exr" ] || fail "no frame $f"; done
+  expect_rc 4 "$hairgen" diff "$tmp/run/beauty.0001.exr" "$tmp/run/beauty.0072.exr"
+  # The share of pixels that change from one frame to the next: large while the head turns (frames
+  # 10-22), small once the hair has settled (measured: 44% and 6%).
+  changed() {
+    "$hairgen" diff "$tmp/run/beauty.$1.exr" "$tmp/run/beauty.$2.exr" --channels R,G,B,A 2>&1 |
+      sed -n 's/.*pixels (\([0-9.]*\)%) differ.*/\1/p'
+  }
+  turning=$(changed 0015 0016) settled=$(changed 0071 0072)
+  awk -v t="$turning" -v s="${settled:-0}" 'BEGIN { exit !(t > 20 && s < t / 4) }' ||
+    fail "the hair does not settle after the turn: ${turning}% of pixels change at frame 16, ${settled}% at 72"
+  ffprobe -v error -count_frames -select_streams v:0 -show_entries stream=nb_read_frames -of csv=p=0 \
+    "$tmp/run/beauty.mp4" | grep -qx 72 || fail "the movie does not hold the shot's 72 frames"
+  ;;
 render_motion)
   # Motion vectors of a frame are the move since the frame before, read from the sequence whenever it
   # is in the shot: a range rendered in two jobs gives the bytes of one job.
