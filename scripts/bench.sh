@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Benchmarks, one group or all: scripts/bench.sh [grow|cantilever|interpolate|shade|render|all] [Google Benchmark flags]
+# Benchmarks, one group or all: scripts/bench.sh [grow|cantilever|interpolate|shade|render|simulate|cache|all] [Google Benchmark flags]
 # Builds Release first. Speed targets are checked here, never by timed unit tests.
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -15,8 +15,9 @@ case "$group" in
   shade) filter='ShadeCoupe3' ;;
   render) filter='Render' ;;
   simulate) filter='SimulateAnjyo' ;;
+  cache) filter='ReadCache|WriteCache' ;;
   all) filter='.' ;;
-  *) echo "bench.sh: unknown group '$group' (grow, cantilever, interpolate, shade, render, simulate, all)" >&2; exit 2 ;;
+  *) echo "bench.sh: unknown group '$group' (grow, cantilever, interpolate, shade, render, simulate, cache, all)" >&2; exit 2 ;;
 esac
 echo "machine: $(nproc) cores, $(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2 | sed 's/^ //')"
 exec build/tests/hairgen_bench --benchmark_filter="$filter" "$@"

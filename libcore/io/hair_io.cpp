@@ -1,9 +1,13 @@
 #include "libcore/io/hair_io.h"
 
+#include <algorithm>
+#include <bit>
 #include <cmath>
 #include <cstring>
+#include <functional>
 #include <limits>
 
+#include <tbb/parallel_for.h>
 #include <zlib.h>
 
 #include "libcore/util/error.h"
@@ -17,11 +21,38 @@ constexpr uint32_t kSegments = 1, kPoints = 2, kThickness = 4, kTransparency = 8
 constexpr size_t kHeaderSize = 128, kInfoSize = 88;
 constexpr uint32_t kBlockVersion = 1;
 
+// Arrays of 4- and 8-byte words travel as their bytes on a little-endian machine; elsewhere every word
+// is swapped on its way in and out.
+constexpr bool kLittleEndian = std::endian::native == std::endian::little;
+
+template <size_t Word>
+void swapWords(void* data, size_t bytes) {
+  uint8_t* b = static_cast<uint8_t*>(data);
+  for (size_t i = 0; i + Word <= bytes; i += Word) std::reverse(b + i, b + i + Word);
+}
+
+// CRC-32 of a large buffer in 8 MB blocks on every core, combined in order: the same value as one pass.
+uint32_t crcOf(uint32_t crc, const uint8_t* data, size_t size) {
+  constexpr size_t kBlock = size_t(8) << 20;
+  if (size < 2 * kBlock) return uint32_t(crc32_z(crc, data, size));
+  const size_t blocks = (size + kBlock - 1) / kBlock;
+  std::vector<uLong> part(blocks);
+  tbb::parallel_for(size_t(0), blocks, [&](size_t i) {
+    const size_t begin = i * kBlock, length = std::min(kBlock, size - begin);
+    part[i] = crc32_z(0L, data + begin, length);
+  });
+  uLong whole = crc;
+  for (size_t i = 0; i < blocks; ++i)
+    whole = crc32_combine(whole, part[i], z_off_t(std::min(kBlock, size - i * kBlock)));
+  return uint32_t(whole);
+}
+
+// Where encoded bytes go: a growing buffer (encodeHair) or a file being written (writeHair).
 class Writer {
  public:
+  explicit Writer(std::function<void(const uint8_t*, size_t)> sink) : sink_(std::move(sink)) {}
   void bytes(const void* p, size_t n) {
-    const uint8_t* b = static_cast<const uint8_t*>(p);
-    out.insert(out.end(), b, b + n);
+    if (n) sink_(static_cast<const uint8_t*>(p), n);
   }
   void u16(uint16_t v) {
     uint8_t b[2] = {uint8_t(v), uint8_t(v >> 8)};
@@ -36,87 +67,126 @@ class Writer {
     u32(uint32_t(v));
     u32(uint32_t(v >> 32));
   }
-  void f32(float v) {
-    uint32_t bits;
-    std::memcpy(&bits, &v, 4);
-    u32(bits);
-  }
-  void f64(double v) {
-    uint64_t bits;
-    std::memcpy(&bits, &v, 8);
-    u64(bits);
-  }
+  void f32(float v) { u32(std::bit_cast<uint32_t>(v)); }
   void vec(const glm::vec3& v) {
     f32(v.x);
     f32(v.y);
     f32(v.z);
   }
-  std::vector<uint8_t> out;
+  // An array of Word-byte words (floats, uint32s, doubles, and vectors of them), as little-endian bytes.
+  template <size_t Word, typename T>
+  void array(const std::vector<T>& v) {
+    static_assert(sizeof(T) % Word == 0);
+    const size_t n = v.size() * sizeof(T);
+    if constexpr (kLittleEndian) {
+      bytes(v.data(), n);
+    } else {
+      std::vector<uint8_t> copy(reinterpret_cast<const uint8_t*>(v.data()),
+                                reinterpret_cast<const uint8_t*>(v.data()) + n);
+      swapWords<Word>(copy.data(), n);
+      bytes(copy.data(), n);
+    }
+  }
+
+ private:
+  std::function<void(const uint8_t*, size_t)> sink_;
 };
 
-class Reader {
+// A chunk: tag, length, the payload as Word-byte words, and the CRC-32 of all three (of the bytes as
+// written, so the payload is swapped first on a big-endian machine).
+template <size_t Word, typename T>
+void chunk(Writer& w, const char tag[4], const std::vector<T>& values) {
+  const uint64_t length = values.size() * sizeof(T);
+  uint8_t head[12];
+  std::memcpy(head, tag, 4);
+  for (int i = 0; i < 8; ++i) head[4 + i] = uint8_t(length >> (8 * i));
+  const uint8_t* payload = reinterpret_cast<const uint8_t*>(values.data());
+  std::vector<uint8_t> swapped;
+  if constexpr (!kLittleEndian) {
+    swapped.assign(payload, payload + length);
+    swapWords<Word>(swapped.data(), length);
+    payload = swapped.data();
+  }
+  const uint32_t crc = crcOf(uint32_t(crc32(0L, head, 12)), payload, length);
+  w.bytes(head, 12);
+  w.bytes(payload, length);
+  w.u32(crc);
+}
+
+// Where decoded bytes come from: memory (decodeHair) or a file read piece by piece (readHair), so a
+// file's arrays are read straight into their vectors and never held twice.
+class Source {
  public:
-  Reader(const uint8_t* data, size_t size, const std::string& name) : data_(data), size_(size), name_(name) {}
-  size_t remaining() const { return size_ - pos_; }
-  size_t position() const { return pos_; }
-  void need(uint64_t n, const std::string& what) const {
-    if (n > remaining())
-      throw InputError({name_, 0}, "truncated: " + what + " needs " + std::to_string(n) +
-                                       " bytes at offset " + std::to_string(pos_) + " but only " +
-                                       std::to_string(remaining()) + " remain");
-  }
-  const uint8_t* take(size_t n) {
-    const uint8_t* p = data_ + pos_;
-    pos_ += n;
-    return p;
-  }
-  uint16_t u16() {
-    const uint8_t* b = take(2);
-    return uint16_t(b[0] | b[1] << 8);
-  }
-  uint32_t u32() {
-    const uint8_t* b = take(4);
-    return uint32_t(b[0]) | uint32_t(b[1]) << 8 | uint32_t(b[2]) << 16 | uint32_t(b[3]) << 24;
-  }
-  uint64_t u64() {
-    uint64_t lo = u32();
-    return lo | uint64_t(u32()) << 32;
-  }
-  float f32() {
-    uint32_t bits = u32();
-    float v;
-    std::memcpy(&v, &bits, 4);
-    return v;
-  }
-  glm::vec3 vec() {
-    float x = f32(), y = f32();
-    return {x, y, f32()};
+  virtual ~Source() = default;
+  virtual uint64_t remaining() const = 0;
+  virtual void read(void* out, size_t bytes) = 0;  // after need(): the bytes are there
+};
+
+class MemorySource final : public Source {
+ public:
+  MemorySource(const uint8_t* data, size_t size) : data_(data), size_(size) {}
+  uint64_t remaining() const override { return size_ - pos_; }
+  void read(void* out, size_t bytes) override {
+    if (bytes) std::memcpy(out, data_ + pos_, bytes);
+    pos_ += bytes;
   }
 
  private:
   const uint8_t* data_;
-  size_t size_;
-  size_t pos_ = 0;
-  const std::string& name_;
+  size_t size_, pos_ = 0;
 };
 
-void chunk(Writer& w, const char tag[4], const std::vector<uint8_t>& payload) {
-  Writer head;
-  head.bytes(tag, 4);
-  head.u64(payload.size());
-  uLong crc = crc32(0L, head.out.data(), static_cast<uInt>(head.out.size()));
-  crc = crc32_z(crc, payload.data(), payload.size());
-  w.bytes(head.out.data(), head.out.size());
-  w.bytes(payload.data(), payload.size());
-  w.u32(static_cast<uint32_t>(crc));
-}
+class FileSource final : public Source {
+ public:
+  explicit FileSource(const std::filesystem::path& path) : file_(path) {}
+  uint64_t remaining() const override { return file_.remaining(); }
+  void read(void* out, size_t bytes) override { file_.read(out, bytes); }
 
-template <typename Fn>
-std::vector<uint8_t> payload(Fn fill) {
-  Writer w;
-  fill(w);
-  return std::move(w.out);
-}
+ private:
+  InputFile file_;
+};
+
+class Reader {
+ public:
+  Reader(Source& source, const std::string& name) : source_(source), name_(name) {}
+  uint64_t remaining() const { return source_.remaining(); }
+  void need(uint64_t n, const std::string& what) const {
+    if (n > remaining())
+      throw InputError({name_, 0}, "truncated: " + what + " needs " + std::to_string(n) + " bytes but only " +
+                                       std::to_string(remaining()) + " remain");
+  }
+  void bytes(void* out, size_t n) { source_.read(out, n); }
+  uint16_t u16() {
+    uint8_t b[2];
+    bytes(b, 2);
+    return uint16_t(b[0] | b[1] << 8);
+  }
+  uint32_t u32() {
+    uint8_t b[4];
+    bytes(b, 4);
+    return uint32_t(b[0]) | uint32_t(b[1]) << 8 | uint32_t(b[2]) << 16 | uint32_t(b[3]) << 24;
+  }
+  float f32() { return std::bit_cast<float>(u32()); }
+  glm::vec3 vec() {
+    float x = f32(), y = f32();
+    return {x, y, f32()};
+  }
+  // `count` values of Word-byte words into `v`, after need() has checked they are there; returns the
+  // bytes as they were in the file (for a CRC) through `crc` when it is given.
+  template <size_t Word, typename T>
+  void array(std::vector<T>& v, uint64_t count, uint32_t* crc = nullptr) {
+    static_assert(sizeof(T) % Word == 0);
+    v.resize(count);
+    const size_t n = size_t(count) * sizeof(T);
+    bytes(v.data(), n);
+    if (crc) *crc = crcOf(*crc, reinterpret_cast<const uint8_t*>(v.data()), n);
+    if constexpr (!kLittleEndian) swapWords<Word>(v.data(), n);
+  }
+
+ private:
+  Source& source_;
+  const std::string& name_;
+};
 
 }  // namespace
 
@@ -184,13 +254,16 @@ Provenance parseProvenance(const std::string& text, const std::string& name) {
   return p;
 }
 
-std::vector<uint8_t> encodeHair(const Strands& s) {
+namespace {
+
+void encodeHairTo(const Strands& s, Writer& w) {
   s.validate("strands to write");
   const size_t strandCount = s.strandCount(), pointCount = s.pointCount();
   if (strandCount > std::numeric_limits<uint32_t>::max() || pointCount > std::numeric_limits<uint32_t>::max())
     throw InputError("too many strands or points for a .hair file (at most 2^32 - 1 each)");
 
   bool uniform = strandCount > 0;
+  std::vector<uint16_t> segments(strandCount);
   for (size_t i = 0; i < strandCount; ++i) {
     uint32_t n = s.pointsOf(i);
     if (n == 0)
@@ -199,11 +272,11 @@ std::vector<uint8_t> encodeHair(const Strands& s) {
       throw InputError("strand " + std::to_string(i) + " has " + std::to_string(n) +
                        " points; .hair allows 65536");
     if (n != s.pointsOf(0)) uniform = false;
+    segments[i] = static_cast<uint16_t>(n - 1);
   }
   uint32_t flags = kPoints | (uniform ? 0 : kSegments) | (s.thickness.empty() ? 0 : kThickness) |
                    (s.transparency.empty() ? 0 : kTransparency) | (s.colors.empty() ? 0 : kColor);
 
-  Writer w;
   w.bytes("HAIR", 4);
   w.u32(static_cast<uint32_t>(strandCount));
   w.u32(static_cast<uint32_t>(pointCount));
@@ -217,65 +290,40 @@ std::vector<uint8_t> encodeHair(const Strands& s) {
   std::memcpy(info, text.data(), std::min(text.size(), kInfoSize - 1));
   w.bytes(info, kInfoSize);
 
-  if (flags & kSegments)
-    for (size_t i = 0; i < strandCount; ++i) w.u16(static_cast<uint16_t>(s.pointsOf(i) - 1));
-  for (const glm::vec3& p : s.points) w.vec(p);
-  for (float t : s.thickness) w.f32(t);
-  for (float t : s.transparency) w.f32(t);
-  for (const glm::vec3& c : s.colors) w.vec(c);
+  if (flags & kSegments) w.array<2>(segments);
+  w.array<4>(s.points);
+  w.array<4>(s.thickness);
+  w.array<4>(s.transparency);
+  w.array<4>(s.colors);
 
-  std::vector<std::pair<const char*, std::vector<uint8_t>>> chunks;
-  auto vec3s = [](const std::vector<glm::vec3>& v) {
-    return payload([&](Writer& p) {
-      for (auto& x : v) p.vec(x);
-    });
-  };
-  auto u32s = [](const std::vector<uint32_t>& v) {
-    return payload([&](Writer& p) {
-      for (auto x : v) p.u32(x);
-    });
-  };
-  if (!s.tangents.empty()) chunks.emplace_back("TANG", vec3s(s.tangents));
-  if (!s.normals.empty()) chunks.emplace_back("NORM", vec3s(s.normals));
-  if (!s.strandId.empty()) chunks.emplace_back("SIDS", u32s(s.strandId));
-  if (!s.rootTriangle.empty()) chunks.emplace_back("RTRI", u32s(s.rootTriangle));
-  if (!s.rootBary.empty()) chunks.emplace_back("RBAR", vec3s(s.rootBary));
-  if (!s.rootUv.empty())
-    chunks.emplace_back("RUVS", payload([&](Writer& p) {
-                          for (auto& x : s.rootUv) {
-                            p.f32(x.x);
-                            p.f32(x.y);
-                          }
-                        }));
-  if (!s.guideIds.empty())
-    chunks.emplace_back("GIDS", payload([&](Writer& p) {
-                          for (auto& x : s.guideIds) {
-                            p.u32(x.x);
-                            p.u32(x.y);
-                            p.u32(x.z);
-                          }
-                        }));
-  if (!s.guideWeights.empty()) chunks.emplace_back("GWTS", vec3s(s.guideWeights));
-  if (!s.simulationState.empty())
-    chunks.emplace_back("DYNS", payload([&](Writer& p) {
-                          for (double v : s.simulationState) p.f64(v);
-                        }));
-  if (!s.provenance.empty()) {
-    std::string prov = provenanceText(s.provenance);
-    chunks.emplace_back("PROV", std::vector<uint8_t>(prov.begin(), prov.end()));
-  }
+  const std::string prov = s.provenance.empty() ? std::string() : provenanceText(s.provenance);
+  const std::vector<char> provBytes(prov.begin(), prov.end());
+  const uint32_t chunks = !s.tangents.empty() + !s.normals.empty() + !s.strandId.empty() +
+                          !s.rootTriangle.empty() + !s.rootBary.empty() + !s.rootUv.empty() +
+                          !s.guideIds.empty() + !s.guideWeights.empty() + !s.simulationState.empty() +
+                          !prov.empty();
   w.bytes("HGEN", 4);
   w.u32(kBlockVersion);
-  w.u32(static_cast<uint32_t>(chunks.size()));
-  for (const auto& [tag, bytes] : chunks) chunk(w, tag, bytes);
-  return std::move(w.out);
+  w.u32(chunks);
+  if (!s.tangents.empty()) chunk<4>(w, "TANG", s.tangents);
+  if (!s.normals.empty()) chunk<4>(w, "NORM", s.normals);
+  if (!s.strandId.empty()) chunk<4>(w, "SIDS", s.strandId);
+  if (!s.rootTriangle.empty()) chunk<4>(w, "RTRI", s.rootTriangle);
+  if (!s.rootBary.empty()) chunk<4>(w, "RBAR", s.rootBary);
+  if (!s.rootUv.empty()) chunk<4>(w, "RUVS", s.rootUv);
+  if (!s.guideIds.empty()) chunk<4>(w, "GIDS", s.guideIds);
+  if (!s.guideWeights.empty()) chunk<4>(w, "GWTS", s.guideWeights);
+  if (!s.simulationState.empty()) chunk<8>(w, "DYNS", s.simulationState);
+  if (!prov.empty()) chunk<1>(w, "PROV", provBytes);
 }
 
-Strands decodeHair(const uint8_t* data, size_t size, const std::string& name, HairHeader* headerOut) {
-  Reader r(data, size, name);
+Strands decodeHairFrom(Source& source, const std::string& name, HairHeader* headerOut) {
+  Reader r(source, name);
   HairHeader header;
   r.need(kHeaderSize, "the 128-byte header");
-  if (std::memcmp(r.take(4), "HAIR", 4) != 0)
+  char magic[4];
+  r.bytes(magic, 4);
+  if (std::memcmp(magic, "HAIR", 4) != 0)
     throw InputError({name, 0}, "not a .hair file: it does not start with \"HAIR\"");
   const uint64_t strandCount = r.u32(), pointCount = r.u32();
   header.flags = r.u32();
@@ -284,7 +332,8 @@ Strands decodeHair(const uint8_t* data, size_t size, const std::string& name, Ha
   s.defaultThickness = r.f32();
   s.defaultTransparency = r.f32();
   s.defaultColor = r.vec();
-  const char* info = reinterpret_cast<const char*>(r.take(kInfoSize));
+  char info[kInfoSize];
+  r.bytes(info, kInfoSize);
   header.info.assign(info, strnlen(info, kInfoSize));
   if (!(header.flags & kPoints))
     throw InputError({name, 0}, "the file has no points array (flag 2 is not set)");
@@ -302,10 +351,11 @@ Strands decodeHair(const uint8_t* data, size_t size, const std::string& name, Ha
                                     std::to_string(pointCount) + " points; every strand needs at least one");
   s.firstPoint.resize(strandCount + 1);
   s.firstPoint[0] = 0;
+  std::vector<uint16_t> segments;
+  if (header.flags & kSegments) r.array<2>(segments, strandCount);
   uint64_t total = 0;
   for (uint64_t i = 0; i < strandCount; ++i) {
-    uint64_t segments = header.flags & kSegments ? r.u16() : header.defaultSegments;
-    total += segments + 1;
+    total += uint64_t(header.flags & kSegments ? segments[i] : header.defaultSegments) + 1;
     if (total > pointCount)
       throw InputError({name, 0}, "the strands' segment counts need more than the " +
                                       std::to_string(pointCount) + " points the header declares (strand " +
@@ -315,25 +365,16 @@ Strands decodeHair(const uint8_t* data, size_t size, const std::string& name, Ha
   if (total != pointCount)
     throw InputError({name, 0}, "the strands' segment counts cover " + std::to_string(total) +
                                     " points but the header declares " + std::to_string(pointCount));
-  s.points.resize(pointCount);
-  for (glm::vec3& p : s.points) p = r.vec();
-  if (header.flags & kThickness) {
-    s.thickness.resize(pointCount);
-    for (float& t : s.thickness) t = r.f32();
-  }
-  if (header.flags & kTransparency) {
-    s.transparency.resize(pointCount);
-    for (float& t : s.transparency) t = r.f32();
-  }
-  if (header.flags & kColor) {
-    s.colors.resize(pointCount);
-    for (glm::vec3& c : s.colors) c = r.vec();
-  }
+  r.array<4>(s.points, pointCount);
+  if (header.flags & kThickness) r.array<4>(s.thickness, pointCount);
+  if (header.flags & kTransparency) r.array<4>(s.transparency, pointCount);
+  if (header.flags & kColor) r.array<4>(s.colors, pointCount);
 
   const bool blockFound = r.remaining() > 0;
   if (blockFound) {
     r.need(12, "the hairgen chunk block header");
-    if (std::memcmp(r.take(4), "HGEN", 4) != 0)
+    r.bytes(magic, 4);
+    if (std::memcmp(magic, "HGEN", 4) != 0)
       throw InputError({name, 0},
                        std::to_string(r.remaining() + 4) +
                            " unexpected bytes after the cyHair arrays (not a hairgen chunk block)");
@@ -344,75 +385,51 @@ Strands decodeHair(const uint8_t* data, size_t size, const std::string& name, Ha
     uint32_t chunkCount = r.u32();
     for (uint32_t c = 0; c < chunkCount; ++c) {
       r.need(12, "chunk " + std::to_string(c) + "'s header");
-      const uint8_t* head = r.take(12);
+      uint8_t head[12];
+      r.bytes(head, 12);
       std::string tag(reinterpret_cast<const char*>(head), 4);
       uint64_t length = 0;
       for (int i = 0; i < 8; ++i) length |= uint64_t(head[4 + i]) << (8 * i);
       r.need(length, "chunk '" + tag + "'");
       r.need(length + 4, "chunk '" + tag + "' and its CRC");
-      const uint8_t* bytes = r.take(length);
-      uint32_t stored = r.u32();
-      uLong crc = crc32_z(crc32(0L, head, 12), bytes, length);
-      if (static_cast<uint32_t>(crc) != stored)
-        throw InputError({name, 0}, "chunk '" + tag + "' fails its CRC-32 check: the file is corrupt");
       for (const std::string& seen : header.chunks)
         if (seen == tag) throw InputError({name, 0}, "chunk '" + tag + "' appears twice");
       header.chunks.push_back(tag);
 
-      Reader p(bytes, length, name);
-      auto expect = [&](uint64_t count, uint64_t bytesEach) {
+      // The payload, read straight into the array it fills when its size is the one expected.
+      auto sized = [&](uint64_t count, uint64_t bytesEach) {
         if (length != count * bytesEach)
           throw InputError({name, 0}, "chunk '" + tag + "' holds " + std::to_string(length) +
                                           " bytes, expected " + std::to_string(count * bytesEach));
+        return count;
       };
-      auto readVec3 = [&](std::vector<glm::vec3>& v, uint64_t count) {
-        expect(count, 12);
-        v.resize(count);
-        for (auto& x : v) x = p.vec();
-      };
-      auto readU32 = [&](std::vector<uint32_t>& v, uint64_t count) {
-        expect(count, 4);
-        v.resize(count);
-        for (auto& x : v) x = p.u32();
-      };
+      uint32_t crc = uint32_t(crc32(0L, head, 12));
+      std::vector<char> other;
       if (tag == "TANG")
-        readVec3(s.tangents, pointCount);
+        r.array<4>(s.tangents, sized(pointCount, 12), &crc);
       else if (tag == "NORM")
-        readVec3(s.normals, pointCount);
+        r.array<4>(s.normals, sized(pointCount, 12), &crc);
       else if (tag == "SIDS")
-        readU32(s.strandId, strandCount);
+        r.array<4>(s.strandId, sized(strandCount, 4), &crc);
       else if (tag == "RTRI")
-        readU32(s.rootTriangle, strandCount);
+        r.array<4>(s.rootTriangle, sized(strandCount, 4), &crc);
       else if (tag == "RBAR")
-        readVec3(s.rootBary, strandCount);
+        r.array<4>(s.rootBary, sized(strandCount, 12), &crc);
       else if (tag == "GWTS")
-        readVec3(s.guideWeights, strandCount);
-      else if (tag == "RUVS") {
-        expect(strandCount, 8);
-        s.rootUv.resize(strandCount);
-        for (auto& x : s.rootUv) {
-          x.x = p.f32();
-          x.y = p.f32();
-        }
-      } else if (tag == "GIDS") {
-        expect(strandCount, 12);
-        s.guideIds.resize(strandCount);
-        for (auto& x : s.guideIds) {
-          x.x = p.u32();
-          x.y = p.u32();
-          x.z = p.u32();
-        }
-      } else if (tag == "DYNS") {
+        r.array<4>(s.guideWeights, sized(strandCount, 12), &crc);
+      else if (tag == "RUVS")
+        r.array<4>(s.rootUv, sized(strandCount, 8), &crc);
+      else if (tag == "GIDS")
+        r.array<4>(s.guideIds, sized(strandCount, 12), &crc);
+      else if (tag == "DYNS") {
         if (length % 8) throw InputError({name, 0}, "chunk 'DYNS' is not a whole number of float64 values");
-        s.simulationState.resize(length / 8);
-        for (double& v : s.simulationState) {
-          uint64_t bits = uint64_t(p.u32());
-          bits |= uint64_t(p.u32()) << 32;
-          std::memcpy(&v, &bits, 8);
-        }
-      } else if (tag == "PROV") {
-        s.provenance = parseProvenance(std::string(reinterpret_cast<const char*>(bytes), length), name);
+        r.array<8>(s.simulationState, length / 8, &crc);
+      } else {
+        r.array<1>(other, length, &crc);  // PROV, or a chunk of a newer hairgen: checked, then skipped
       }
+      if (crc != r.u32())
+        throw InputError({name, 0}, "chunk '" + tag + "' fails its CRC-32 check: the file is corrupt");
+      if (tag == "PROV") s.provenance = parseProvenance(std::string(other.begin(), other.end()), name);
     }
     if (r.remaining() > 0)
       throw InputError({name, 0}, std::to_string(r.remaining()) + " unexpected bytes after the last chunk");
@@ -427,14 +444,32 @@ Strands decodeHair(const uint8_t* data, size_t size, const std::string& name, Ha
   return s;
 }
 
+}  // namespace
+
+std::vector<uint8_t> encodeHair(const Strands& s) {
+  std::vector<uint8_t> out;
+  Writer w([&](const uint8_t* p, size_t n) { out.insert(out.end(), p, p + n); });
+  encodeHairTo(s, w);
+  return out;
+}
+
+Strands decodeHair(const uint8_t* data, size_t size, const std::string& name, HairHeader* header) {
+  MemorySource source(data, size);
+  return decodeHairFrom(source, name, header);
+}
+
 Strands readHair(const std::filesystem::path& file, HairHeader* header) {
-  std::vector<uint8_t> bytes = readFileBytes(file);
-  return decodeHair(bytes.data(), bytes.size(), file.string(), header);
+  FileSource source(file);
+  return decodeHairFrom(source, file.string(), header);
 }
 
 void writeHair(const std::filesystem::path& file, const Strands& strands) {
-  std::vector<uint8_t> bytes = encodeHair(strands);
-  writeFileAtomic(file, bytes.data(), bytes.size());
+  AtomicFile out(file);
+  Writer w([&](const uint8_t* p, size_t n) {
+    out.stream().write(reinterpret_cast<const char*>(p), std::streamsize(n));
+  });
+  encodeHairTo(strands, w);
+  out.commit();
 }
 
 }  // namespace hairgen

@@ -23,32 +23,9 @@ namespace {
 
 template <typename Container>
 Container readWhole(const fs::path& path) {
-  const FileLoc where{path.string(), 0};
-  // O_NONBLOCK: opening a FIFO must not wait for a writer; fstat then refuses it.
-  const int fd = ::open(path.c_str(), O_RDONLY | O_NONBLOCK | O_CLOEXEC);
-  if (fd < 0) throw InputError(where, std::string("cannot open: ") + std::strerror(errno));
-  struct Closer {
-    int fd;
-    ~Closer() { ::close(fd); }
-  } closer{fd};
-  struct stat st {};
-  if (::fstat(fd, &st) != 0) throw InputError(where, std::string("cannot read: ") + std::strerror(errno));
-  if (S_ISDIR(st.st_mode)) throw InputError(where, "is a directory, expected a file");
-  if (!S_ISREG(st.st_mode))
-    throw InputError(where, "is not a regular file (a FIFO, device or socket); name a file, not a stream");
-  const uint64_t size = uint64_t(st.st_size), budget = memoryBudget();
-  if (size > budget)
-    throw InputError(where, "is " + formatBytes(size) + ", more than the " + formatBytes(budget) +
-                                " of memory this machine has free for it");
-  Container data(static_cast<size_t>(size), 0);
-  size_t done = 0;
-  while (done < data.size()) {
-    const ssize_t n = ::read(fd, reinterpret_cast<char*>(data.data()) + done, data.size() - done);
-    if (n < 0 && errno == EINTR) continue;
-    if (n < 0) throw IoError(where, std::string("read failed: ") + std::strerror(errno));
-    if (n == 0) throw InputError(where, "the file shrank while it was read");
-    done += size_t(n);
-  }
+  InputFile file(path);
+  Container data(static_cast<size_t>(file.size()), 0);
+  file.read(data.data(), data.size());
   return data;
 }
 
@@ -193,6 +170,46 @@ void requireRegularFile(const fs::path& path) {
   if (fs::is_directory(status)) throw InputError(where, "is a directory, expected a file");
   if (!fs::is_regular_file(status))
     throw InputError(where, "is not a regular file (a FIFO, device or socket); name a file, not a stream");
+}
+
+InputFile::InputFile(const fs::path& path) : name_(path.string()) {
+  const FileLoc where{name_, 0};
+  // O_NONBLOCK: opening a FIFO must not wait for a writer; fstat then refuses it.
+  fd_ = ::open(path.c_str(), O_RDONLY | O_NONBLOCK | O_CLOEXEC);
+  if (fd_ < 0) throw InputError(where, std::string("cannot open: ") + std::strerror(errno));
+  struct stat st {};
+  std::string refusal;
+  if (::fstat(fd_, &st) != 0)
+    refusal = std::string("cannot read: ") + std::strerror(errno);
+  else if (S_ISDIR(st.st_mode))
+    refusal = "is a directory, expected a file";
+  else if (!S_ISREG(st.st_mode))
+    refusal = "is not a regular file (a FIFO, device or socket); name a file, not a stream";
+  else if (uint64_t(st.st_size) > memoryBudget())
+    refusal = "is " + formatBytes(uint64_t(st.st_size)) + ", more than the " + formatBytes(memoryBudget()) +
+              " of memory this machine has free for it";
+  if (!refusal.empty()) {
+    ::close(fd_);
+    throw InputError(where, refusal);
+  }
+  size_ = uint64_t(st.st_size);
+}
+
+InputFile::~InputFile() {
+  ::close(fd_);
+}
+
+void InputFile::read(void* out, size_t bytes) {
+  if (bytes > size_ - position_) throw InputError({name_, 0}, "the file shrank while it was read");
+  size_t done = 0;
+  while (done < bytes) {
+    const ssize_t n = ::read(fd_, static_cast<char*>(out) + done, bytes - done);
+    if (n < 0 && errno == EINTR) continue;
+    if (n < 0) throw IoError({name_, 0}, std::string("read failed: ") + std::strerror(errno));
+    if (n == 0) throw InputError({name_, 0}, "the file shrank while it was read");
+    done += size_t(n);
+  }
+  position_ += bytes;
 }
 
 std::string readFileText(const fs::path& path) {

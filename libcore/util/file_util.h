@@ -28,6 +28,27 @@ namespace hairgen {
 std::string readFileText(const std::filesystem::path& path);
 std::vector<uint8_t> readFileBytes(const std::filesystem::path& path);
 
+// An input read piece by piece, with readFileBytes' rules checked when it is opened (a regular file
+// no larger than the memory budget, else an InputError naming it). read() fills exactly `bytes` bytes
+// or throws: a file that ends early ("shrank while it was read") is an InputError, a read error an
+// IoError.
+class InputFile {
+ public:
+  explicit InputFile(const std::filesystem::path& path);
+  ~InputFile();
+  InputFile(const InputFile&) = delete;
+  InputFile& operator=(const InputFile&) = delete;
+
+  uint64_t size() const { return size_; }
+  uint64_t remaining() const { return size_ - position_; }
+  void read(void* out, size_t bytes);
+
+ private:
+  std::string name_;
+  int fd_ = -1;
+  uint64_t size_ = 0, position_ = 0;
+};
+
 // For inputs a library opens by name: an InputError unless `path` is a regular file.
 void requireRegularFile(const std::filesystem::path& path);
 

@@ -8,6 +8,9 @@
 //                       seconds.
 //   CantileverStyling:  Anjyo's figures, 20,000 hairs of 20 segments bent around the head ellipsoid.
 //   SimulateAnjyo:      those hairs through 25 frames of the gust shot while the head turns.
+//   ReadCache/WriteCache: the 150,000-strand coupe's .hair (points, tangents, ids, weights: ~240 MB at 64
+//                       vertices) from and to a file in the system's temporary folder, every core;
+//                       bytes_per_second is the file's size over the time.
 //   Render/strands/width/height/samples: the render stage on coupe 3 with the head and shadows,
 //                       through whatever EGL opens (llvmpipe here); counters give each pass's seconds.
 #include <benchmark/benchmark.h>
@@ -18,6 +21,7 @@
 #include <tbb/info.h>
 
 #include "libcore/config/setup.h"
+#include "libcore/io/hair_io.h"
 #include "libcore/io/obj_io.h"
 #include "libcore/render/gl_context.h"
 #include "stages/cantilever.h"
@@ -220,6 +224,35 @@ const Strands& coupe3Strands(int strands) {
   style.hairDensity = strands / area;
   return made[strands] = interpolate(c.wick, guides, style, c.config.collision, {});
 }
+
+// The .hair cache of the 150,000-strand coupe, written once, then read whole (checked: CRCs, finiteness).
+std::filesystem::path coupeCache() {
+  static const std::filesystem::path file = [] {
+    const std::filesystem::path f = std::filesystem::temp_directory_path() / "hairgen_bench_coupe.hair";
+    writeHair(f, coupe3Strands(150000));
+    return f;
+  }();
+  return file;
+}
+
+void ReadCache(benchmark::State& state) {
+  const std::filesystem::path file = coupeCache();
+  for (auto _ : state) {
+    Strands s = readHair(file);
+    benchmark::DoNotOptimize(s.points.data());
+  }
+  state.SetBytesProcessed(int64_t(state.iterations()) * int64_t(std::filesystem::file_size(file)));
+}
+BENCHMARK(ReadCache)->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(3.0);
+
+void WriteCache(benchmark::State& state) {
+  const Strands& coupe = coupe3Strands(150000);
+  const std::filesystem::path file = std::filesystem::temp_directory_path() / "hairgen_bench_write.hair";
+  for (auto _ : state) writeHair(file, coupe);
+  state.SetBytesProcessed(int64_t(state.iterations()) * int64_t(std::filesystem::file_size(file)));
+  std::filesystem::remove(file);
+}
+BENCHMARK(WriteCache)->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(3.0);
 
 void Render(benchmark::State& state) {
   static GlContext gl;
