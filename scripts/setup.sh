@@ -8,7 +8,7 @@ cd "$(dirname "$0")/.."
 packages=(
   build-essential cmake ninja-build pkg-config git clang-format
   libglm-dev libcli11-dev libtinyobjloader-dev libtinygltf-dev nlohmann-json3-dev libstb-dev
-  libopenexr-dev openexr libopenimageio-dev openimageio-tools libtbb-dev zlib1g-dev
+  libopenexr-dev openexr libopenimageio-dev openimageio-tools libpng-dev libtbb-dev zlib1g-dev
   libopenvdb-dev libopenvdb-tools libboost-dev  # OpenVDB's headers include Boost's; its package does not pull them
   libegl-dev libgl-dev libopengl-dev libegl1 libopengl0 libegl-mesa0 libgl1-mesa-dri libgbm1
   libgtest-dev libgmock-dev libbenchmark-dev

@@ -2,20 +2,24 @@
 
 #include <algorithm>
 #include <cmath>
+#include <mutex>
+#include <string_view>
 
 #include <ImathMatrix.h>
 #include <OpenEXR/ImfChannelList.h>
 #include <OpenEXR/ImfFloatAttribute.h>
 #include <OpenEXR/ImfFrameBuffer.h>
 #include <OpenEXR/ImfHeader.h>
+#include <OpenEXR/ImfInputFile.h>
 #include <OpenEXR/ImfMatrixAttribute.h>
 #include <OpenEXR/ImfOutputFile.h>
 #include <OpenEXR/ImfStandardAttributes.h>
 #include <OpenEXR/ImfStringAttribute.h>
 #include <OpenEXR/ImfVecAttribute.h>
 #include <OpenEXR/openexr.h>
-#include <OpenImageIO/imageio.h>
+#include <dlfcn.h>
 #include <half.h>
+#include <png.h>
 
 #include "libcore/util/error.h"
 #include "libcore/util/file_util.h"
@@ -39,16 +43,6 @@ Imath::M44f toImath(const glm::dmat4& m) {
 // cannot make the reader allocate without bound.
 constexpr int kMaxImageSide = 65536;
 constexpr int kMaxImageChannels = 1024;
-
-// The OpenImageIO format whose extensions include `file`'s (case-insensitively), or "" when none does.
-std::string imageFormatOf(const fs::path& file) {
-  const std::string extension = toLower(file.extension().string());
-  if (extension.size() < 2) return {};
-  for (const auto& [format, extensions] : OIIO::get_extension_map())
-    for (const std::string& e : extensions)
-      if ("." + e == extension) return format;
-  return {};
-}
 
 // Refuses a declared image hairgen does not read or that cannot fit in memory. The header is the
 // attacker's: a 12 kB file can declare a 7 GB image, so this runs before anything is allocated.
@@ -163,54 +157,104 @@ void writeExr(const fs::path& file, const Image& image, const ExrMetadata& metad
   });
 }
 
+namespace {
+
+// libhairgen_images.so (image_module.h), loaded once, the first time an image needs OpenImageIO.
+const ImageModule& imageModule() {
+  static const ImageModule* module = nullptr;
+  static std::string failure;
+  static std::once_flag once;
+  std::call_once(once, [] {
+    std::vector<fs::path> places;
+    std::error_code ec;
+    const fs::path self = fs::read_symlink("/proc/self/exe", ec);
+    if (!ec) places.push_back(self.parent_path() / "libhairgen_images.so");
+    places.push_back(fs::path(HAIRGEN_IMAGE_MODULE));  // where the build put it
+    for (const fs::path& place : places) {
+      void* handle = ::dlopen(place.c_str(), RTLD_NOW | RTLD_LOCAL);
+      if (!handle) {
+        failure = oneLine(::dlerror());
+        continue;
+      }
+      using Entry = const ImageModule* (*)();
+      const auto entry = reinterpret_cast<Entry>(::dlsym(handle, "hairgen_image_module"));
+      if (entry && entry()->version == kImageModuleVersion) {
+        module = entry();
+        return;
+      }
+      failure = place.string() + " is not this hairgen's image module";
+    }
+  });
+  if (!module)
+    throw IoError(
+        "cannot read images other than OpenEXR: hairgen's image module (libhairgen_images.so, "
+        "beside the executable) did not load: " +
+        failure);
+  return *module;
+}
+
+// The first part of an EXR, every channel as float: R, G, B, A first, then the others in the file's
+// order. The header has been checked (checkExrHeader), so nothing here allocates what it declares
+// beyond what fits.
+Image readExr(const fs::path& file, const FileLoc& where) {
+  try {
+    Imf::InputFile in(file.c_str());
+    const Imath::Box2i window = in.header().dataWindow();
+    Image image;
+    image.width = window.max.x - window.min.x + 1;
+    image.height = window.max.y - window.min.y + 1;
+    std::vector<std::string> names;
+    for (auto it = in.header().channels().begin(); it != in.header().channels().end(); ++it) {
+      if (it.channel().xSampling != 1 || it.channel().ySampling != 1)
+        throw InputError(where, "channel " + std::string(it.name()) +
+                                    " is subsampled; hairgen reads full-resolution channels");
+      names.push_back(it.name());
+    }
+    const auto rank = [](const std::string& n) {
+      return n.size() == 1 ? std::min(std::string_view("RGBA").find(n[0]), size_t(4)) : size_t(4);
+    };
+    std::stable_sort(names.begin(), names.end(),
+                     [&](const std::string& a, const std::string& b) { return rank(a) < rank(b); });
+    const size_t pixels = size_t(image.width) * size_t(image.height);
+    Imf::FrameBuffer frame;
+    for (const std::string& name : names) {
+      image.channels.push_back(name);
+      image.planes.emplace_back(pixels);
+      frame.insert(name, Imf::Slice::Make(Imf::FLOAT, image.planes.back().data(), window));
+    }
+    in.setFrameBuffer(frame);
+    in.readPixels(window.min.y, window.max.y);
+    return image;
+  } catch (const InputError&) {
+    throw;
+  } catch (const std::exception& e) {
+    throw InputError(where, "not a readable OpenEXR file: " + oneLine(e.what()));
+  }
+}
+
+}  // namespace
+
 Image readImage(const fs::path& file) {
   requireRegularFile(file);
   const FileLoc where{file.string(), 0};
-  // Only the reader the extension names reads the file. OpenImageIO's open() would otherwise hand a
-  // file its own reader refused to every reader it has (DICOM, FFmpeg, camera RAW, ...): a 1.6 kB
-  // mangled .exr then cost gigabytes (found by tests/fuzz/fuzz_exr).
-  const std::string format = imageFormatOf(file);
-  if (format.empty())
-    throw InputError(where, "no image format has the extension '" + file.extension().string() +
-                                "'; name an image by its format (.exr, .png, .tif, ...)");
-  if (format == "openexr") checkExrHeader(file, where);
-  auto in = OIIO::ImageInput::create(format);
-  if (!in) throw InputError(where, "cannot read image: " + OIIO::geterror());
-  OIIO::ImageSpec spec;
-  if (!in->open(file.string(), spec)) throw InputError(where, "cannot read image: " + in->geterror());
-  if (spec.depth > 1)
-    throw InputError(where,
-                     "declares a volume " + std::to_string(spec.depth) + " pixels deep; expected a 2D image");
-  checkDeclaredSize(where, spec.width, spec.height, spec.nchannels);
-  Image image;
-  image.width = spec.width;
-  image.height = spec.height;
-  const size_t pixels = size_t(spec.width) * spec.height;
-  std::vector<float> interleaved(pixels * spec.nchannels);
-  if (!in->read_image(0, 0, 0, spec.nchannels, OIIO::TypeDesc::FLOAT, interleaved.data()))
-    throw InputError(where, "cannot read image: " + in->geterror());
-  for (int c = 0; c < spec.nchannels; ++c) {
-    image.channels.push_back(spec.channelnames[c]);
-    std::vector<float> plane(pixels);
-    for (size_t i = 0; i < pixels; ++i) plane[i] = interleaved[i * spec.nchannels + c];
-    image.planes.push_back(std::move(plane));
+  if (toLower(file.extension().string()) == ".exr") {
+    checkExrHeader(file, where);
+    return readExr(file, where);
   }
+  Image image;
+  std::string error;
+  if (!imageModule().read(file.c_str(), kMaxImageSide, kMaxImageChannels, memoryBudget(), &image, &error))
+    throw InputError(where, error);
   return image;
 }
 
 ImageHeader readImageHeader(const fs::path& file) {
   requireRegularFile(file);
-  auto in = OIIO::ImageInput::open(file.string());
-  if (!in) throw InputError({file.string(), 0}, "cannot read image: " + oneLine(OIIO::geterror()));
-  const OIIO::ImageSpec& spec = in->spec();
+  const FileLoc where{file.string(), 0};
+  if (toLower(file.extension().string()) == ".exr") checkExrHeader(file, where);
   ImageHeader header;
-  header.format = in->format_name();
-  header.width = spec.width;
-  header.height = spec.height;
-  for (int c = 0; c < spec.nchannels; ++c)
-    header.channels.emplace_back(spec.channelnames[c], spec.channelformat(c).c_str());
-  for (const OIIO::ParamValue& p : spec.extra_attribs)
-    header.attributes.emplace_back(p.name().string(), oneLine(p.get_string(16)));
+  std::string error;
+  if (!imageModule().header(file.c_str(), &header, &error)) throw InputError(where, error);
   return header;
 }
 
@@ -228,15 +272,18 @@ void writePreview(const fs::path& file, const Image& image, const glm::dvec3& ba
       rgb[i * 3 + c] = static_cast<unsigned char>(std::lround(srgb * 255.0));
     }
   }
-  auto out = OIIO::ImageOutput::create(file.string());
-  if (!out) throw IoError("cannot write " + file.string() + ": " + OIIO::geterror());
-  OIIO::ImageSpec spec(image.width, image.height, 3, OIIO::TypeDesc::UINT8);
-  spec.attribute("Software", "hairgen " HAIRGEN_VERSION);
-  writeThroughTemporary(file, [&](const fs::path& temporary) {
-    if (!out->open(temporary.string(), spec) || !out->write_image(OIIO::TypeDesc::UINT8, rgb.data()) ||
-        !out->close())
-      throw IoError("cannot write " + file.string() + ": " + out->geterror());
-  });
+  png_image png{};
+  png.version = PNG_IMAGE_VERSION;
+  png.width = png_uint_32(image.width);
+  png.height = png_uint_32(image.height);
+  png.format = PNG_FORMAT_RGB;
+  png_alloc_size_t bytes = 0;
+  if (!png_image_write_to_memory(&png, nullptr, &bytes, 0, rgb.data(), 0, nullptr))
+    throw IoError("cannot write " + file.string() + ": " + png.message);
+  std::vector<unsigned char> encoded(bytes);
+  if (!png_image_write_to_memory(&png, encoded.data(), &bytes, 0, rgb.data(), 0, nullptr))
+    throw IoError("cannot write " + file.string() + ": " + png.message);
+  writeFileAtomic(file, encoded.data(), bytes);
 }
 
 }  // namespace hairgen

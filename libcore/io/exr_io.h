@@ -10,6 +10,7 @@
 
 #include <glm/glm.hpp>
 
+#include "libcore/io/image_module.h"
 #include "libcore/render/renderer.h"
 
 namespace hairgen {
@@ -24,16 +25,11 @@ struct ExrMetadata {
 
 void writeExr(const std::filesystem::path& file, const Image& image, const ExrMetadata& metadata);
 
-// Any image OpenImageIO reads, every channel as float. Throws InputError naming the file.
+// An image, every channel as float: an EXR with OpenEXR, any other format OpenImageIO reads through
+// hairgen's image module (image_module.h). Throws InputError naming the file.
 Image readImage(const std::filesystem::path& file);
 
-// An image's header without its pixels, for `hairgen info`: size, channels and metadata.
-struct ImageHeader {
-  std::string format;  // OpenImageIO's name of the file format ("openexr")
-  int width = 0, height = 0;
-  std::vector<std::pair<std::string, std::string>> channels;    // name, type ("half", "float")
-  std::vector<std::pair<std::string, std::string>> attributes;  // name, value as text, file order
-};
+// An image's header, for `hairgen info` (through the image module, for every format).
 ImageHeader readImageHeader(const std::filesystem::path& file);
 
 // An 8-bit sRGB PNG for people to look at: premultiplied R G B A over `background` (R G B + (1 − A) ×

@@ -3,9 +3,6 @@
 #include <algorithm>
 #include <cmath>
 
-#include <OpenImageIO/imagebuf.h>
-#include <OpenImageIO/imagebufalgo.h>
-
 #include "libcore/io/exr_io.h"
 #include "libcore/util/text.h"
 
@@ -18,9 +15,8 @@ std::string number(double v) {
   return text;
 }
 
-// A channel pair ready for OpenImageIO: where both hold the same non-finite value the pair is (0, 0);
-// where only one does, the pair is (0, 0) too and the pixel is recorded as infinitely different
-// (compare() skips non-finite values rather than failing on them).
+// A channel pair ready to compare: where both hold the same non-finite value the pair is (0, 0); where
+// only one does, the pair is (0, 0) too and the pixel is recorded as infinitely different.
 struct Prepared {
   std::vector<float> a, b;
   std::vector<size_t> infinite;  // pixels of this channel with a one-sided NaN or infinity
@@ -37,10 +33,33 @@ Prepared prepare(const std::vector<float>& a, const std::vector<float>& b) {
   return p;
 }
 
-OIIO::ImageBuf buffer(int width, int height, int channels, const float* data) {
-  OIIO::ImageBuf buf(OIIO::ImageSpec(width, height, channels, OIIO::TypeDesc::FLOAT));
-  buf.set_pixels(OIIO::ROI::All(), OIIO::TypeDesc::FLOAT, data);
-  return buf;
+// One channel's errors as OpenImageIO's compare (and so idiff) computes them: |a − b| of each float
+// pair (subtracted in float), summed in double for the mean and RMS over every pixel, the largest and
+// the first pixel (in scanline order) that has it.
+struct ChannelErrors {
+  double mean = 0.0, rms = 0.0, max = 0.0;
+  int x = 0, y = 0;
+};
+
+ChannelErrors errorsOf(const Prepared& p, int width) {
+  ChannelErrors e;
+  double sum = 0.0, squares = 0.0;
+  size_t worst = 0;
+  for (size_t i = 0; i < p.a.size(); ++i) {
+    const double d = std::abs(p.a[i] - p.b[i]);
+    sum += d;
+    squares += d * d;
+    if (d > e.max) {
+      e.max = d;
+      worst = i;
+    }
+  }
+  const double n = p.a.empty() ? 1.0 : double(p.a.size());
+  e.mean = sum / n;
+  e.rms = std::sqrt(squares / n);
+  e.x = int(worst % size_t(width));
+  e.y = int(worst / size_t(width));
+  return e;
 }
 
 }  // namespace
@@ -65,8 +84,9 @@ ImageDiff diffImages(const Image& a, const Image& b, const std::vector<std::stri
   }
 
   const size_t pixels = size_t(a.width) * size_t(a.height), nc = names.size();
-  std::vector<float> interleavedA(pixels * nc), interleavedB(pixels * nc);
-  std::vector<char> infinitePixel(pixels, 0);
+  // A pixel fails when any of its channels does, and counts once.
+  std::vector<char> failing(pixels, 0);
+  const float failThreshold = float(thresholds.fail);
   diff.difference.width = a.width;
   diff.difference.height = a.height;
   diff.worst = 0.0;
@@ -74,24 +94,16 @@ ImageDiff diffImages(const Image& a, const Image& b, const std::vector<std::stri
     const std::vector<float>& pa = a.plane(names[c]);
     const std::vector<float>& pb = b.plane(names[c]);
     const Prepared p = prepare(pa, pb);
-    for (size_t i = 0; i < pixels; ++i) {
-      interleavedA[i * nc + c] = p.a[i];
-      interleavedB[i * nc + c] = p.b[i];
-    }
     ChannelDiff stats{names[c]};
-    OIIO::ImageBuf ca = buffer(a.width, a.height, 1, p.a.data()),
-                   cb = buffer(a.width, a.height, 1, p.b.data());
-    const OIIO::ImageBufAlgo::CompareResults r =
-        OIIO::ImageBufAlgo::compare(ca, cb, float(thresholds.fail), float(thresholds.fail));
-    stats.mean = r.meanerror;
-    stats.rms = r.rms_error;
-    stats.max = r.maxerror;
-    int x = r.maxx, y = r.maxy;
+    const ChannelErrors r = errorsOf(p, a.width);
+    stats.mean = r.mean;
+    stats.rms = r.rms;
+    stats.max = r.max;
+    int x = r.x, y = r.y;
     if (!p.infinite.empty()) {
       stats.mean = stats.rms = stats.max = HUGE_VAL;
       x = int(p.infinite.front() % size_t(a.width));
       y = int(p.infinite.front() / size_t(a.width));
-      for (size_t i : p.infinite) infinitePixel[i] = 1;
     }
     if (stats.max > diff.worst) {
       diff.worst = stats.max;
@@ -102,20 +114,19 @@ ImageDiff diffImages(const Image& a, const Image& b, const std::vector<std::stri
       diff.worstB = pb[size_t(y) * a.width + x];
     }
     std::vector<float> d(pixels);
-    for (size_t i = 0; i < pixels; ++i) d[i] = std::abs(p.a[i] - p.b[i]);
-    for (size_t i : p.infinite) d[i] = HUGE_VALF;
+    for (size_t i = 0; i < pixels; ++i) {
+      d[i] = std::abs(p.a[i] - p.b[i]);
+      if (d[i] > failThreshold) failing[i] = 1;
+    }
+    for (size_t i : p.infinite) {
+      d[i] = HUGE_VALF;
+      failing[i] = 1;
+    }
     diff.difference.channels.push_back(names[c]);
     diff.difference.planes.push_back(std::move(d));
     diff.channels.push_back(stats);
   }
-
-  // A pixel fails when any of its channels does: one comparison over all of them counts it once.
-  OIIO::ImageBuf all = buffer(a.width, a.height, int(nc), interleavedA.data());
-  OIIO::ImageBuf allB = buffer(a.width, a.height, int(nc), interleavedB.data());
-  const OIIO::ImageBufAlgo::CompareResults r =
-      OIIO::ImageBufAlgo::compare(all, allB, float(thresholds.fail), float(thresholds.fail));
-  diff.failingPixels = size_t(r.nfail);
-  for (char f : infinitePixel) diff.failingPixels += f;
+  diff.failingPixels = size_t(std::count(failing.begin(), failing.end(), char(1)));
   diff.failingPercent = pixels ? 100.0 * double(diff.failingPixels) / double(pixels) : 0.0;
 
   if (diff.worst > thresholds.hardFail)

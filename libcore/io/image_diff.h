@@ -1,4 +1,5 @@
-// Golden-image comparison as OpenImageIO's idiff does it (ImageBufAlgo::compare), with its thresholds:
+// Golden-image comparison as OpenImageIO's idiff does it (the statistics of ImageBufAlgo::compare,
+// computed here), with its thresholds:
 // a pixel fails when any channel differs by more than `fail`; the images fail when more than
 // `failPercent` percent of the pixels fail, or when any channel anywhere differs by more than
 // `hardFail`. NaN rule: a NaN in both images at the same place is equal; a NaN (or an infinity) in only

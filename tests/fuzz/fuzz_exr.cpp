@@ -1,13 +1,13 @@
-// Fuzzes readImage (libcore/io/exr_io.h): the input is an OpenEXR file. OpenImageIO reads by file name,
+// Fuzzes readImage (libcore/io/exr_io.h): the input is an OpenEXR file. OpenEXR reads by file name,
 // so each input is written to input.exr in a private folder made once per process (under $TMPDIR,
-// removed at exit) and read from there, as `hairgen diff` reads its images. OpenEXR and OpenImageIO
-// are Debian's builds, not instrumented: their bugs show only as crashes or memory, and coverage guides
-// the fuzzer through hairgen's code alone. Findings: see fuzz_target.h.
+// removed at exit) and read from there, as `hairgen diff` reads its images. OpenEXR (the header
+// checked by OpenEXRCore, the pixels read by its C++ reader) is Debian's build, not instrumented: its
+// bugs show only as crashes or memory, and coverage guides the fuzzer through hairgen's code alone. Findings: see fuzz_target.h.
 //
 // readImage refuses a declared image larger than memoryBudget(), the machine's free memory. Under
 // libFuzzer the process must stay within -rss_limit_mb on any machine, so this target links
 // memoryBudget() to fuzzBudget() below instead (-Wl,--wrap in tests/fuzz/CMakeLists.txt): a quarter of
-// the RSS limit, leaving the rest to ASan's shadow and quarantine and to OpenImageIO's own buffers.
+// the RSS limit, leaving the rest to ASan's shadow and quarantine and to OpenEXR's own buffers.
 #include <cstddef>
 #include <cstdint>
 #include <cstdlib>
