@@ -185,6 +185,12 @@ void registerRender(CLI::App& app, int& exitCode) {
         if (head && sequence && !motion.still()) return posedMesh(*head, motion.pose(f));
         return std::nullopt;
       };
+      if (options->motion && !config.dynamics.given)
+        note(options->common,
+             "hairgen render: no Dynamics Info names the shot's first frame, so frame " +
+                 std::to_string(frames.first) +
+                 " is taken as the first and moves by 0; a range split into jobs gives other "
+                 "vectors where it is split (name the shot's DynamicsInfo in the Setup)");
       if (options->motion && frames.first - 1 >= shotStart) {
         hairFileBefore = frameFile(options->hair, frames.first - 1);
         hairBefore = readStrands(hairFileBefore);

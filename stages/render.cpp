@@ -79,7 +79,8 @@ const Strands& conformed(const Strands& hair, const RenderOptions& options, std:
 }  // namespace
 
 bool sameStrands(const Strands& a, const Strands& b) {
-  return a.firstPoint == b.firstPoint && a.points.size() == b.points.size();
+  return a.firstPoint == b.firstPoint && a.points.size() == b.points.size() &&
+         (a.strandId.empty() || b.strandId.empty() || a.strandId == b.strandId);
 }
 
 RenderOutput render(GlContext& gl, const Strands& hair, const Mesh* head, const Visuality& visuality,

@@ -3,6 +3,8 @@
 
 #include <cstring>
 
+#include <zlib.h>
+
 #include "libcore/io/hair_io.h"
 #include "libcore/util/error.h"
 #include "libcore/util/file_util.h"
@@ -125,6 +127,51 @@ TEST(HairFile, OversizedCountsAreRejectedBeforeAllocating) {
   uint64_t huge = uint64_t(1) << 60;
   std::memcpy(&bad[chunkLength], &huge, 8);
   EXPECT_THROW(decodeHair(bad.data(), bad.size(), "o.hair"), InputError);
+}
+
+// Appends one chunk of a newer hairgen (tag, payload) to a file's block, with a correct CRC.
+std::vector<uint8_t> withChunk(std::vector<uint8_t> bytes, const char tag[4],
+                               const std::vector<uint8_t>& payload) {
+  const size_t block = readCyHair(bytes).bytesRead;
+  uint32_t count = 0;
+  std::memcpy(&count, &bytes[block + 8], 4);
+  ++count;
+  std::memcpy(&bytes[block + 8], &count, 4);
+  std::vector<uint8_t> chunk(tag, tag + 4);
+  const uint64_t length = payload.size();
+  for (int i = 0; i < 8; ++i) chunk.push_back(uint8_t(length >> (8 * i)));
+  chunk.insert(chunk.end(), payload.begin(), payload.end());
+  const uint32_t crc = uint32_t(crc32(0L, chunk.data(), uInt(chunk.size())));
+  for (int i = 0; i < 4; ++i) chunk.push_back(uint8_t(crc >> (8 * i)));
+  bytes.insert(bytes.end(), chunk.begin(), chunk.end());
+  return bytes;
+}
+
+TEST(HairFile, ChunksOfANewerHairgenAreCheckedThenSkippedEmptyOnesToo) {
+  const Strands s = test::sampleStrands(3);
+  for (size_t length : {0, 1, 100}) {
+    const std::vector<uint8_t> bytes = withChunk(encodeHair(s), "NEWC", std::vector<uint8_t>(length, 7));
+    HairHeader header;
+    EXPECT_EQ(decodeHair(bytes.data(), bytes.size(), "n.hair", &header), s) << length << " bytes";
+    EXPECT_EQ(header.chunks.back(), "NEWC");
+  }
+}
+
+TEST(HairFile, AFileOfManyChunksIsRefusedAtOnceAndTagsAreShownEscaped) {
+  std::vector<uint8_t> bytes = withChunk(encodeHair(test::sampleStrands(2)), "\x01\x1b[X", {});
+  HairHeader header;
+  decodeHair(bytes.data(), bytes.size(), "e.hair", &header);
+  EXPECT_EQ(header.chunks.back(), "\\x01\\x1b[X");
+  // A block that declares four billion chunks is refused from its count, not after comparing each.
+  const size_t block = readCyHair(bytes).bytesRead;
+  const uint32_t many = 0xffffffffu;
+  std::memcpy(&bytes[block + 8], &many, 4);
+  try {
+    decodeHair(bytes.data(), bytes.size(), "m.hair");
+    ADD_FAILURE() << "accepted";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("chunks"), std::string::npos) << e.what();
+  }
 }
 
 TEST(HairFile, GarbageAfterArraysAndBadMagicAreErrors) {

@@ -178,7 +178,7 @@ const ImageModule& imageModule() {
       }
       using Entry = const ImageModule* (*)();
       const auto entry = reinterpret_cast<Entry>(::dlsym(handle, "hairgen_image_module"));
-      if (entry && entry()->version == kImageModuleVersion) {
+      if (entry && std::string_view(entry()->build) == kImageModuleBuild) {
         module = entry();
         return;
       }

@@ -2,7 +2,9 @@
 
 #include <algorithm>
 #include <bit>
+#include <cctype>
 #include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <functional>
 #include <limits>
@@ -20,6 +22,9 @@ namespace {
 constexpr uint32_t kSegments = 1, kPoints = 2, kThickness = 4, kTransparency = 8, kColor = 16;
 constexpr size_t kHeaderSize = 128, kInfoSize = 88;
 constexpr uint32_t kBlockVersion = 1;
+constexpr uint32_t kMaxChunks = 1024;
+// The arrays are the bytes of these types: packed floats and uint32s, as the layout says.
+static_assert(sizeof(glm::vec3) == 12 && sizeof(glm::vec2) == 8 && sizeof(glm::uvec3) == 12);
 
 // Arrays of 4- and 8-byte words travel as their bytes on a little-endian machine; elsewhere every word
 // is swapped on its way in and out.
@@ -33,6 +38,7 @@ void swapWords(void* data, size_t bytes) {
 
 // CRC-32 of a large buffer in 8 MB blocks on every core, combined in order: the same value as one pass.
 uint32_t crcOf(uint32_t crc, const uint8_t* data, size_t size) {
+  if (size == 0) return crc;  // zlib answers 0 for a null buffer, which an empty vector's data() may be
   constexpr size_t kBlock = size_t(8) << 20;
   if (size < 2 * kBlock) return uint32_t(crc32_z(crc, data, size));
   const size_t blocks = (size + kBlock - 1) / kBlock;
@@ -383,23 +389,33 @@ Strands decodeHairFrom(Source& source, const std::string& name, HairHeader* head
       throw InputError({name, 0}, "chunk block version " + std::to_string(version) +
                                       " is not supported (this hairgen reads 1)");
     uint32_t chunkCount = r.u32();
+    // hairgen writes a dozen; a file that claims more is refused before each is checked against the
+    // others (which would cost the square of the count).
+    if (chunkCount > kMaxChunks)
+      throw InputError({name, 0}, "declares " + std::to_string(chunkCount) +
+                                      " chunks; hairgen reads at most " + std::to_string(kMaxChunks));
     for (uint32_t c = 0; c < chunkCount; ++c) {
       r.need(12, "chunk " + std::to_string(c) + "'s header");
       uint8_t head[12];
       r.bytes(head, 12);
-      std::string tag(reinterpret_cast<const char*>(head), 4);
+      std::string tag(reinterpret_cast<const char*>(head), 4), shown;
+      for (char ch : tag) {  // the tag as messages and `info` show it: control bytes escaped
+        char hex[5];
+        std::snprintf(hex, sizeof hex, "\\x%02x", unsigned(static_cast<unsigned char>(ch)));
+        shown += std::isprint(static_cast<unsigned char>(ch)) ? std::string(1, ch) : std::string(hex);
+      }
       uint64_t length = 0;
       for (int i = 0; i < 8; ++i) length |= uint64_t(head[4 + i]) << (8 * i);
-      r.need(length, "chunk '" + tag + "'");
-      r.need(length + 4, "chunk '" + tag + "' and its CRC");
+      r.need(length, "chunk '" + shown + "'");
+      r.need(length + 4, "chunk '" + shown + "' and its CRC");
       for (const std::string& seen : header.chunks)
-        if (seen == tag) throw InputError({name, 0}, "chunk '" + tag + "' appears twice");
-      header.chunks.push_back(tag);
+        if (seen == shown) throw InputError({name, 0}, "chunk '" + shown + "' appears twice");
+      header.chunks.push_back(shown);
 
       // The payload, read straight into the array it fills when its size is the one expected.
       auto sized = [&](uint64_t count, uint64_t bytesEach) {
         if (length != count * bytesEach)
-          throw InputError({name, 0}, "chunk '" + tag + "' holds " + std::to_string(length) +
+          throw InputError({name, 0}, "chunk '" + shown + "' holds " + std::to_string(length) +
                                           " bytes, expected " + std::to_string(count * bytesEach));
         return count;
       };
@@ -428,7 +444,7 @@ Strands decodeHairFrom(Source& source, const std::string& name, HairHeader* head
         r.array<1>(other, length, &crc);  // PROV, or a chunk of a newer hairgen: checked, then skipped
       }
       if (crc != r.u32())
-        throw InputError({name, 0}, "chunk '" + tag + "' fails its CRC-32 check: the file is corrupt");
+        throw InputError({name, 0}, "chunk '" + shown + "' fails its CRC-32 check: the file is corrupt");
       if (tag == "PROV") s.provenance = parseProvenance(std::string(other.begin(), other.end()), name);
     }
     if (r.remaining() > 0)

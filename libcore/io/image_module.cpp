@@ -108,7 +108,7 @@ bool header(const char* path, ImageHeader* out, std::string* error) try {
   return false;
 }
 
-const ImageModule kModule{kImageModuleVersion, read, header};
+const ImageModule kModule{kImageModuleBuild, read, header};
 
 }  // namespace
 }  // namespace hairgen

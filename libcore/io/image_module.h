@@ -28,14 +28,14 @@ struct ImageHeader {
 };
 
 struct ImageModule {
-  int version;  // kImageModuleVersion: a module from another build is refused
+  const char* build;  // kImageModuleBuild: a module from another version or compiler is refused
   // Reads the image with the reader that `path`'s extension names, every channel as float; refuses one
   // that declares more than `maxSide` pixels a side, `maxChannels` channels or `budget` bytes.
   bool (*read)(const char* path, int maxSide, int maxChannels, uint64_t budget, Image* out,
                std::string* error);
   bool (*header)(const char* path, ImageHeader* out, std::string* error);
 };
-constexpr int kImageModuleVersion = 1;
+inline constexpr const char* kImageModuleBuild = HAIRGEN_VERSION " " __VERSION__;
 
 }  // namespace hairgen
 

@@ -2,7 +2,8 @@
 // so each input is written to input.exr in a private folder made once per process (under $TMPDIR,
 // removed at exit) and read from there, as `hairgen diff` reads its images. OpenEXR (the header
 // checked by OpenEXRCore, the pixels read by its C++ reader) is Debian's build, not instrumented: its
-// bugs show only as crashes or memory, and coverage guides the fuzzer through hairgen's code alone. Findings: see fuzz_target.h.
+// bugs show only as crashes or memory, and coverage guides the fuzzer through hairgen's code alone. Findings:
+// see fuzz_target.h.
 //
 // readImage refuses a declared image larger than memoryBudget(), the machine's free memory. Under
 // libFuzzer the process must stay within -rss_limit_mb on any machine, so this target links

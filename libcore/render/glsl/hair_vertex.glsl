@@ -72,7 +72,9 @@ void main() {
 #ifdef MOTION
   // Both ends the same way, so what did not move moved by exactly 0.
   vec4 now = uViewProj * vec4(p, 1.0), before = uPreviousViewProj * vec4(previous, 1.0);
-  vMotion = (now.xy / now.w - before.xy / before.w) * 0.5 * uImageSize;
+  // A point at or behind the camera (w <= 0) in either frame has no place on the image: its w is held
+  // just in front, so the move stays finite and the clipped primitive's motion is large, not NaN.
+  vMotion = (now.xy / max(now.w, 1e-6) - before.xy / max(before.w, 1e-6)) * 0.5 * uImageSize;
 #endif
 #ifdef RIBBON
   float side = (gl_VertexID & 1) == 0 ? -1.0 : 1.0;

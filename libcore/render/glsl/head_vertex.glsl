@@ -19,7 +19,9 @@ void main() {
   gl_Position = uProj * view;
 #ifdef MOTION
   vec4 now = uViewProj * vec4(aPosition, 1.0), before = uPreviousViewProj * vec4(aPrevious, 1.0);
-  vMotion = (now.xy / now.w - before.xy / before.w) * 0.5 * uImageSize;
+  // A point at or behind the camera (w <= 0) in either frame has no place on the image: its w is held
+  // just in front, so the move stays finite and the clipped primitive's motion is large, not NaN.
+  vMotion = (now.xy / max(now.w, 1e-6) - before.xy / max(before.w, 1e-6)) * 0.5 * uImageSize;
 #endif
   vWorld = aPosition;
   vNormal = aNormal;
