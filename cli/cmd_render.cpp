@@ -155,8 +155,7 @@ void registerRender(CLI::App& app, int& exitCode) {
       auto frameFile = [&](const std::string& pattern, int f) {
         return sequence && !pattern.empty() ? framePath(pattern, f).string() : pattern;
       };
-      std::optional<Mesh> head;
-      if (config.setup.headModel.given()) head = readObj(config.setup.headModel.path);
+      std::optional<Mesh> head = readScene(options->common, config, false, true, stats).head;
       const HeadMotion motion = headMotionOf(config);
       stats.time("read", clock.lap());
       RenderOptions renderOptions;

@@ -60,7 +60,7 @@ void runShot(const CommonOptions& common, const Config& config, const Mesh& wick
   const HeadMotion motion = headMotionOf(config);
   const bool shaded = wantsShade(config.visuality, config.render);
   std::optional<Mesh> head;
-  if (render && config.setup.headModel.given()) head = readObj(config.setup.headModel.path);
+  if (render && config.setup.headModel.given()) head = readHead(config);
   std::unique_ptr<GlContext> gl;
   if (render) gl = openDevice(common, config, stats);
   const fs::path simPattern = out / "sim" / "guides.####.hair", exrPattern = out / "beauty.####.exr",
@@ -160,7 +160,7 @@ void registerRun(CLI::App& app, int& exitCode) {
         note(options->common, "run: loaded " + config.setup.loadFile.path.string() + " (" +
                                   std::to_string(coupe.strandCount()) + " strands)");
       } else {
-        wick = readObj(config.setup.wickModel.path);
+        wick = *readScene(options->common, config, true, false, stats).wick;
         stats.add("read", clock.lap());
         // Every stage's work is estimated before the first starts: a coupe that cannot be rendered is
         // refused before minutes of growing.
@@ -193,7 +193,7 @@ void registerRun(CLI::App& app, int& exitCode) {
         runShot(options->common, config, wick, grown.guides, coupe, out, !options->noRender, stats);
       } else if (!options->noRender) {
         std::optional<Mesh> head;
-        if (config.setup.headModel.given()) head = readObj(config.setup.headModel.path);
+        if (config.setup.headModel.given()) head = readHead(config);
         const std::unique_ptr<GlContext> gl = openDevice(options->common, config, stats);
         RenderOutput image =
             renderStage(options->common, config, *gl, coupe, head ? &*head : nullptr, {}, stats);

@@ -12,6 +12,7 @@
 
 #include "libcore/config/params.h"
 #include "libcore/config/setup.h"
+#include "libcore/model/mesh.h"
 #include "libcore/model/strands.h"
 #include "libcore/model/units.h"
 #include "libcore/util/error.h"
@@ -70,6 +71,20 @@ void addUnitFlags(CLI::App& command, UnitOptions& options, const std::string& fi
 UnitConversion unitConversion(const UnitOptions& options);
 // Reads strands (readStrands) and applies the options' conversion, recorded in their provenance.
 Strands readStrandsAs(const std::string& file, const UnitOptions& options);
+
+// The meshes of a job, read as the Setup says (MeshUnits, MeshUpAxis, WickGroup) so that they are in
+// metres, +y up, with the `auto` collision shapes fitted to them.
+struct Scene {
+  std::optional<Mesh> wick;  // when the command needs it and the Setup names one
+  std::optional<Mesh> head;  // when the command needs it, or a shape is fitted to it
+};
+Mesh readWick(const Config& config);
+Mesh readHead(const Config& config);
+// Reads the meshes, fits `config.collision`'s auto shapes, and judges the scene (checkScene, and
+// with `estimates` the work of every stage of `hairgen run`): a refusal is an InputError (exit 2)
+// unless --force, a memory refusal always; warnings go to stderr. Records the meshes' conversion in
+// `stats`.
+Scene readScene(const CommonOptions& options, Config& config, bool needWick, bool needHead, Stats& stats);
 
 // "1.23 s"
 std::string formatSeconds(double seconds);

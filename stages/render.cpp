@@ -7,6 +7,7 @@
 #include "libcore/render/views.h"
 #include "libcore/util/error.h"
 #include "stages/estimate.h"
+#include "stages/scene.h"
 
 namespace hairgen {
 
@@ -84,7 +85,10 @@ RenderOutput render(GlContext& gl, const Strands& hair, const Mesh* head, const 
   input.head = head;
   input.visuality = visuality;
   input.settings = settings;
-  if (options.frame) frameHair(input.settings, *input.hair);
+  if (options.frame)
+    frameHair(input.settings, *input.hair);
+  else if (settings.cameraAuto)
+    frameScene(input.settings, *input.hair, head);
   input.shaders = shaders;
   input.domResolution =
       options.domResolution > 0 ? options.domResolution : domResolutionFor(settings.resolution);
