@@ -162,6 +162,10 @@ void registerRun(CLI::App& app, int& exitCode) {
       } else {
         wick = *readScene(options->common, config, true, false, stats).wick;
         stats.add("read", clock.lap());
+        if (wick.triangles.empty())  // refused before minutes of growing, not after
+          throw InputError({config.setup.wickModel.path.string(), 0},
+                           "the wick has no faces, only points (roots): `hairgen grow` grows guides on them, "
+                           "but run interpolates strands over a surface and needs one (a scalp mesh)");
         // Every stage's work is estimated before the first starts: a coupe that cannot be rendered is
         // refused before minutes of growing.
         for (const WorkEstimate& e :

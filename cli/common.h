@@ -41,9 +41,15 @@ void addCommonFlags(CLI::App& command, CommonOptions& options, bool configFlags)
 std::vector<Override> parseOverrides(const CommonOptions& options);
 
 // Collects timings and counts for --stats.
+// Every file has the same keys, in camelCase: command, version, configDigest and seed (commands that read
+// a Setup), overrides, seconds, counts, outputs (the files written), peakMemoryBytes, exitCode, and on
+// failure error. A command that fails still writes its --stats file, with what it had gathered.
 class Stats {
  public:
   explicit Stats(std::string command);
+  ~Stats();  // while a command fails, hands what it gathered to runCommand's --stats file
+  Stats(const Stats&) = delete;
+  Stats& operator=(const Stats&) = delete;
   void time(const std::string& phase, double seconds) { json_["seconds"][phase] = seconds; }
   // Adds to a phase's time (a phase done in several pieces).
   void add(const std::string& phase, double seconds) {
@@ -58,6 +64,7 @@ class Stats {
  private:
   std::chrono::steady_clock::time_point start_;
   nlohmann::ordered_json json_;
+  int exceptions_ = 0;  // std::uncaught_exceptions() when made
 };
 
 // --units and --up-axis: the lengths and up axis of a strand file made elsewhere (PLY, .data, a cyHair

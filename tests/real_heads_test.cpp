@@ -12,9 +12,11 @@
 #include <filesystem>
 #include <fstream>
 #include <iostream>
+#include <optional>
 #include <sstream>
 #include <string>
 
+#include "libcore/config/setup.h"
 #include "libcore/io/exr_io.h"
 #include "libcore/io/hair_cache.h"
 #include "libcore/io/obj_io.h"
@@ -56,6 +58,52 @@ double distanceToMesh(const glm::dvec3& p, const Mesh& m) {
   return best;
 }
 
+struct Figures {
+  double worstRoot = 0.0;       // metres from the scalp
+  double insideFraction = 0.0;  // of the points past 1 cm of arc length
+  double coverage = 0.0;        // of the image's pixels
+};
+
+// The three figures of a `hairgen run` output folder, against `scalp` (metres, y up) and the head
+// fitted as `Ellipsoid auto` fits it.
+Figures measure(const fs::path& out, const Mesh& scalp, const Mesh* head) {
+  Figures f;
+  const Strands coupe = readStrands(out / "coupe.hair");
+  const Strands guides = readStrands(out / "guides.hair");
+  for (const Strands* s : {&guides, &coupe})
+    for (size_t i = 0; i < s->strandCount(); i += 7) {
+      const glm::dvec3 root(s->points[s->firstPoint[i]]);
+      double d = HUGE_VAL;
+      if (scalp.triangles.empty())
+        for (const glm::vec3& p : scalp.positions) d = std::min(d, glm::length(root - glm::dvec3(p)));
+      else
+        d = distanceToMesh(root, scalp);
+      f.worstRoot = std::max(f.worstRoot, d);
+    }
+  Collision fitted;
+  fitted.shapes.push_back(CollisionShape{});
+  fitted.shapes[0].kind = ShapeKind::kEllipsoid;
+  fitted.shapes[0].fitted = true;
+  fitCollision(fitted, scalp, head);
+  const CollisionShape& e = fitted.shapes[0];
+  size_t counted = 0, inside = 0;
+  for (size_t i = 0; i < coupe.strandCount(); ++i) {
+    double arc = 0.0;
+    for (uint32_t p = coupe.firstPoint[i] + 1; p < coupe.firstPoint[i + 1]; ++p) {
+      arc += glm::length(coupe.points[p] - coupe.points[p - 1]);
+      if (arc < 0.01) continue;
+      ++counted;
+      inside += glm::length((glm::dvec3(coupe.points[p]) - e.centre) / e.halfExtents) < 1.0;
+    }
+  }
+  f.insideFraction = double(inside) / double(std::max<size_t>(counted, 1));
+  const std::vector<float>& opacity = readImage(out / "beauty.exr").plane("opacity.Y");
+  size_t covered = 0;
+  for (float o : opacity) covered += o > 0.0f;
+  f.coverage = double(covered) / double(opacity.size());
+  return f;
+}
+
 struct Variant {
   const char* name;
   double metresPerUnit;  // the file's unit
@@ -66,6 +114,23 @@ struct Variant {
 }  // namespace
 
 int main(int argc, char** argv) {
+  if (argc == 4 && std::string(argv[1]) == "--measure") {  // --measure SETUP OUT: a run made by hand
+    const Config config = loadConfig(argv[2], {}, SetupUse::kRun);
+    MeshReadOptions options;
+    options.group = config.setup.wickGroup;
+    options.allowPoints = true;
+    options.conversion = config.setup.meshConversion;
+    const Mesh scalp = readObj(config.setup.wickModel.path, options);
+    std::optional<Mesh> head;
+    if (config.setup.headModel.given())
+      head = readObj(config.setup.headModel.path, {"", false, options.conversion});
+    const Figures f = measure(argv[3], scalp, head ? &*head : nullptr);
+    std::printf(
+        "roots within %.3f mm of the scalp, %.2f%% of points past 1 cm inside the fitted head, hair "
+        "covers %.1f%% of the image\n",
+        f.worstRoot * 1e3, f.insideFraction * 100, f.coverage * 100);
+    return 0;
+  }
   if (argc != 4) {
     std::cerr << "usage: real_heads_test HAIRGEN SOURCE_DIR WORK_DIR\n";
     return 2;
@@ -112,34 +177,8 @@ int main(int argc, char** argv) {
       ++failures;
       continue;
     }
-    const Strands coupe = readStrands(dir / "out/coupe.hair");
-    const Strands guides = readStrands(dir / "out/guides.hair");
-    double worstRoot = 0.0;
-    for (const Strands* s : {&guides, &coupe})
-      for (size_t i = 0; i < s->strandCount(); i += 7)
-        worstRoot = std::max(worstRoot, distanceToMesh(glm::dvec3(s->points[s->firstPoint[i]]), truth));
-    Collision head;
-    head.shapes.push_back(CollisionShape{});
-    head.shapes[0].kind = ShapeKind::kEllipsoid;
-    head.shapes[0].fitted = true;
-    fitCollision(head, truth, nullptr);
-    const CollisionShape& e = head.shapes[0];
-    size_t counted = 0, inside = 0;
-    for (size_t i = 0; i < coupe.strandCount(); ++i) {
-      double arc = 0.0;
-      for (uint32_t p = coupe.firstPoint[i] + 1; p < coupe.firstPoint[i + 1]; ++p) {
-        arc += glm::length(coupe.points[p] - coupe.points[p - 1]);
-        if (arc < 0.01) continue;
-        ++counted;
-        inside += glm::length((glm::dvec3(coupe.points[p]) - e.centre) / e.halfExtents) < 1.0;
-      }
-    }
-    const Image image = readImage(dir / "out/beauty.exr");
-    const std::vector<float>& opacity = image.plane("opacity.Y");
-    size_t covered = 0;
-    for (float o : opacity) covered += o > 0.0f;
-    const double insideFraction = double(inside) / double(std::max<size_t>(counted, 1)),
-                 coverage = double(covered) / double(opacity.size());
+    const Figures f = measure(dir / "out", truth, nullptr);
+    const double worstRoot = f.worstRoot, insideFraction = f.insideFraction, coverage = f.coverage;
     const bool ok = worstRoot < 0.0005 && insideFraction < 0.01 && coverage > 0.05;
     std::printf(
         "%s %s: roots within %.3f mm of the scalp, %.2f%% of points past 1 cm inside the fitted head, "
