@@ -97,6 +97,7 @@ void registerRender(CLI::App& app, int& exitCode) {
     std::string setup, hair, output, dom, preview, frames;
     UnitOptions units;
     double scale = 1.0;
+    std::vector<double> translate;
     bool frame = false, listDevices = false;
   };
   auto options = std::make_shared<Options>();
@@ -118,6 +119,11 @@ void registerRender(CLI::App& app, int& exitCode) {
                                        "Multiply the hair's positions and widths: --units as a factor")
                            ->check(kFiniteNonNegative & CLI::PositiveNumber);
   scale->excludes(cmd->get_option("--units"));
+  cmd->add_option("--translate", options->translate,
+                  "Move the hair by X Y Z metres after --units/--up-axis/--scale, to sit it on the head")
+      ->expected(3)
+      ->type_name("X Y Z")
+      ->check(CLI::Range(-1e4, 1e4));
   cmd->add_flag("--frame", options->frame, "Aim the camera and light at the hair and fit it in the view");
   cmd->add_option(
          "--frames", options->frames,
@@ -163,13 +169,30 @@ void registerRender(CLI::App& app, int& exitCode) {
       const UnitConversion conversion = unitConversion(options->units);
       renderOptions.zUp = conversion.upAxis == UpAxis::kZ;
       renderOptions.scale = conversion.metresPerUnit.value_or(options->scale);
+      // The head of a foreign hair file is usually in the file's units and axis too: it moves with the
+      // hair unless the Setup says how to read it (MeshUnits, MeshUpAxis).
+      const Setup& s = config.setup;
+      if (head && !s.meshConversion.metresPerUnit && !s.meshConversion.upAxis &&
+          (renderOptions.zUp || renderOptions.scale != 1.0)) {
+        UnitConversion headConversion;
+        if (renderOptions.scale != 1.0) headConversion.metresPerUnit = renderOptions.scale;
+        if (renderOptions.zUp) headConversion.upAxis = UpAxis::kZ;
+        for (glm::vec3& p : head->positions) p = headConversion.position(p);
+        for (glm::vec3& n : head->normals) n = headConversion.direction(n);
+      }
       renderOptions.keepDom = !options->dom.empty();
       const std::unique_ptr<GlContext> gl =
           openDevice(options->common, config, stats);  // one for every frame
       Progress progress("render", "frames", size_t(frames.count()), sequence && !options->common.quiet);
       for (int f = frames.first; f <= frames.last; ++f) {
         const std::string hairFile = frameFile(options->hair, f);
-        const Strands hair = readStrands(hairFile);
+        Strands hair = readStrands(hairFile);
+        if (!options->translate.empty()) {
+          // After the render stage's conversion: translate in metres, y up.
+          conform(hair, renderOptions.zUp, renderOptions.scale);
+          const glm::vec3 offset(options->translate[0], options->translate[1], options->translate[2]);
+          for (glm::vec3& p : hair.points) p += offset;
+        }
         if (config.render.shadingModel == ShadingModel::kVolumetric && config.render.volumetricBlend > 0.0 &&
             hair.normals.empty())
           throw InputError({hairFile, 0},
@@ -180,11 +203,16 @@ void registerRender(CLI::App& app, int& exitCode) {
         std::optional<Mesh> posedHead;
         if (head && sequence && !motion.still()) posedHead = posedMesh(*head, motion.pose(f));
         stats.add("read", clock.lap());
+        RenderOptions frameOptions = renderOptions;
+        if (!options->translate.empty()) {  // conformed above
+          frameOptions.zUp = false;
+          frameOptions.scale = 1.0;
+        }
         RenderOutput out = renderStage(options->common, config, *gl, hair,
                                        posedHead ? &*posedHead
                                        : head    ? &*head
                                                  : nullptr,
-                                       renderOptions, stats);
+                                       frameOptions, stats);
         clock.lap();
         // The image's config digest is that of the camera and light it was rendered with (--frame aims them).
         Config rendered = config;
