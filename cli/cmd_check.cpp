@@ -6,6 +6,11 @@
 #include "libcore/config/setup.h"
 #include "libcore/io/info.h"
 #include "libcore/util/json.h"
+#include "stages/estimate.h"
+#include "stages/scene.h"
+#include "stages/shade.h"
+
+#include <tbb/task_arena.h>
 
 namespace hairgen::cli {
 
@@ -40,7 +45,24 @@ void registerCheck(CLI::App& app, int& exitCode) {
       std::vector<Override> overrides = parseOverrides(options->common);
       Config config = loadConfig(options->setup, overrides, SetupUse::kCheck);
       stats.setOverrides(overrides);
-      const nlohmann::ordered_json report = describeSetup(options->setup, config);
+      const Scene scene = readScene(options->common, config, true, true, stats);
+      nlohmann::ordered_json report = describeSetup(
+          options->setup, config, scene.wick ? &*scene.wick : nullptr, scene.head ? &*scene.head : nullptr);
+      if (!config.setup.meshConversion.describe().empty())
+        report["meshConversion"] = config.setup.meshConversion.describe();
+      const std::vector<std::string> fitted = fittedShapeLines(config.collision);
+      if (!fitted.empty()) report["fittedShapes"] = fitted;
+      if (scene.wick && !config.setup.load) {
+        nlohmann::ordered_json work = nlohmann::ordered_json::array();
+        for (const WorkEstimate& e :
+             estimateRun(config, *scene.wick, wantsShade(config.visuality, config.render), true,
+                         size_t(tbb::this_task_arena::max_concurrency()))) {
+          requireFits(e, options->common.force);
+          work.push_back(
+              {{"stage", e.stage}, {"bytes", e.bytes}, {"seconds", e.seconds}, {"detail", e.detail}});
+        }
+        report["work"] = work;
+      }
       stats.json()["report"] = report;
       if (options->canonical) {
         std::cout << config.canonicalText();

@@ -77,7 +77,7 @@ void registerDiff(CLI::App& app, int& exitCode) {
       if (!options->sheet.empty() && !d.difference.planes.empty())
         writeComparisonSheet(options->sheet, a, b, d);
       std::cout << (d.code == ExitCode::kSuccess ? "PASS" : "FAIL: " + d.reason) << "\n";
-      stats.counts()["failing_pixels"] = d.failingPixels;
+      stats.counts()["failingPixels"] = d.failingPixels;
       stats.json()["worst"] = d.worst;
       stats.json()["passed"] = d.code == ExitCode::kSuccess;
       stats.write(options->common);

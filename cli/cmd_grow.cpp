@@ -41,6 +41,8 @@ GrowResult growStage(const CommonOptions& common, const Config& config, const Me
   GrowResult result =
       grow(wick, config.hairstyle, config.collision, GrowOptions{config.digest(), &progress, common.force});
   double seconds = clock.lap();
+  const std::string applied = config.setup.meshConversion.describe();
+  if (!applied.empty()) result.guides.provenance.conversion = "wick: " + applied;
   stats.time("grow", seconds);
   stats.counts()["guides"] = result.guides.strandCount();
   stats.counts()["guidePoints"] = result.guides.pointCount();
@@ -82,9 +84,9 @@ void registerGrow(CLI::App& app, int& exitCode) {
       hairFormatOf(options->output);
       Stopwatch clock;
       Config config = loadStageConfig(options->setup, options->common, SetupUse::kGrow, stats);
-      Mesh wick = readObj(config.setup.wickModel.path);
+      const Scene scene = readScene(options->common, config, true, false, stats);
       stats.time("read", clock.lap());
-      GrowResult result = growStage(options->common, config, wick, stats);
+      GrowResult result = growStage(options->common, config, *scene.wick, stats);
       if (!options->diagnostics.empty())
         writeDiagnostics(options->diagnostics, options->setup, config, result);
       writeStrands(options->output, result.guides);

@@ -43,7 +43,8 @@ void registerInterpolate(CLI::App& app, int& exitCode) {
       hairFormatOf(options->output);
       Stopwatch clock;
       Config config = loadStageConfig(options->setup, options->common, SetupUse::kInterpolate, stats);
-      Mesh wick = readObj(config.setup.wickModel.path);
+      const Scene scene = readScene(options->common, config, true, false, stats);
+      const Mesh& wick = *scene.wick;
       if (options->frames.empty()) {
         Strands guides = readStrandsAs(options->guides, options->units);
         stats.time("read", clock.lap());
@@ -92,6 +93,8 @@ Strands interpolateStage(const CommonOptions& common, const Config& config, cons
   Strands coupe = interpolate(wick, guides, config.hairstyle, config.collision,
                               InterpolateOptions{config.digest(), guidesName, &progress, common.force});
   double seconds = clock.lap();
+  const std::string applied = config.setup.meshConversion.describe();
+  if (!applied.empty()) coupe.provenance.conversion = "wick: " + applied;
   stats.time("interpolate", seconds);
   stats.counts()["triangles"] = wick.triangles.size();
   stats.counts()["strands"] = coupe.strandCount();

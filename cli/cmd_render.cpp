@@ -99,6 +99,7 @@ void registerRender(CLI::App& app, int& exitCode) {
     std::string setup, hair, output, dom, preview, frames;
     UnitOptions units;
     double scale = 1.0;
+    std::vector<double> translate;
     bool frame = false, listDevices = false, motion = false;
   };
   auto options = std::make_shared<Options>();
@@ -120,6 +121,11 @@ void registerRender(CLI::App& app, int& exitCode) {
                                        "Multiply the hair's positions and widths: --units as a factor")
                            ->check(kFiniteNonNegative & CLI::PositiveNumber);
   scale->excludes(cmd->get_option("--units"));
+  cmd->add_option("--translate", options->translate,
+                  "Move the hair by X Y Z metres after --units/--up-axis/--scale, to sit it on the head")
+      ->expected(3)
+      ->type_name("X Y Z")
+      ->check(CLI::Range(-1e4, 1e4));
   cmd->add_flag("--frame", options->frame, "Aim the camera and light at the hair and fit it in the view");
   cmd->add_option(
          "--frames", options->frames,
@@ -162,8 +168,7 @@ void registerRender(CLI::App& app, int& exitCode) {
       auto frameFile = [&](const std::string& pattern, int f) {
         return sequence && !pattern.empty() ? framePath(pattern, f).string() : pattern;
       };
-      std::optional<Mesh> head;
-      if (config.setup.headModel.given()) head = readObj(config.setup.headModel.path);
+      std::optional<Mesh> head = readScene(options->common, config, false, true, stats).head;
       const HeadMotion motion = headMotionOf(config);
       stats.time("read", clock.lap());
       RenderOptions renderOptions;
@@ -171,6 +176,17 @@ void registerRender(CLI::App& app, int& exitCode) {
       const UnitConversion conversion = unitConversion(options->units);
       renderOptions.zUp = conversion.upAxis == UpAxis::kZ;
       renderOptions.scale = conversion.metresPerUnit.value_or(options->scale);
+      // The head of a foreign hair file is usually in the file's units and axis too: it moves with the
+      // hair unless the Setup says how to read it (MeshUnits, MeshUpAxis).
+      const Setup& s = config.setup;
+      if (head && !s.meshConversion.metresPerUnit && !s.meshConversion.upAxis &&
+          (renderOptions.zUp || renderOptions.scale != 1.0)) {
+        UnitConversion headConversion;
+        if (renderOptions.scale != 1.0) headConversion.metresPerUnit = renderOptions.scale;
+        if (renderOptions.zUp) headConversion.upAxis = UpAxis::kZ;
+        for (glm::vec3& p : head->positions) p = headConversion.position(p);
+        for (glm::vec3& n : head->normals) n = headConversion.direction(n);
+      }
       renderOptions.keepDom = !options->dom.empty();
       const std::unique_ptr<GlContext> gl =
           openDevice(options->common, config, stats);  // one for every frame
@@ -191,15 +207,36 @@ void registerRender(CLI::App& app, int& exitCode) {
                  std::to_string(frames.first) +
                  " is taken as the first and moves by 0; a range split into jobs gives other "
                  "vectors where it is split (name the shot's DynamicsInfo in the Setup)");
+      // --translate moves the hair after its conversion, so the stage gets it converted and moved.
+      RenderOptions frameOptions = renderOptions;
+      if (!options->translate.empty()) frameOptions.zUp = false, frameOptions.scale = 1.0;
+      auto readHair = [&](const std::string& file) {
+        Strands h = readStrands(file);
+        if (!options->translate.empty()) {
+          conform(h, renderOptions.zUp, renderOptions.scale);
+          const glm::vec3 offset(options->translate[0], options->translate[1], options->translate[2]);
+          for (glm::vec3& p : h.points) p += offset;
+        }
+        return h;
+      };
+      // A sequence aims an auto camera (or --frame) at its shot's first frame, so the camera holds still
+      // and a range split into jobs sees through the same camera; when that frame's file is gone, at the
+      // range's first.
+      std::optional<Strands> framing;
+      if (sequence && (options->frame || config.render.cameraAuto)) {
+        const std::string first = frameFile(options->hair, shotStart);
+        framing = readHair(fs::is_regular_file(first) ? first : frameFile(options->hair, frames.first));
+        frameOptions.framing = &*framing;
+      }
       if (options->motion && frames.first - 1 >= shotStart) {
         hairFileBefore = frameFile(options->hair, frames.first - 1);
-        hairBefore = readStrands(hairFileBefore);
+        hairBefore = readHair(hairFileBefore);
         headBefore = poseHead(frames.first - 1);
       }
       Progress progress("render", "frames", size_t(frames.count()), sequence && !options->common.quiet);
       for (int f = frames.first; f <= frames.last; ++f) {
         const std::string hairFile = frameFile(options->hair, f);
-        Strands hair = readStrands(hairFile);
+        Strands hair = readHair(hairFile);
         if (options->motion && !hairBefore) {
           hairBefore = hair;  // nothing before the shot: no motion
           hairFileBefore = hairFile;
@@ -225,7 +262,7 @@ void registerRender(CLI::App& app, int& exitCode) {
                                        posedHead ? &*posedHead
                                        : head    ? &*head
                                                  : nullptr,
-                                       renderOptions, stats, options->motion ? &before : nullptr);
+                                       frameOptions, stats, options->motion ? &before : nullptr);
         clock.lap();
         // The image's config digest is that of the camera and light it was rendered with (--frame aims them).
         Config rendered = config;

@@ -61,7 +61,7 @@ void runShot(const CommonOptions& common, const Config& config, const Mesh& wick
   const HeadMotion motion = headMotionOf(config);
   const bool shaded = wantsShade(config.visuality, config.render);
   std::optional<Mesh> head;
-  if (render && config.setup.headModel.given()) head = readObj(config.setup.headModel.path);
+  if (render && config.setup.headModel.given()) head = readHead(config);
   std::unique_ptr<GlContext> gl;
   if (render) gl = openDevice(common, config, stats);
   const fs::path simPattern = out / "sim" / "guides.####.hair", exrPattern = out / "beauty.####.exr",
@@ -70,8 +70,9 @@ void runShot(const CommonOptions& common, const Config& config, const Mesh& wick
                    " at " + formatReal(d.frameRate) + " fps");
   Progress progress("run", "frames", size_t(frames.count()), !common.quiet);
   Stopwatch clock;
-  std::optional<Strands> coupeBefore;
+  std::optional<Strands> coupeBefore, firstCoupe;
   std::optional<Mesh> headBefore;
+  RenderOptions renderOptions;  // an auto camera aims at the shot's first frame and holds still
   SimulateOptions simOptions;
   simOptions.configDigest = config.digest();
   simOptions.frames = frames;
@@ -89,9 +90,10 @@ void runShot(const CommonOptions& common, const Config& config, const Mesh& wick
     std::optional<Mesh> posedHead;
     if (head) posedHead = motion.still() ? *head : posedMesh(*head, motion.pose(f));
     if (motionVectors && !coupeBefore) coupeBefore = coupe, headBefore = posedHead;
+    if (!firstCoupe) renderOptions.framing = &firstCoupe.emplace(coupe);
     const FrameBefore before{coupeBefore ? &*coupeBefore : nullptr, headBefore ? &*headBefore : nullptr};
-    RenderOutput image = renderStage(common, config, *gl, coupe, posedHead ? &*posedHead : nullptr, {}, stats,
-                                     motionVectors ? &before : nullptr);
+    RenderOutput image = renderStage(common, config, *gl, coupe, posedHead ? &*posedHead : nullptr,
+                                     renderOptions, stats, motionVectors ? &before : nullptr);
     if (motionVectors) coupeBefore = std::move(coupe), headBefore = std::move(posedHead);
     clock.lap();
     writeRenderOutputs(config, image, framePath(exrPattern, f).string(), "",
@@ -173,8 +175,12 @@ void registerRun(CLI::App& app, int& exitCode) {
         note(options->common, "run: loaded " + config.setup.loadFile.path.string() + " (" +
                                   std::to_string(coupe.strandCount()) + " strands)");
       } else {
-        wick = readObj(config.setup.wickModel.path);
+        wick = *readScene(options->common, config, true, false, stats).wick;
         stats.add("read", clock.lap());
+        if (wick.triangles.empty())  // refused before minutes of growing, not after
+          throw InputError({config.setup.wickModel.path.string(), 0},
+                           "the wick has no faces, only points (roots): `hairgen grow` grows guides on them, "
+                           "but run interpolates strands over a surface and needs one (a scalp mesh)");
         // Every stage's work is estimated before the first starts: a coupe that cannot be rendered is
         // refused before minutes of growing.
         for (const WorkEstimate& e :
@@ -207,7 +213,7 @@ void registerRun(CLI::App& app, int& exitCode) {
                 stats);
       } else if (!options->noRender) {
         std::optional<Mesh> head;
-        if (config.setup.headModel.given()) head = readObj(config.setup.headModel.path);
+        if (config.setup.headModel.given()) head = readHead(config);
         const std::unique_ptr<GlContext> gl = openDevice(options->common, config, stats);
         RenderOutput image =
             renderStage(options->common, config, *gl, coupe, head ? &*head : nullptr, {}, stats);

@@ -27,8 +27,8 @@ ShadeResult shadeStage(const CommonOptions& common, const Config& config, Strand
   stats.counts()["strands"] = shaded.strandCount();
   stats.counts()["points"] = shaded.pointCount();
   stats.counts()["grid"] = {grid.size.x, grid.size.y, grid.size.z};
-  stats.counts()["voxel_size"] = grid.voxel;
-  stats.counts()["shell_density"] = result.volume.iso;
+  stats.counts()["voxelSize"] = grid.voxel;
+  stats.counts()["shellDensity"] = result.volume.iso;
   std::ostringstream line;
   line << "shade: " << grid.size.x << "×" << grid.size.y << "×" << grid.size.z << " grid (VoxelSize "
        << formatReal(grid.voxel) << "), shell at " << std::setprecision(3) << result.volume.iso

@@ -41,7 +41,8 @@ void registerSimulate(CLI::App& app, int& exitCode) {
         throw InputError("-o " + options->output + ": write #### (or %04d) where the frame number goes");
       hairFormatOf(options->output);
       Stopwatch clock;
-      const Config config = loadStageConfig(options->setup, options->common, SetupUse::kRender, stats);
+      Config config = loadStageConfig(options->setup, options->common, SetupUse::kRender, stats);
+      readScene(options->common, config, false, false, stats);  // fits any auto collision shape
       const Dynamics& d = config.dynamics;
       const FrameRange frames = options->frames.empty() ? FrameRange{d.firstFrame, d.lastFrame}
                                                         : parseFrameRange(options->frames, "--frames");

@@ -12,6 +12,7 @@
 #include "libcore/util/error.h"
 #include "libcore/util/file_util.h"
 #include "libcore/util/json.h"
+#include "libcore/util/resources.h"
 #include "libcore/util/text.h"
 
 namespace hairgen::cli {
@@ -68,7 +69,21 @@ std::vector<Override> parseOverrides(const CommonOptions& options) {
   return overrides;
 }
 
-Stats::Stats(std::string command) : start_(std::chrono::steady_clock::now()) {
+namespace {
+// What the Stats of a failing command had gathered when it was unwound, for runCommand.
+nlohmann::ordered_json gFailedStats;
+}  // namespace
+
+Stats::~Stats() {
+  if (std::uncaught_exceptions() > exceptions_) {
+    json_["seconds"]["total"] =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
+    gFailedStats = json_;
+  }
+}
+
+Stats::Stats(std::string command)
+    : start_(std::chrono::steady_clock::now()), exceptions_(std::uncaught_exceptions()) {
   json_["command"] = std::move(command);
   json_["version"] = HAIRGEN_VERSION;
   json_["seconds"] = nlohmann::ordered_json::object();
@@ -84,15 +99,39 @@ void Stats::setOverrides(const std::vector<Override>& overrides) {
 void Stats::write(const CommonOptions& options) {
   json_["seconds"]["total"] =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
+  nlohmann::ordered_json outputs = nlohmann::ordered_json::array();
+  for (const std::filesystem::path& p : committedOutputs()) outputs.push_back(p.string());
+  json_["outputs"] = outputs;
+  json_["peakMemoryBytes"] = peakResidentBytes();
+  json_["exitCode"] = 0;
   if (!options.statsFile.empty()) writeFileAtomic(options.statsFile, jsonText(json_) + "\n");
 }
 
 int runCommand(const std::string& command, const CommonOptions& options, const std::function<void()>& body) {
   installInterruptCleanup();
   forgetCommittedOutputs();
+  gFailedStats = nullptr;
   auto failed = [&](const std::string& message, ExitCode code) {
     discardCommittedOutputs();  // a failed command leaves none of its outputs
     std::cerr << "hairgen " << command << ": error: " << oneLine(message) << "\n";
+    if (!options.statsFile.empty()) {
+      // A farm script reads why, even from a command that failed before it gathered anything.
+      nlohmann::ordered_json stats =
+          gFailedStats.is_object() ? gFailedStats : nlohmann::ordered_json::object();
+      if (!stats.contains("command")) stats["command"] = command;
+      if (!stats.contains("version")) stats["version"] = HAIRGEN_VERSION;
+      stats["outputs"] = nlohmann::ordered_json::array();
+      stats["peakMemoryBytes"] = peakResidentBytes();
+      stats["exitCode"] = int(code);
+      stats["error"] = oneLine(message);
+      try {
+        writeFileAtomic(options.statsFile, jsonText(stats) + "\n");
+        forgetCommittedOutputs();
+      } catch (const std::exception& e) {
+        std::cerr << "hairgen " << command << ": error: --stats " << options.statsFile << ": " << e.what()
+                  << "\n";
+      }
+    }
     return static_cast<int>(code);
   };
   try {
@@ -114,7 +153,10 @@ Config loadStageConfig(const std::filesystem::path& setup, const CommonOptions& 
                        Stats& stats) {
   std::vector<Override> overrides = parseOverrides(options);
   stats.setOverrides(overrides);
-  return loadConfig(setup, overrides, use);
+  Config config = loadConfig(setup, overrides, use);
+  stats.json()["configDigest"] = config.digest();
+  stats.json()["seed"] = config.hairstyle.seed;
+  return config;
 }
 
 void addUnitFlags(CLI::App& command, UnitOptions& options, const std::string& file) {

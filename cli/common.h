@@ -12,6 +12,7 @@
 
 #include "libcore/config/params.h"
 #include "libcore/config/setup.h"
+#include "libcore/model/mesh.h"
 #include "libcore/model/strands.h"
 #include "libcore/model/units.h"
 #include "libcore/util/error.h"
@@ -40,9 +41,15 @@ void addCommonFlags(CLI::App& command, CommonOptions& options, bool configFlags)
 std::vector<Override> parseOverrides(const CommonOptions& options);
 
 // Collects timings and counts for --stats.
+// Every file has the same keys, in camelCase: command, version, configDigest and seed (commands that read
+// a Setup), overrides, seconds, counts, outputs (the files written), peakMemoryBytes, exitCode, and on
+// failure error. A command that fails still writes its --stats file, with what it had gathered.
 class Stats {
  public:
   explicit Stats(std::string command);
+  ~Stats();  // while a command fails, hands what it gathered to runCommand's --stats file
+  Stats(const Stats&) = delete;
+  Stats& operator=(const Stats&) = delete;
   void time(const std::string& phase, double seconds) { json_["seconds"][phase] = seconds; }
   // Adds to a phase's time (a phase done in several pieces).
   void add(const std::string& phase, double seconds) {
@@ -57,6 +64,7 @@ class Stats {
  private:
   std::chrono::steady_clock::time_point start_;
   nlohmann::ordered_json json_;
+  int exceptions_ = 0;  // std::uncaught_exceptions() when made
 };
 
 // --units and --up-axis: the lengths and up axis of a strand file made elsewhere (PLY, .data, a cyHair
@@ -70,6 +78,20 @@ void addUnitFlags(CLI::App& command, UnitOptions& options, const std::string& fi
 UnitConversion unitConversion(const UnitOptions& options);
 // Reads strands (readStrands) and applies the options' conversion, recorded in their provenance.
 Strands readStrandsAs(const std::string& file, const UnitOptions& options);
+
+// The meshes of a job, read as the Setup says (MeshUnits, MeshUpAxis, WickGroup) so that they are in
+// metres, +y up, with the `auto` collision shapes fitted to them.
+struct Scene {
+  std::optional<Mesh> wick;  // when the command needs it and the Setup names one
+  std::optional<Mesh> head;  // when the command needs it, or a shape is fitted to it
+};
+Mesh readWick(const Config& config);
+Mesh readHead(const Config& config);
+// Reads the meshes, fits `config.collision`'s auto shapes, and judges the scene (checkScene, and
+// with `estimates` the work of every stage of `hairgen run`): a refusal is an InputError (exit 2)
+// unless --force, a memory refusal always; warnings go to stderr. Records the meshes' conversion in
+// `stats`.
+Scene readScene(const CommonOptions& options, Config& config, bool needWick, bool needHead, Stats& stats);
 
 // "1.23 s"
 std::string formatSeconds(double seconds);

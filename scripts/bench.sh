@@ -9,7 +9,7 @@ bash scripts/setup.sh --no-build
 cmake -S . -B build -G Ninja -DCMAKE_BUILD_TYPE=Release >/dev/null
 cmake --build build --target hairgen_bench hairgen
 case "$group" in
-  grow) filter='EnergyEvaluation|GrowCoupe3' ;;
+  grow) filter='EnergyEvaluation|GrowCoupe3|GrowDefault' ;;
   cantilever) filter='CantileverStyling' ;;
   interpolate) filter='InterpolateCoupe3' ;;
   shade) filter='ShadeCoupe3' ;;

@@ -144,7 +144,8 @@ GrowResult growCantilever(const Mesh& wick, const Hairstyle& style, const Collis
     }
   std::vector<std::vector<glm::dvec3>> hairs(count);
   tbb::parallel_for(size_t(0), count, [&](size_t i) {
-    hairs[i] = bendHair(glm::dvec3(wick.positions[i]), glm::dvec3(wick.normals[i]), style, head);
+    const glm::dvec3 rootPos(wick.positions[i]);
+    hairs[i] = bendHair(rootPos, style.growDirection(rootPos, glm::dvec3(wick.normals[i])), style, head);
     cutHair(hairs[i], style, head);
     if (options.progress) options.progress->advance();
   });
@@ -159,8 +160,9 @@ GrowResult growCantilever(const Mesh& wick, const Hairstyle& style, const Collis
       if (!std::isfinite(h[n].x) || !std::isfinite(h[n].y) || !std::isfinite(h[n].z))
         throw NumericError("hair " + std::to_string(i) + " has a non-finite node");
       guides.points.push_back(glm::vec3(h[n]));
-      glm::dvec3 t = h.size() < 2 ? glm::normalize(glm::dvec3(wick.normals[i]))
-                                  : (n + 1 < h.size() ? h[n + 1] - h[n] : h[n] - h[n - 1]);
+      glm::dvec3 t = h.size() < 2
+                         ? style.growDirection(glm::dvec3(wick.positions[i]), glm::dvec3(wick.normals[i]))
+                         : (n + 1 < h.size() ? h[n + 1] - h[n] : h[n] - h[n - 1]);
       guides.tangents.push_back(glm::vec3(glm::normalize(t)));
     }
     guides.firstPoint.push_back(static_cast<uint32_t>(guides.points.size()));

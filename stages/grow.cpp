@@ -73,7 +73,8 @@ GrowResult grow(const Mesh& wick, const Hairstyle& style, const Collision& colli
   std::vector<std::string> failures(count);
   tbb::parallel_for(size_t(0), count, [&](size_t i) {
     const double envelope = envelopes[i];
-    RodFrame root = follicleFrame(glm::dvec3(wick.positions[i]), glm::dvec3(wick.normals[i]));
+    const glm::dvec3 rootPos(wick.positions[i]);
+    RodFrame root = follicleFrame(rootPos, style.growDirection(rootPos, glm::dvec3(wick.normals[i])));
     try {
       result.reports[i] = growGuide(root, envelope, style, collision);
       result.reports[i].follicle = static_cast<uint32_t>(i);
@@ -93,7 +94,8 @@ GrowResult grow(const Mesh& wick, const Hairstyle& style, const Collision& colli
   guides.tangents.reserve(count * s.size());
   std::vector<glm::dvec3> positions, tangents;
   for (size_t i = 0; i < count; ++i) {
-    RodFrame root = follicleFrame(glm::dvec3(wick.positions[i]), glm::dvec3(wick.normals[i]));
+    const glm::dvec3 rootPos(wick.positions[i]);
+    RodFrame root = follicleFrame(rootPos, style.growDirection(rootPos, glm::dvec3(wick.normals[i])));
     sampleRod(root, style.hairLengths, result.reports[i].coordinates, s, positions, &tangents);
     for (size_t k = 0; k < s.size(); ++k) {
       guides.points.push_back(glm::vec3(positions[k]));

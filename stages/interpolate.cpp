@@ -139,6 +139,8 @@ void blendStrand(const GuideSpan (&g)[3], uint32_t n, const glm::dvec3& root, co
 }
 
 glm::dvec3 strayCentre(const Collision& collision) {
+  for (const CollisionShape& s : collision.shapes)  // a shape fitted to the head is the head
+    if (s.fitted) return s.centre;
   for (const CollisionShape& s : collision.shapes)
     if (s.kind == ShapeKind::kEllipsoid) return s.centre;
   return glm::dvec3(0.0);
@@ -146,6 +148,11 @@ glm::dvec3 strayCentre(const Collision& collision) {
 
 Strands interpolate(const Mesh& wick, const Strands& guides, const Hairstyle& style,
                     const Collision& collision, const InterpolateOptions& options) {
+  if (wick.triangles.empty())
+    throw InputError(
+        "the wick has no faces, only points (roots): interpolation spreads strands over a "
+        "surface and needs one; give a scalp mesh as WickModel (the guides grown on the points "
+        "can still be rendered)");
   checkGuides(wick, guides, options.guidesName, options.pose);
   const size_t triangleCount = wick.triangles.size();
   size_t pointsPerGuide = 0;

@@ -7,6 +7,7 @@
 #include "libcore/render/views.h"
 #include "libcore/util/error.h"
 #include "stages/estimate.h"
+#include "stages/scene.h"
 
 namespace hairgen {
 
@@ -92,7 +93,14 @@ RenderOutput render(GlContext& gl, const Strands& hair, const Mesh* head, const 
   input.head = head;
   input.visuality = visuality;
   input.settings = settings;
-  if (options.frame) frameHair(input.settings, *input.hair);
+  // The camera (and light) aimed at the hair asked for: a sequence aims at its shot's first frame, so
+  // the camera holds still; otherwise at the hair rendered.
+  std::optional<Strands> copyFraming;
+  const Strands& aim = options.framing ? conformed(*options.framing, options, copyFraming) : *input.hair;
+  if (options.frame)
+    frameHair(input.settings, aim);
+  else if (settings.cameraAuto)
+    frameScene(input.settings, aim, head);
   if (before) {
     const std::optional<CustomStage>& vertex = shaders.hairVert ? shaders.hairVert : shaders.headVert;
     if (shaders.hairVert || (head && shaders.headVert))
@@ -110,7 +118,13 @@ RenderOutput render(GlContext& gl, const Strands& hair, const Mesh* head, const 
     previous.hair = &conformed(*before->hair, options, copyBefore);
     previous.head = head ? before->head : nullptr;
     previous.settings = settings;
-    if (options.frame) frameHair(previous.settings, *previous.hair);
+    // The camera of the frame before: the same when it is aimed at the shot's first frame or fixed;
+    // aimed at that frame's hair when each frame aims at its own.
+    const Strands& aimBefore = options.framing ? aim : *previous.hair;
+    if (options.frame)
+      frameHair(previous.settings, aimBefore);
+    else if (settings.cameraAuto)
+      frameScene(previous.settings, aimBefore, before->head ? before->head : head);
     input.previous = previous;
   }
   input.shaders = shaders;

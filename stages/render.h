@@ -60,6 +60,9 @@ struct RenderOptions {
   bool keepDom = false;   // return the light's maps in RenderOutput::dom
   int domResolution = 0;  // texels per side of the light's maps; 0: domResolutionFor(Resolution)
   bool force = false;     // render work estimated to take absurdly long (never work that cannot fit)
+  // The hair the camera is aimed at (--frame, CameraPosition auto), as read; null: the hair rendered.
+  // A sequence names its shot's first frame, so the camera holds still over the shot.
+  const Strands* framing = nullptr;
 };
 
 // Hair made elsewhere, to hairgen's conventions: z-up turned to y-up (x, y, z) → (x, z, −y), then

@@ -325,6 +325,10 @@ TEST(ConfigKeys, EveryDigestKeyIsInTheCanonicalText) {
   config.dynamics.wind.push_back(WindKey{});
   config.dynamics.headKeys.push_back(HeadKey{});
   config.hairstyle.hairLengths = {0.04};
+  config.setup.meshConversion = {0.01, UpAxis::kZ};  // enter the digest only when given
+  config.setup.wickGroup = "scalp";
+  config.hairstyle.rootTilt = 20.0;
+  config.hairstyle.rootFlow = {RootFlow::Kind::kAwayFrom, glm::dvec3(0, 0.2, 0)};
   config.hairstyle.forces.push_back(ForceField{});
   config.hairstyle.cuts.push_back(HairCut{});
   for (ShapeKind kind : {ShapeKind::kSphere, ShapeKind::kEllipsoid, ShapeKind::kCuboid})

@@ -30,6 +30,7 @@ void addStraight(Strands& s, glm::vec3 a, glm::vec3 b, int n = 11) {
 RenderSettings frontCamera(int size, int samples) {
   RenderSettings r;
   r.resolution = {size, size};
+  r.cameraAuto = false;
   r.cameraPosition = {0.0, 0.0, 0.3};
   r.cameraTarget = {0.0, 0.0, 0.0};
   r.fieldOfView = 30.0;
@@ -227,6 +228,7 @@ struct HairOverAPlane {
     }
     settings.resolution = {128, 128};
     settings.samples = 1;
+    settings.cameraAuto = false;
     settings.cameraPosition = {0.0, 0.5, 0.0};
     settings.cameraTarget = {0.0, 0.0, 0.0};
     settings.cameraUp = {0.0, 0.0, -1.0};

@@ -44,6 +44,7 @@ glm::dmat3 orthonormalAxes(const SectionReader& reader, const ConfigLine& line, 
 
 // The values after the kind: volume penalty centre, then the radius or the half-extents and axes.
 std::string shapeText(const CollisionShape& c) {
+  if (c.fitted) return join({c.envelopeGrowth, c.penalty}) + " auto";
   std::string out = join({c.envelopeGrowth, c.penalty}) + " " + join(c.centre) + " " + join(c.halfExtents);
   if (c.kind != ShapeKind::kSphere)
     out += " " + join(c.axes[0]) + " " + join(c.axes[1]) + " " + join(c.axes[2]);
@@ -51,13 +52,23 @@ std::string shapeText(const CollisionShape& c) {
 }
 
 CollisionShape readShape(const SectionReader& reader, const ConfigLine& line, ShapeKind kind) {
+  if (line.values.size() == 3 && toLower(line.values[2]) == "auto") {
+    CollisionShape shape;
+    shape.kind = kind;
+    shape.where = line.where;
+    shape.fitted = true;
+    shape.envelopeGrowth = reader.checkReal(line, 0, {}, "volume");
+    shape.penalty = reader.checkReal(line, 1, Range::nonNegative(), "penalty");
+    return shape;
+  }
   size_t count = kind == ShapeKind::kSphere ? 6 : 17;
   if (line.values.size() != count)
     throw reader.error(
         line, "'" + line.key + "' takes " + std::to_string(count) + " values, found " +
                   std::to_string(line.values.size()) + "; expected " +
                   (kind == ShapeKind::kSphere ? "volume penalty cx cy cz r"
-                                              : "volume penalty cx cy cz a b c ux uy uz vx vy vz wx wy wz"));
+                                              : "volume penalty cx cy cz a b c ux uy uz vx vy vz wx wy wz") +
+                  (kind == ShapeKind::kCuboid ? "" : ", or volume penalty auto (fitted to the head)"));
   CollisionShape shape;
   shape.kind = kind;
   shape.where = line.where;
@@ -120,6 +131,45 @@ ForceField readForce(const SectionReader& r, const ConfigLine& line) {
 
 // ---------------------------------------------------------------------------------------------- Setup
 
+// MeshUnits and MeshUpAxis enter the digest only when given, so that the digest of a Setup written
+// before they existed does not change.
+Key<Setup> meshUnitsKey() {
+  return customKey<Setup>(
+      {"MeshUnits", "", "the length unit of the wick and head OBJs: m, cm, mm, in, or metres per unit"},
+      "m | cm | mm | in | factor", "factor > 0",
+      [](SectionReader& r, Setup& s) {
+        const ConfigLine* line = r.line("MeshUnits");
+        if (!line) return;
+        std::optional<double> unit =
+            line->values.size() == 1 ? parseLengthUnit(line->values[0]) : std::nullopt;
+        if (!unit)
+          throw r.error(*line, "MeshUnits takes m, cm, mm, in or a positive number of metres per unit");
+        s.meshConversion.metresPerUnit = unit;
+      },
+      [](const Setup& s) {
+        return s.meshConversion.metresPerUnit && *s.meshConversion.metresPerUnit != 1.0
+                   ? std::vector<std::string>{formatReal(*s.meshConversion.metresPerUnit)}
+                   : std::vector<std::string>{};
+      });
+}
+
+Key<Setup> meshUpAxisKey() {
+  return customKey<Setup>(
+      {"MeshUpAxis", "", "the up axis of the wick and head OBJs: z turns z-up to hairgen's +y up"}, "y | z",
+      "",
+      [](SectionReader& r, Setup& s) {
+        const ConfigLine* line = r.line("MeshUpAxis");
+        if (!line) return;
+        std::optional<UpAxis> axis = line->values.size() == 1 ? parseUpAxis(line->values[0]) : std::nullopt;
+        if (!axis) throw r.error(*line, "MeshUpAxis takes y or z");
+        s.meshConversion.upAxis = axis;
+      },
+      [](const Setup& s) {
+        return s.meshConversion.upAxis == UpAxis::kZ ? std::vector<std::string>{"z"}
+                                                     : std::vector<std::string>{};
+      });
+}
+
 Section<Setup> makeSetup() {
   auto notInDigest = [](Key<Setup> key) {
     key.spec.inDigest = false;
@@ -158,7 +208,22 @@ Section<Setup> makeSetup() {
        pathKey<Setup>(
            {"HeadFrag", "",
             "GLSL fragment stage shading the head, in place of hairgen's (README, Custom shaders)"},
-           &Setup::headFrag)},
+           &Setup::headFrag),
+       meshUnitsKey(), meshUpAxisKey(),
+       customKey<Setup>(
+           {"WickGroup", "",
+            "grow only on the faces of this OBJ group, object or material of the wick (a whole head can be "
+            "the wick)"},
+           "name", "",
+           [](SectionReader& r, Setup& s) {
+             const ConfigLine* line = r.line("WickGroup");
+             if (!line) return;
+             if (line->values.size() != 1) throw r.error(*line, "WickGroup takes one name");
+             s.wickGroup = line->values[0];
+           },
+           [](const Setup& s) {
+             return s.wickGroup.empty() ? std::vector<std::string>{} : std::vector<std::string>{s.wickGroup};
+           })},
       [](SectionReader& r, Setup& s) {
         if (s.load && !s.loadFile.given())
           throw InputError(r.where("Load"),
@@ -258,6 +323,49 @@ Key<Hairstyle> cutKey() {
       }));
 }
 
+// RootTilt and RootFlow enter the digest only when they lean the hair, so that the digest of a
+// Hairstyle Info written before them does not change.
+Key<Hairstyle> rootTiltKey() {
+  return customKey<Hairstyle>(
+      {"RootTilt", "degrees", "each hair leaves the scalp this far from the normal, toward RootFlow"},
+      "degrees", "[0, 89]",
+      [](SectionReader& r, Hairstyle& h) { h.rootTilt = r.real("RootTilt", 0.0, Range::closed(0.0, 89.0)); },
+      [](const Hairstyle& h) {
+        return h.rootTilt > 0.0 ? std::vector<std::string>{formatReal(h.rootTilt)}
+                                : std::vector<std::string>{};
+      });
+}
+
+Key<Hairstyle> rootFlowKey() {
+  return customKey<Hairstyle>(
+      {"RootFlow", "m",
+       "the direction follicles lean toward: down, a vector x y z, or away-from x y z (a point, e.g. the "
+       "crown)"},
+      "down | x y z | away-from x y z", "",
+      [](SectionReader& r, Hairstyle& h) {
+        const ConfigLine* line = r.line("RootFlow");
+        if (!line) return;
+        const std::vector<std::string>& v = line->values;
+        const std::string first = toLower(v[0]);
+        if (first == "down" && v.size() == 1) return;
+        const bool away = first == "away-from";
+        if (v.size() != (away ? 4u : 3u))
+          throw r.error(*line, "RootFlow takes down, a direction x y z, or away-from x y z");
+        glm::dvec3 value;
+        for (int i = 0; i < 3; ++i)
+          value[i] = r.checkReal(*line, away + i, Range::closed(-1e4, 1e4), "RootFlow");
+        if (!away && glm::length(value) < 1e-9) throw r.error(*line, "RootFlow's direction is zero");
+        h.rootFlow.kind = away ? RootFlow::Kind::kAwayFrom : RootFlow::Kind::kDirection;
+        h.rootFlow.value = away ? value : glm::normalize(value);
+      },
+      [](const Hairstyle& h) {
+        if (h.rootTilt <= 0.0 || h.rootFlow.kind == RootFlow::Kind::kDown) return std::vector<std::string>{};
+        return std::vector<std::string>{
+            std::string(h.rootFlow.kind == RootFlow::Kind::kAwayFrom ? "away-from " : "") +
+            join(h.rootFlow.value)};
+      });
+}
+
 Section<Hairstyle> makeHairstyle() {
   using H = Hairstyle;
   const Range aboveZeroToOne{0.0, 1.0, true, false};
@@ -294,6 +402,8 @@ Section<Hairstyle> makeHairstyle() {
                   &H::clump, Range::closed(0.0, 1.0)),
        boolKey<H>({"StrayHairs", "", "true = the thesis' barycentric assignment (§4.1.4.4)"}, &H::strayHairs),
        unsignedKey<H>({"Seed", "", "keys every random number; --seed overrides it"}, &H::seed),
+       rootTiltKey(),
+       rootFlowKey(),
        integerKey<H>({"Segments", "", "cantilever: equal segments per hair"}, &H::segments, 1, 100000),
        realKey<H>({"FlexuralRigidity", "N·m²", "cantilever: E·I; 0 = Young × π a b³/4"}, &H::flexuralRigidity,
                   Range::nonNegative()),
@@ -393,7 +503,21 @@ Section<RenderSettings> makeRender() {
   return makeSection<R>(
       "Render", "Render Info", "RenderInfo",
       {resolutionKey(),
-       vectorKey<R, 3>({"CameraPosition", "m", "where the camera is"}, &R::cameraPosition, "x y z"),
+       customKey<R>(
+           {"CameraPosition", "m",
+            "where the camera is; auto frames the hair and the head from a three-quarter view, the light "
+            "placed relative to it"},
+           "auto | x y z", "",
+           [](SectionReader& r, R& s) {
+             const ConfigLine* line = r.line("CameraPosition");
+             if (!line || (line->values.size() == 1 && toLower(line->values[0]) == "auto")) return;
+             if (line->values.size() != 3) throw r.error(*line, "CameraPosition takes auto or x y z");
+             s.cameraAuto = false;
+             for (int i = 0; i < 3; ++i) s.cameraPosition[i] = r.checkReal(*line, i, {}, "position");
+           },
+           [](const R& s) {
+             return std::vector<std::string>{s.cameraAuto ? std::string("auto") : join(s.cameraPosition)};
+           }),
        vectorKey<R, 3>({"CameraTarget", "m", "the point the camera looks at"}, &R::cameraTarget, "x y z"),
        vectorKey<R, 3>({"CameraUp", "", "the camera's up direction"}, &R::cameraUp, "x y z"),
        realKey<R>({"FieldOfView", "degrees", "vertical field of view"}, &R::fieldOfView,
@@ -426,6 +550,7 @@ Section<RenderSettings> makeRender() {
        realKey<R>({"VolumetricBlend", "", "0 = Kajiya-Kay, 1 = volumetric"}, &R::volumetricBlend,
                   Range::closed(0.0, 1.0))},
       [](SectionReader& r, R& s) {
+        if (s.cameraAuto) return;  // the stage aims it
         if (glm::length(s.cameraTarget - s.cameraPosition) < 1e-9)
           throw InputError(r.where("CameraTarget"),
                            "CameraTarget equals CameraPosition; the camera needs a direction");

@@ -1,5 +1,6 @@
 #include "libcore/config/params.h"
 
+#include <cmath>
 #include <cstdio>
 #include <numeric>
 #include <sstream>
@@ -56,6 +57,24 @@ bool ForceField::contains(const glm::dvec3& p) const {
       return glm::all(glm::greaterThanEqual(p, lo)) && glm::all(glm::lessThanEqual(p, hi));
   }
   return false;
+}
+
+glm::dvec3 RootFlow::at(const glm::dvec3& root) const {
+  if (kind == Kind::kAwayFrom) {
+    const glm::dvec3 d = root - value;
+    return glm::length(d) > 0.0 ? glm::normalize(d) : glm::dvec3(0.0);
+  }
+  return value;
+}
+
+glm::dvec3 Hairstyle::growDirection(const glm::dvec3& root, const glm::dvec3& normal) const {
+  const glm::dvec3 n = glm::normalize(normal);
+  if (rootTilt <= 0.0) return n;
+  // The flow projected onto the scalp's tangent plane; where it is along the normal, no lean.
+  const glm::dvec3 flow = rootFlow.at(root), along = flow - glm::dot(flow, n) * n;
+  if (glm::length(along) < 1e-6) return n;
+  const double tilt = glm::radians(rootTilt);
+  return std::cos(tilt) * n + std::sin(tilt) * glm::normalize(along);
 }
 
 double Hairstyle::totalLength() const {

@@ -10,6 +10,7 @@
 
 #include <glm/glm.hpp>
 
+#include "libcore/model/units.h"
 #include "libcore/util/error.h"
 
 namespace hairgen {
@@ -44,6 +45,15 @@ struct HairCut {
   FileLoc where;
 };
 
+// RootFlow: the direction a follicle leans toward (README, Real heads).
+struct RootFlow {
+  enum class Kind { kDown, kDirection, kAwayFrom };
+  Kind kind = Kind::kDown;
+  glm::dvec3 value{0.0, -1.0, 0.0};  // kDirection: a unit vector; kAwayFrom: a point, metres
+  // The direction at a follicle at `root`: down (−y), the fixed vector, or away from the point.
+  glm::dvec3 at(const glm::dvec3& root) const;
+};
+
 // Hairstyle Info: the mechanics of one hair and the density of the coupe.
 struct Hairstyle {
   double visualityStep = 0.0025;    // metres of arc length between output vertices
@@ -64,6 +74,12 @@ struct Hairstyle {
   double clump = 0.25;     // tip weights v1, v2 drawn in [0, Clump): 0 gathers tips at the nearest guide
   bool strayHairs = true;  // true = the thesis' barycentric assignment (§4.1.4.4)
   uint64_t seed = 0;       // keys every random number; --seed overrides it
+  // Follicle inclination: each hair leaves the scalp rootTilt degrees from the normal, toward the
+  // RootFlow direction projected onto the scalp (0 = along the normal, the thesis).
+  double rootTilt = 0.0;  // degrees
+  RootFlow rootFlow;
+  // The direction hair leaves the scalp at a follicle at `root` with unit normal `normal`.
+  glm::dvec3 growDirection(const glm::dvec3& root, const glm::dvec3& normal) const;
   // Model cantilever (Anjyo et al. 1992):
   int segments = 20;              // equal segments per hair, over the whole of HairLengths
   double flexuralRigidity = 0.0;  // E·I in N·m²; 0 = Young × π a b³/4
@@ -87,6 +103,7 @@ struct CollisionShape {
   glm::dvec3 halfExtents{0.0};  // metres: radius, semi-axes or half-extents along `axes`
   glm::dmat3 axes{1.0};         // columns: the body's unit axes (orthonormalised on read)
   FileLoc where;                // the config line it came from
+  bool fitted = false;          // `auto`: centre and half-extents are fitted to the head (fitCollision)
 };
 
 struct Collision {
@@ -106,7 +123,10 @@ struct Visuality {
 
 // Render Info (new in hairgen): camera, light and film.
 struct RenderSettings {
-  glm::ivec2 resolution{640, 640};              // pixels
+  glm::ivec2 resolution{640, 640};  // pixels
+  // CameraPosition auto (the default when Render Info names none): the render stage frames the hair and
+  // the head from the gallery's three-quarter view and places the light relative to it (frameScene).
+  bool cameraAuto = true;
   glm::dvec3 cameraPosition{0.32, 0.16, 0.52};  // metres; frames the bundled head from front-right
   glm::dvec3 cameraTarget{0.0, 0.03, 0.0};
   glm::dvec3 cameraUp{0.0, 1.0, 0.0};
@@ -197,6 +217,10 @@ struct Setup {
   PathRef hairstyleInfo, collisionInfo, visualityInfo, renderInfo, dynamicsInfo;
   PathRef wickModel, headModel;
   PathRef hairVert, hairFrag, headVert, headFrag;  // optional GLSL overrides
+  // MeshUnits and MeshUpAxis: applied to the wick and the head when they are read, so that everything
+  // inside hairgen is metres, +y up (README, Real heads).
+  UnitConversion meshConversion;
+  std::string wickGroup;  // WickGroup: the OBJ group, object or material the follicles grow on; "" = all
 };
 
 // A command-line override `--set Section.Key=VALUE`.

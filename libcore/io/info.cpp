@@ -12,6 +12,7 @@
 #include "libcore/io/usd_io.h"
 #include "libcore/util/error.h"
 #include "libcore/util/json.h"
+#include "libcore/util/resources.h"
 #include "libcore/util/text.h"
 
 namespace hairgen {
@@ -100,8 +101,8 @@ nlohmann::ordered_json describeFile(const std::filesystem::path& file) {
     j["format"] = "obj";
     j["vertices"] = mesh.vertexCount();
     j["triangles"] = mesh.triangleCount();
-    j["area_m2"] = surfaceArea(mesh);
-    j["area_cm2"] = surfaceArea(mesh) * 1e4;
+    j["areaM2"] = surfaceArea(mesh);
+    j["areaCm2"] = surfaceArea(mesh) * 1e4;
     double edge = 0.0;
     for (const glm::uvec3& t : mesh.triangles)
       for (int c = 0; c < 3; ++c) edge += glm::length(mesh.positions[t[c]] - mesh.positions[t[(c + 1) % 3]]);
@@ -195,8 +196,8 @@ std::string formatDescription(const nlohmann::ordered_json& j) {
   }
   if (j["format"] == "obj") {
     out << "  " << j["vertices"] << " vertices, " << j["triangles"] << " triangles, area "
-        << num(j["area_cm2"]) << " cm² (" << num(j["area_m2"]) << " m²), mean edge "
-        << num(j["meanEdgeLength"]) << " m\n"
+        << num(j["areaCm2"]) << " cm² (" << num(j["areaM2"]) << " m²), mean edge " << num(j["meanEdgeLength"])
+        << " m\n"
         << "  bounds " << box(j["bounds"]) << "\n"
         << "  normals " << j["normals"].get<std::string>() << (j["uvs"].get<bool>() ? ", UVs" : ", no UVs")
         << "\n"
@@ -240,7 +241,8 @@ std::string formatDescription(const nlohmann::ordered_json& j) {
   return out.str();
 }
 
-nlohmann::ordered_json describeSetup(const std::string& setupName, const Config& config) {
+nlohmann::ordered_json describeSetup(const std::string& setupName, const Config& config, const Mesh* wick,
+                                     const Mesh* head) {
   nlohmann::ordered_json report;
   report["setup"] = setupName;
   report["digest"] = config.digest();
@@ -248,14 +250,15 @@ nlohmann::ordered_json describeSetup(const std::string& setupName, const Config&
   report["collisionShapes"] = config.collision.shapes.size();
   report["superHelixElements"] = config.hairstyle.hairLengths.size();
   report["hairLength"] = config.hairstyle.totalLength();
-  for (auto [ref, key] : {std::pair{&config.setup.wickModel, "wick"}, {&config.setup.headModel, "head"}}) {
+  for (auto [ref, key, given] : {std::tuple{&config.setup.wickModel, "wick", wick},
+                                 std::tuple{&config.setup.headModel, "head", head}}) {
     if (!ref->given()) continue;
     MeshReadStats meshStats;
-    Mesh mesh = readObj(ref->path, &meshStats);
+    Mesh mesh = given ? *given : readObj(ref->path, &meshStats);
     report[key] = {{"file", ref->path.string()},
                    {"vertices", mesh.vertexCount()},
                    {"triangles", mesh.triangleCount()},
-                   {"area_cm2", surfaceArea(mesh) * 1e4},
+                   {"areaCm2", surfaceArea(mesh) * 1e4},
                    {"degenerateFacesDropped", meshStats.degenerateDropped}};
   }
   return report;
@@ -270,7 +273,18 @@ std::string formatSetupReport(const nlohmann::ordered_json& report) {
   for (const char* key : {"wick", "head"})
     if (report.contains(key))
       out << "  " << key << " " << report[key]["file"].get<std::string>() << ": " << report[key]["vertices"]
-          << " vertices, " << report[key]["triangles"] << " triangles\n";
+          << " vertices, " << report[key]["triangles"] << " triangles, "
+          << std::lround(report[key]["areaCm2"].get<double>()) << " cm²\n";
+  if (report.contains("meshConversion"))
+    out << "  meshes: " << report["meshConversion"].get<std::string>() << "\n";
+  if (report.contains("fittedShapes")) {
+    out << "  fitted collision shapes (to freeze them, put these lines in the Collision Info):\n";
+    for (const auto& line : report["fittedShapes"]) out << "    " << line.get<std::string>() << "\n";
+  }
+  if (report.contains("work"))
+    for (const auto& w : report["work"])
+      out << "  " << w["stage"].get<std::string>() << ": about " << formatBytes(w["bytes"].get<uint64_t>())
+          << ", " << w["detail"].get<std::string>() << "\n";
   return out.str();
 }
 

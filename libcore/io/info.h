@@ -6,6 +6,7 @@
 #include <nlohmann/json.hpp>
 
 #include "libcore/config/params.h"
+#include "libcore/model/mesh.h"
 
 namespace hairgen {
 
@@ -18,7 +19,10 @@ std::string formatDescription(const nlohmann::ordered_json& description);
 
 // What `hairgen check` reports of a job: the digest, the counts that shape the work, and each mesh the
 // Setup names (read, so a broken mesh is found before the work).
-nlohmann::ordered_json describeSetup(const std::string& setupName, const Config& config);
+// `wick` and `head`: the meshes as the Setup reads them (units, axis, group); read from the files as
+// they are when null.
+nlohmann::ordered_json describeSetup(const std::string& setupName, const Config& config,
+                                     const Mesh* wick = nullptr, const Mesh* head = nullptr);
 std::string formatSetupReport(const nlohmann::ordered_json& report);
 
 }  // namespace hairgen

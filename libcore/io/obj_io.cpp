@@ -3,11 +3,13 @@
 // statements it checked reach tinyobjloader.
 #include "libcore/io/obj_io.h"
 
+#include <algorithm>
 #include <cmath>
 #include <sstream>
 
 #include <tiny_obj_loader.h>
 
+#include "libcore/model/shape_fit.h"
 #include "libcore/util/error.h"
 #include "libcore/util/file_util.h"
 #include "libcore/util/text.h"
@@ -58,9 +60,13 @@ void checkCorner(std::string_view corner, const FileLoc& where, const size_t cou
 // The rest (objects, groups, materials, lines, skin weights, tags) hairgen does not use, and
 // tinyobjloader's parsers of them are lenient to the point of undefined behaviour: a 'vw' joint id of
 // 7e32 was converted to int (found by tests/fuzz/fuzz_obj).
-std::string validate(std::string_view text, const std::string& name) {
+// With a `group`, only the faces under a g, o or usemtl line naming it are kept; `names` collects every
+// name those lines give, for the error when none matches.
+std::string validate(std::string_view text, const std::string& name, const std::string& group = "",
+                     std::vector<std::string>* names = nullptr) {
   std::string checked;
   size_t counts[3] = {0, 0, 0};  // v, vt, vn
+  bool inGroup = false, inMaterial = false;
   forEachLine(text, [&](std::string_view line, int lineNumber) {
     FileLoc where{name, lineNumber};
     if (line.find('\0') != std::string_view::npos)
@@ -68,6 +74,17 @@ std::string validate(std::string_view text, const std::string& name) {
     std::vector<std::string_view> words = splitWords(line);
     if (words.empty() || words[0][0] == '#') return;
     std::string_view tag = words[0];
+    if (tag == "g" || tag == "o" || tag == "usemtl") {
+      bool match = false;
+      for (size_t i = 1; i < words.size(); ++i) {
+        match = match || words[i] == group;
+        if (names && std::find(names->begin(), names->end(), words[i]) == names->end())
+          names->push_back(std::string(words[i]));
+      }
+      // A face belongs to its group (g or o) and to its material; either may select it.
+      (tag == "usemtl" ? inMaterial : inGroup) = match;
+      return;
+    }
     auto numbers = [&](size_t minCount, size_t maxCount, const char* what) {
       size_t n = words.size() - 1;
       if (n < minCount || n > maxCount)
@@ -98,6 +115,7 @@ std::string validate(std::string_view text, const std::string& name) {
     } else if (tag == "f") {
       if (words.size() < 4) throw InputError(where, "a face needs at least three corners");
       for (size_t i = 1; i < words.size(); ++i) checkCorner(words[i], where, counts);
+      if (!group.empty() && !inGroup && !inMaterial) return;
     } else {
       return;
     }
@@ -107,11 +125,53 @@ std::string validate(std::string_view text, const std::string& name) {
   return checked;
 }
 
+// A wick of roots alone (HairStep's roots10k.obj): every vertex a follicle, its normal from the file or
+// pointing away from the least-squares sphere through the points (a scalp is close to one).
+Mesh pointCloud(const tinyobj::attrib_t& attrib) {
+  Mesh mesh;
+  const size_t count = attrib.vertices.size() / 3;
+  for (size_t i = 0; i < count; ++i)
+    mesh.positions.push_back(
+        {attrib.vertices[3 * i], attrib.vertices[3 * i + 1], attrib.vertices[3 * i + 2]});
+  if (attrib.normals.size() == attrib.vertices.size()) {
+    for (size_t i = 0; i < count; ++i)
+      mesh.normals.push_back(glm::normalize(
+          glm::vec3(attrib.normals[3 * i], attrib.normals[3 * i + 1], attrib.normals[3 * i + 2])));
+    return mesh;
+  }
+  const glm::dvec3 centre = fitSphere(mesh.positions).centre;
+  for (const glm::vec3& p : mesh.positions) {
+    glm::dvec3 d = glm::dvec3(p) - centre;
+    mesh.normals.push_back(glm::length(d) > 0.0 ? glm::vec3(glm::normalize(d)) : glm::vec3(0, 1, 0));
+  }
+  return mesh;
+}
+
+void applyConversion(Mesh& mesh, const UnitConversion& conversion) {
+  if (!conversion.changesCoordinates()) return;
+  for (glm::vec3& p : mesh.positions) p = conversion.position(p);
+  for (glm::vec3& n : mesh.normals) n = conversion.direction(n);
+}
+
 }  // namespace
 
 Mesh parseObj(std::string_view text, const std::string& name, MeshReadStats* statsOut) {
+  return parseObj(text, name, MeshReadOptions{}, statsOut);
+}
+
+Mesh parseObj(std::string_view text, const std::string& name, const MeshReadOptions& options,
+              MeshReadStats* statsOut) {
   text = withoutBom(text);  // tinyobjloader would read "\xEF\xBB\xBFv" as an unknown tag and drop the vertex
-  const std::string checked = validate(text, name);
+  std::vector<std::string> names;
+  const std::string checked = validate(text, name, options.group, &names);
+  if (!options.group.empty() && std::find(names.begin(), names.end(), options.group) == names.end()) {
+    std::string list;
+    for (const std::string& n : names) list += (list.empty() ? "" : ", ") + n;
+    throw InputError(
+        {name, 0},
+        "WickGroup '" + options.group + "' is not a group, object or material of this mesh; " +
+            (list.empty() ? std::string("it has none (no g, o or usemtl lines)") : "it has " + list));
+  }
   MeshReadStats stats;
 
   tinyobj::attrib_t attrib;
@@ -124,6 +184,14 @@ Mesh parseObj(std::string_view text, const std::string& name, MeshReadStats* sta
 
   size_t vertexCount = attrib.vertices.size() / 3;
   if (vertexCount == 0) throw InputError({name, 0}, "the mesh has no vertices");
+  size_t faces = 0;
+  for (const tinyobj::shape_t& shape : shapes) faces += shape.mesh.num_face_vertices.size();
+  if (options.allowPoints && faces == 0 && options.group.empty()) {
+    Mesh mesh = pointCloud(attrib);
+    applyConversion(mesh, options.conversion);
+    if (statsOut) *statsOut = stats;
+    return mesh;
+  }
 
   std::vector<glm::vec3> positions(vertexCount);
   for (size_t i = 0; i < vertexCount; ++i)
@@ -235,12 +303,17 @@ Mesh parseObj(std::string_view text, const std::string& name, MeshReadStats* sta
       if (remap[i] != UINT32_MAX && uvIndex[i] >= 0)
         mesh.uvs[remap[i]] = {attrib.texcoords[2 * uvIndex[i]], attrib.texcoords[2 * uvIndex[i] + 1]};
   }
+  applyConversion(mesh, options.conversion);
   if (statsOut) *statsOut = stats;
   return mesh;
 }
 
 Mesh readObj(const std::filesystem::path& file, MeshReadStats* stats) {
   return parseObj(readFileText(file), file.string(), stats);
+}
+
+Mesh readObj(const std::filesystem::path& file, const MeshReadOptions& options, MeshReadStats* stats) {
+  return parseObj(readFileText(file), file.string(), options, stats);
 }
 
 void writeObj(const Mesh& mesh, std::ostream& out, const std::string& headerComment) {

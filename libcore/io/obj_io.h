@@ -7,6 +7,7 @@
 #include <string_view>
 
 #include "libcore/model/mesh.h"
+#include "libcore/model/units.h"
 
 namespace hairgen {
 
@@ -20,12 +21,28 @@ struct MeshReadStats {
   bool normalsReindexed = false;    // normals were indexed apart from positions and averaged per vertex
 };
 
+// How to read a mesh: which faces, and in which units and frame.
+struct MeshReadOptions {
+  std::string group;  // keep only faces of this group (g), object (o) or material (usemtl); "" = all
+  bool allowPoints =
+      false;  // a file of vertices and no faces is a point cloud (a wick of roots), not an error
+  UnitConversion conversion;  // applied to positions and normals on reading
+};
+
 // Reads an OBJ: triangles and polygons (triangulated), normals and UVs indexed apart from positions
 // (averaged, resp. first seen, per position, so each position stays one follicle), missing normals
 // computed area-weighted. Malformed numbers, out-of-range indices and meshes with no vertices or no
 // faces are InputErrors naming file:line.
+// With `options.group`, vertices no kept face uses are dropped, and a name that no g, o or usemtl line
+// gives is an InputError listing the names that exist. With `options.allowPoints`, a file with no faces
+// gives a mesh with no triangles, its normals from the file's `vn` lines (one per vertex, in order) or,
+// without them, pointing away from the points' least-squares sphere.
 Mesh readObj(const std::filesystem::path& file, MeshReadStats* stats = nullptr);
+Mesh readObj(const std::filesystem::path& file, const MeshReadOptions& options,
+             MeshReadStats* stats = nullptr);
 Mesh parseObj(std::string_view text, const std::string& name, MeshReadStats* stats = nullptr);
+Mesh parseObj(std::string_view text, const std::string& name, const MeshReadOptions& options,
+              MeshReadStats* stats = nullptr);
 
 // Writes positions, normals, UVs (when present) and triangles; floats in shortest round-trip form so
 // the same mesh always gives the same bytes.

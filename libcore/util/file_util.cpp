@@ -311,6 +311,11 @@ void discardCommittedOutputs() {
   gCommitted.clear();
 }
 
+std::vector<fs::path> committedOutputs() {
+  std::lock_guard<std::mutex> lock(gCommittedMutex);
+  return std::vector<fs::path>(gCommitted.begin(), gCommitted.end());
+}
+
 void forgetCommittedOutputs() {
   std::lock_guard<std::mutex> lock(gCommittedMutex);
   gCommitted.clear();

@@ -91,5 +91,7 @@ void installInterruptCleanup();
 // resp. forgets them (a command that succeeded).
 void discardCommittedOutputs();
 void forgetCommittedOutputs();
+// The files committed since the last call of either, in commit order (for --stats).
+std::vector<std::filesystem::path> committedOutputs();
 
 }  // namespace hairgen

@@ -2,6 +2,8 @@
 //   EnergyEvaluation:   one thread, energies at the minimised coordinates of 50 guides, so
 //                       items_per_second is energy evaluations per second per core.
 //   GrowCoupe3:         the whole grow stage on every core, counters guides/s and evaluations/s.
+//   GrowDefault:        the same on the default coupe (configs/default), what the README's first
+//                       command grows.
 //   InterpolateCoupe3:  ~150,000 strands of 64 vertices from coupe 3's guides, every core.
 //   ShadeCoupe3:        `shade` on that 150,000-strand coupe with coupe 3's Render Info (grid, signed
 //                       distance, normals), every core; counters give the grid's size and each part's
@@ -34,17 +36,23 @@
 namespace hairgen {
 namespace {
 
-struct Coupe3 {
+// A bundled coupe's config and wick.
+struct Bundled {
   Config config;
   Mesh wick;
-  Coupe3()
-      : config(loadConfig(std::filesystem::path(HAIRGEN_SOURCE_DIR) / "configs/thesis/coupe3/setup.txt", {},
-                          SetupUse::kGrow)),
+  explicit Bundled(const char* setup)
+      : config(
+            loadConfig(std::filesystem::path(HAIRGEN_SOURCE_DIR) / "configs" / setup, {}, SetupUse::kGrow)),
         wick(readObj(config.setup.wickModel.path)) {}
 };
+using Coupe3 = Bundled;
 
 const Coupe3& coupe3() {
-  static const Coupe3 c;
+  static const Coupe3 c("thesis/coupe3/setup.txt");
+  return c;
+}
+const Bundled& defaultCoupe() {
+  static const Bundled c("default/setup.txt");
   return c;
 }
 
@@ -69,8 +77,7 @@ void EnergyEvaluation(benchmark::State& state) {
 }
 BENCHMARK(EnergyEvaluation);
 
-void GrowCoupe3(benchmark::State& state) {
-  const Coupe3& c = coupe3();
+void growBundled(benchmark::State& state, const Bundled& c) {
   uint64_t evaluations = 0, guides = 0;
   for (auto _ : state) {
     GrowResult g = grow(c.wick, c.config.hairstyle, c.config.collision, {});
@@ -82,8 +89,16 @@ void GrowCoupe3(benchmark::State& state) {
   state.counters["evals/s/core"] =
       benchmark::Counter(double(evaluations) / tbb::info::default_concurrency(), benchmark::Counter::kIsRate);
   state.counters["follicles"] = double(c.wick.vertexCount());
+  state.counters["elements"] = double(c.config.hairstyle.hairLengths.size());
+}
+void GrowCoupe3(benchmark::State& state) {
+  growBundled(state, coupe3());
 }
 BENCHMARK(GrowCoupe3)->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(3.0);
+void GrowDefault(benchmark::State& state) {
+  growBundled(state, defaultCoupe());
+}
+BENCHMARK(GrowDefault)->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(3.0);
 
 void InterpolateCoupe3(benchmark::State& state) {
   const Coupe3& c = coupe3();

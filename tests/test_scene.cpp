@@ -1,0 +1,111 @@
+// Real heads (README, Real heads): meshes read in other units, axes and groups, shapes fitted to a head,
+// the scene check, follicle inclination.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "libcore/io/obj_io.h"
+#include "libcore/model/shape_fit.h"
+#include "stages/scene.h"
+
+namespace hairgen {
+namespace {
+
+// Points on an axis-aligned ellipsoid, the upper `cap` of it (1 = all of it).
+std::vector<glm::vec3> onEllipsoid(glm::dvec3 centre, glm::dvec3 axes, double cap) {
+  std::vector<glm::vec3> out;
+  for (int i = 0; i <= 40; ++i)
+    for (int j = 0; j < 40; ++j) {
+      const double theta = M_PI * cap * i / 40.0, phi = 2 * M_PI * j / 40.0;
+      out.push_back(glm::vec3(centre + axes * glm::dvec3(std::sin(theta) * std::cos(phi), std::cos(theta),
+                                                         std::sin(theta) * std::sin(phi))));
+    }
+  return out;
+}
+
+TEST(ShapeFit, EllipsoidThroughItsOwnPointsIsExact) {
+  const glm::dvec3 centre(0.01, 1.7, -0.02), axes(0.08, 0.09, 0.11);
+  const EllipsoidFit e = fitAlignedEllipsoid(onEllipsoid(centre, axes, 1.0));
+  ASSERT_TRUE(e.valid);
+  EXPECT_NEAR(glm::length(e.centre - centre), 0.0, 1e-5);
+  EXPECT_NEAR(glm::length(e.semiAxes - axes), 0.0, 1e-5);
+  const SphereFit s = fitSphere(onEllipsoid(centre, glm::dvec3(0.1), 0.4));  // a cap: a scalp
+  EXPECT_NEAR(glm::length(s.centre - centre), 0.0, 1e-5);
+  EXPECT_NEAR(s.radius, 0.1, 1e-5);
+}
+
+TEST(ShapeFit, RootsOfAScalpLieOnOrOutsideTheFittedHead) {
+  const std::vector<glm::vec3> scalp = onEllipsoid({0, 1.7, 0}, {0.08, 0.085, 0.1}, 0.45);
+  const HeadFit fit = fitHead({}, scalp, false);
+  size_t inside = 0;
+  for (const glm::vec3& p : scalp)
+    inside += glm::length((glm::dvec3(p) - fit.centre) / fit.semiAxes) < 1.0 - 1e-6;
+  EXPECT_LE(double(inside), kRootsInside * double(scalp.size()) + 1);
+  EXPECT_NEAR(fit.centre.y, 1.7, 0.02);
+}
+
+const char* kGrouped =
+    "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nv 1 1 1\n"
+    "g skin\nf 1 2 3\ng scalp\nf 2 5 3\nusemtl hair\nf 1 3 4\n";
+
+TEST(MeshRead, WickGroupKeepsItsFacesAndNamesTheOthersWhenWrong) {
+  const Mesh skin = parseObj(kGrouped, "g.obj", MeshReadOptions{"skin", false, {}});
+  EXPECT_EQ(skin.triangleCount(), 1u);
+  EXPECT_EQ(skin.vertexCount(), 3u);  // only the vertices its faces use
+  EXPECT_EQ(parseObj(kGrouped, "g.obj", MeshReadOptions{"scalp", false, {}}).triangleCount(), 2u);
+  EXPECT_EQ(parseObj(kGrouped, "g.obj", MeshReadOptions{"hair", false, {}}).triangleCount(), 1u);
+  try {
+    parseObj(kGrouped, "g.obj", MeshReadOptions{"Scalp", false, {}});
+    FAIL() << "a wrong group was accepted";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("skin, scalp, hair"), std::string::npos) << e.what();
+  }
+}
+
+TEST(MeshRead, UnitsAndUpAxisAreAppliedOnReading) {
+  UnitConversion cmZUp{0.01, UpAxis::kZ};
+  const Mesh m =
+      parseObj("v 0 0 0\nv 100 0 0\nv 0 0 100\nf 1 2 3\n", "z.obj", MeshReadOptions{"", false, cmZUp});
+  EXPECT_EQ(m.positions[2], glm::vec3(0, 1, 0));  // z-up, centimetres: 1 m up
+  EXPECT_NEAR(m.normals[0].z, 1.0f, 1e-6f);       // the file's −y (its normal here) is +z
+}
+
+TEST(MeshRead, PointsAloneAreFolliclesFacingAwayFromTheirSphere) {
+  std::string text;
+  for (const glm::vec3& p : onEllipsoid({0, 1.7, 0}, glm::dvec3(0.1), 0.4))
+    text += "v " + std::to_string(p.x) + " " + std::to_string(p.y) + " " + std::to_string(p.z) + "\n";
+  EXPECT_THROW(parseObj(text, "roots.obj"), InputError);  // a mesh needs faces unless points are allowed
+  const Mesh roots = parseObj(text, "roots.obj", MeshReadOptions{"", true, {}});
+  EXPECT_EQ(roots.triangleCount(), 0u);
+  for (size_t i = 0; i < roots.vertexCount(); ++i) {
+    const glm::vec3 out = glm::normalize(roots.positions[i] - glm::vec3(0, 1.7f, 0));
+    EXPECT_GT(glm::dot(out, roots.normals[i]), 0.999f);
+  }
+}
+
+TEST(SceneCheck, NamesTheUnitsOfAScalpInCentimetres) {
+  Config config;
+  Mesh scalp;
+  scalp.positions = onEllipsoid({0, 170, 0}, glm::dvec3(10), 0.4);  // 10 cm radius, written in cm
+  for (int i = 0; i + 41 < int(scalp.positions.size()); ++i)
+    if ((i + 1) % 40) scalp.triangles.push_back({uint32_t(i), uint32_t(i + 40), uint32_t(i + 1)});
+  const std::vector<SceneFinding> found = checkScene(config, scalp, nullptr);
+  ASSERT_FALSE(found.empty());
+  EXPECT_TRUE(found[0].refuse);
+  EXPECT_NE(found[0].message.find("set MeshUnits cm"), std::string::npos) << found[0].message;
+}
+
+TEST(RootTilt, LeansTheFollicleTowardTheFlowByTheAngle) {
+  Hairstyle h;
+  const glm::dvec3 n(0, 0, 1);
+  EXPECT_EQ(h.growDirection({0, 0, 0}, n), n);  // RootTilt 0: the thesis' normal
+  h.rootTilt = 30.0;
+  const glm::dvec3 d = h.growDirection({0, 0, 0}, n);  // RootFlow down
+  EXPECT_NEAR(glm::degrees(std::acos(glm::dot(d, n))), 30.0, 1e-9);
+  EXPECT_LT(d.y, 0.0);
+  h.rootFlow = {RootFlow::Kind::kAwayFrom, glm::dvec3(0, 1, 0)};
+  EXPECT_EQ(h.growDirection({0, 1, 0}, {0, 1, 0}), glm::dvec3(0, 1, 0));  // at the crown itself: no lean
+}
+
+}  // namespace
+}  // namespace hairgen
