@@ -335,23 +335,32 @@ void SpringHair::stepStrand(size_t s, const AccelerationField& field, double dt)
   const uint32_t n = rest_.pointsOf(s) - 1;
   thread_local std::vector<glm::dvec3> turn, force, before;
   thread_local std::vector<double> lambda;
-  turn.resize(n + 1);
+  turn.resize(n + 2);
   force.resize(n + 1);
   before.resize(n + 1);
   // Bending: g_j = k_j (b̄_j − b_j), and each point's force Σ_j (B_j)_i g_j.
-  auto dir = [&](uint32_t j) { return (x_[p0 + j] - x_[p0 + j - 1]) / length_[p0 + j]; };
-  for (uint32_t j = 0; j < n; ++j) {
-    const glm::dvec3 b = dir(j + 1) - (j == 0 ? rootDirection_[s] : dir(j));
-    turn[j] = bend_[p0 + j] * (target_[p0 + j] - b);
+  // Each segment's direction over its rest length (e_j / l_j), once.
+  thread_local std::vector<glm::dvec3> unit;
+  thread_local std::vector<double> inverseLength;
+  unit.resize(n + 2);
+  inverseLength.resize(n + 2);
+  unit[0] = rootDirection_[s];
+  inverseLength[n + 1] = 0.0;
+  for (uint32_t j = 1; j <= n; ++j) {
+    inverseLength[j] = 1.0 / length_[p0 + j];
+    unit[j] = (x_[p0 + j] - x_[p0 + j - 1]) * inverseLength[j];
   }
-  turn[n] = glm::dvec3(0.0);  // no joint at the tip
+  unit[n + 1] = glm::dvec3(0.0);
+  for (uint32_t j = 0; j < n; ++j) turn[j] = bend_[p0 + j] * (target_[p0 + j] - (unit[j + 1] - unit[j]));
+  turn[n] = turn[n + 1] = glm::dvec3(0.0);  // no joint at the tip
   for (uint32_t i = 1; i <= n; ++i) {
     const uint32_t p = p0 + i;
-    glm::dvec3 f = turn[i - 1] / length_[p];
-    if (i < n) f += turn[i + 1] / length_[p + 1] - turn[i] * (1.0 / length_[p] + 1.0 / length_[p + 1]);
+    // Row i of Bᵀ: joints i − 1, i and i + 1 (turn[n] is 0, and 1/l_{n+1} is 0).
+    glm::dvec3 f = turn[i - 1] * inverseLength[i] + turn[i + 1] * inverseLength[i + 1] -
+                   turn[i] * (inverseLength[i] + inverseLength[i + 1]);
     // The rest tension along the segments, turning with them.
-    f -= restTension_[p] * dir(i);
-    if (i < n) f += restTension_[p + 1] * dir(i + 1);
+    f -= restTension_[p] * unit[i];
+    if (i < n) f += restTension_[p + 1] * unit[i + 1];
     f += mass_[p] * field.at(x_[p], v_[p]);
     if (!difference_.values.empty() && densityStrength_ > 0.0)
       f += mass_[p] * densityStrength_ * densityForce(difference_, x_[p]);
@@ -374,10 +383,12 @@ void SpringHair::stepStrand(size_t s, const AccelerationField& field, double dt)
   }
   // Inextensible (to the stretch compliance), twist springs, collisions, and the stretch once more.
   lambda.assign(n + 2, 0.0);
-  projectStretch(s, dt, 3, lambda);
+  projectStretch(s, dt, 1, lambda);
+  bool twisted = false;
   for (uint32_t i = 0; i + 3 <= n; ++i) {
     const uint32_t a = p0 + i, b = p0 + i + 3;
     if (twistCompliance_[a] < 0.0) continue;
+    twisted = true;
     const glm::dvec3 e = x_[b] - x_[a];
     const double len = glm::length(e);
     const double wsum = inverseMass_[a] + inverseMass_[b] + twistCompliance_[a] / (dt * dt);
@@ -385,17 +396,23 @@ void SpringHair::stepStrand(size_t s, const AccelerationField& field, double dt)
     x_[a] -= inverseMass_[a] * dl * e / len;
     x_[b] += inverseMass_[b] * dl * e / len;
   }
+  bool moved = twisted;
   for (size_t c = 0; c < shapes_.size(); ++c) {
     for (uint32_t i = 1; i <= n; ++i) {
       const uint32_t p = p0 + i;
       const glm::dvec3 v = x_[p] - shapes_[c].centre;
       if (glm::dot(v, v) >= shapeReach2_[c]) continue;
       const double inside = penetration(shapes_[c], x_[p]), allowed = restDepth_[c][p];
-      if (inside > allowed + 1e-9) x_[p] = pushedOut(shapes_[c], x_[p], inside, allowed);
+      if (inside > allowed + 1e-9) {
+        x_[p] = pushedOut(shapes_[c], x_[p], inside, allowed);
+        moved = true;
+      }
     }
   }
-  lambda.assign(n + 2, 0.0);
-  projectStretch(s, dt, 1, lambda);
+  if (moved) {  // what the twist springs and the shapes did to the lengths
+    lambda.assign(n + 2, 0.0);
+    projectStretch(s, dt, 1, lambda);
+  }
   for (uint32_t i = 1; i <= n; ++i) v_[p0 + i] = (x_[p0 + i] - before[i]) / dt;
 }
 
