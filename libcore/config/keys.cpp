@@ -743,8 +743,8 @@ Section<Dynamics> makeDynamics() {
                    "springs: a hair cache whose density the hair is pushed toward (Petrovic et al. §5.2)"},
                   &D::densityTarget),
        realKey<D>({"DensityStrength", "m/s²",
-                   "springs: a particle's acceleration per unit of the memo's density force (points per "
-                   "node); 0 = none"},
+                   "springs: the density force (Petrovic et al. §5.2) as a point's acceleration where the "
+                   "density differs from the target's by its mean from one node to the next; 0 = none"},
                   &D::densityStrength, Range::closed(0.0, 1e9)),
        densitySpacingsKey(),
        realKey<D>({"DensityRefine", "",

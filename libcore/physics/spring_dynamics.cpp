@@ -188,6 +188,15 @@ SpringHair::SpringHair(const Strands& rest, const Hairstyle& style, const Dynami
       Grid target = gridAround(both, h, 3);
       splat(target, densityTarget->points);
       for (float& value : target.values) value = float(double(value) * scale);
+      // The target's mean density where it has any: the force's unit at this spacing.
+      double sum = 0.0;
+      size_t occupied = 0;
+      for (float value : target.values)
+        if (value > 0.0f) {
+          sum += value;
+          ++occupied;
+        }
+      targetMean_.push_back(occupied ? sum / double(occupied) : 1.0);
       targets_.push_back(std::move(target));
     }
     for (size_t level = 0; level < targets_.size(); ++level) startEnergy_.push_back(densityEnergy(level));
@@ -303,15 +312,22 @@ void SpringHair::projectStretch(size_t s, double dt, int iterations, std::vector
   upper.resize(n + 2);
   rhs.resize(n + 2);
   const double dt2 = dt * dt;
-  for (int it = 0; it < iterations; ++it) {
+  // `iterations` passes, and more (up to kMaxPasses) while a segment is still off its length by more
+  // than kStretchTolerance: a big push (a collision, a strong density force) needs a few Newton steps.
+  constexpr int kMaxPasses = 8;
+  constexpr double kStretchTolerance = 1e-3;
+  for (int it = 0; it < kMaxPasses; ++it) {
+    double worst = 0.0;
     for (uint32_t j = 1; j <= n; ++j) {
       const glm::dvec3 e = x[p0 + j] - x[p0 + j - 1];
       const double len = glm::length(e);
+      worst = std::max(worst, std::abs(len - length_[p0 + j]) / length_[p0 + j]);
       u[j] = e / len;
       const double alpha = compliance_[p0 + j] / dt2;
       diag[j] = inverseMass_[p0 + j - 1] + inverseMass_[p0 + j] + alpha;
       rhs[j] = -(len - length_[p0 + j]) - alpha * lambda[j];
     }
+    if (it >= iterations && worst <= kStretchTolerance) break;
     for (uint32_t j = 1; j < n; ++j) upper[j] = -inverseMass_[p0 + j] * glm::dot(u[j], u[j + 1]);
     // Thomas: forward elimination, back substitution.
     for (uint32_t j = 2; j <= n; ++j) {
@@ -362,8 +378,14 @@ void SpringHair::stepStrand(size_t s, const AccelerationField& field, double dt)
     f -= restTension_[p] * unit[i];
     if (i < n) f += restTension_[p + 1] * unit[i + 1];
     f += mass_[p] * field.at(x_[p], v_[p]);
-    if (!difference_.values.empty() && densityStrength_ > 0.0)
-      f += mass_[p] * densityStrength_ * densityForce(difference_, x_[p]);
+    if (!difference_.values.empty() && densityStrength_ > 0.0) {
+      // The memo's F in units of the target's mean density, at most 1 long: where the shapes are far
+      // apart the push is DensityStrength toward the target, not a kick that flings the hair.
+      glm::dvec3 push = densityForce(difference_, x_[p]) / targetMean_[level_];
+      const double size = glm::length(push);
+      if (size > 1.0) push /= size;
+      f += mass_[p] * densityStrength_ * push;
+    }
     force[i] = mass_[p] * v_[p] + dt * f;
   }
   // Backward Euler for the bending (and damping): A v⁺ = M v + Δt f, A = L D Lᵀ.
@@ -488,25 +510,35 @@ std::vector<double> SpringHair::state() const {
 }
 
 void SpringHair::stateInto(std::vector<double>& out) const {
-  out.resize(x_.size() * kStateValues);
+  // Per segment, its end point: the roots are the head's and never move.
+  out.resize((x_.size() - rest_.strandCount()) * kStateValues);
+  size_t k = 0;
   for (size_t p = 0; p < x_.size(); ++p) {
-    double* v = &out[kStateValues * p];
-    for (int k = 0; k < 3; ++k) {
-      v[k] = x_[p][k];
-      v[3 + k] = v_[p][k];
+    if (length_[p] == 0.0) continue;  // a root
+    double* v = &out[kStateValues * k++];
+    for (int c = 0; c < 3; ++c) {
+      v[c] = x_[p][c];
+      v[3 + c] = v_[p][c];
     }
   }
 }
 
 void SpringHair::restore(const std::vector<double>& state, const std::string& source) {
-  if (state.size() != x_.size() * kStateValues)
+  const size_t segments = x_.size() - rest_.strandCount();
+  if (state.size() != segments * kStateValues)
     throw InputError({source, 0}, "its simulation state has " + std::to_string(state.size() / kStateValues) +
-                                      " points, the guides " + std::to_string(x_.size()) +
+                                      " segments, the guides " + std::to_string(segments) +
                                       "; restart from a frame of the same guides (and the same Model)");
   for (double value : state)
     if (!std::isfinite(value)) throw InputError({source, 0}, "its simulation state holds a non-finite value");
+  size_t k = 0;
   for (size_t p = 0; p < x_.size(); ++p) {
-    const double* v = &state[kStateValues * p];
+    if (length_[p] == 0.0) {
+      x_[p] = xRest_[p];
+      v_[p] = glm::dvec3(0.0);
+      continue;
+    }
+    const double* v = &state[kStateValues * k++];
     x_[p] = glm::dvec3(v[0], v[1], v[2]);
     v_[p] = glm::dvec3(v[3], v[4], v[5]);
   }

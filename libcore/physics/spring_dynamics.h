@@ -38,7 +38,9 @@
 //   mass inner product with eigenvalues in [0, 1] (README), so it never raises the kinetic energy.
 // - Density targeting (§5.2): the target's points (scaled to the hair's point count) and the hair's are
 //   splatted on one fixed grid per spacing; a particle's acceleration is DensityStrength times the memo's
-//   F (densityForce in libcore/volume/hair_volume.h). Spacings go from coarse to fine: at each frame
+//   F (densityForce in libcore/volume/hair_volume.h) over the target's mean density where it has any,
+//   so the strength means the same on every grid: the acceleration of a point where the density is
+//   wrong by the target's mean from one node to the next. Spacings go from coarse to fine: at each frame
 //   the hair uses the finest spacing all of whose coarser ones have fallen to DensityRefine of their
 //   starting energy (a rule of the present state, so a restart needs nothing more).
 //
@@ -92,8 +94,8 @@ class SpringHair {
   Strands posed(const Pose& pose) const;
   void posedInto(const Pose& pose, Strands& out) const;
 
-  // What a restart needs: per point, its position and velocity in the head's frame (kStateValues
-  // doubles); and the inverse.
+  // What a restart needs: per segment, its end point's position and velocity in the head's frame
+  // (kStateValues doubles; the roots are the head's); and the inverse.
   static constexpr size_t kStateValues = 6;
   std::vector<double> state() const;
   void stateInto(std::vector<double>& out) const;
@@ -149,6 +151,7 @@ class SpringHair {
   // start; the strength, the refine fraction and the level in use.
   std::vector<Grid> targets_;
   std::vector<double> startEnergy_;
+  std::vector<double> targetMean_;  // per level, the target's mean density over the nodes it occupies
   double densityStrength_ = 0.0, densityRefine_ = 0.5;
   size_t level_ = 0;
   Grid difference_;  // D_s − D_t of the current substep, at level_
