@@ -1,6 +1,8 @@
 // The simulate stage (DESIGN §8): the rest guides stepped through time under Dynamics Info — the wind,
 // the keyed head motion, gravity — one guide cache per frame. Model anjyo is Anjyo et al. 1992 §3
-// (libcore/physics/anjyo_dynamics.h).
+// (libcore/physics/anjyo_dynamics.h); Model springs is Petrovic et al. 2006 §5, mass-spring keyhairs
+// with velocity smoothing and density targeting (libcore/physics/spring_dynamics.h), which reads its
+// DensityTarget cache here.
 //
 // Frame Frames.first is the rest state: the input guides, moved by the head's pose at that frame. Each
 // later frame is one step of 1/FrameRate seconds in Substeps substeps. Every frame carries its frame
