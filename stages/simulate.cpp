@@ -1,10 +1,7 @@
 #include "stages/simulate.h"
 
-#include <optional>
-
 #include <tbb/task_arena.h>
 
-#include "libcore/io/hair_cache.h"
 #include "libcore/physics/anjyo_dynamics.h"
 #include "libcore/physics/spring_dynamics.h"
 #include "libcore/util/error.h"
@@ -51,9 +48,11 @@ void simulate(const Strands& restGuides, const Config& config, const SimulateOpt
                                size_t(tbb::this_task_arena::max_concurrency())),
               options.force);
   if (d.model == DynamicsModel::kSprings) {
-    std::optional<Strands> target;
-    if (d.densityTarget.given()) target = readStrands(d.densityTarget.path.string());
-    SpringHair hair(restGuides, config.hairstyle, d, config.collision, target ? &*target : nullptr);
+    if (d.densityTarget.given() && !options.densityTarget)
+      throw InputError(d.densityTarget.where, "the DensityTarget " + d.densityTarget.path.string() +
+                                                  " was not read; pass it in SimulateOptions");
+    SpringHair hair(restGuides, config.hairstyle, d, config.collision,
+                    d.densityTarget.given() ? options.densityTarget : nullptr);
     run(hair, dynamicsGravity(config.hairstyle, d), restGuides, config, options, frameDone);
   } else {
     AnjyoHair hair(restGuides, config.hairstyle, d, config.collision, config.hairstyle.seed);

@@ -466,6 +466,9 @@ springs)
     --quiet --set "Dynamics.Frames=1 2"
   expect_rc 2 "$hairgen" simulate "$setup" --guides "$tmp/g.hair" -o "$tmp/d/g.####.hair" "${small[@]}" --set "Dynamics.PseudoForce=-0.75 0.1 0.01"
   grep -q "PseudoForce is a key of Model anjyo" "$tmp/err" || fail "anjyo key on springs: $(cat "$tmp/err")"
+  # A key that would be read and not used is refused: a smoothing grid with no smoothing.
+  expect_rc 2 "$hairgen" simulate "$setup" --guides "$tmp/g.hair" -o "$tmp/d/g.####.hair" "${small[@]}" --set Dynamics.VelocitySmoothing=0
+  grep -q "SmoothingSpacing is the grid of VelocitySmoothing" "$tmp/err" || fail "unused SmoothingSpacing: $(cat "$tmp/err")"
   ;;
 shot_run_equals_stages)
   # `run` on a shot writes what the stages chained by hand write: the simulated guides and every frame.

@@ -697,6 +697,16 @@ void checkModelKeys(SectionReader& r, const Dynamics& d) {
                                          (springs ? "anjyo" : "springs") +
                                          ", and this Dynamics Info is Model " + name(d.model) +
                                          "; remove it or change the Model");
+  for (const char* key : {"DensitySpacings", "DensityRefine"})
+    if (r.has(key) && !d.densityTarget.given())
+      throw InputError(r.where(key),
+                       std::string(key) +
+                           " sets up the density grids of a DensityTarget, and none is named; add "
+                           "`DensityTarget FILE` (a hair cache) or remove it");
+  if (r.has("SmoothingSpacing") && !(d.velocitySmoothing > 0.0))
+    throw InputError(r.where("SmoothingSpacing"),
+                     "SmoothingSpacing is the grid of VelocitySmoothing, which is 0; set VelocitySmoothing "
+                     "above 0 or remove it");
   if (d.densityStrength > 0.0 && !d.densityTarget.given())
     throw InputError(r.where("DensityStrength"),
                      "DensityStrength pushes the hair toward a DensityTarget, and none is named; add "
