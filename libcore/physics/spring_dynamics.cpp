@@ -18,16 +18,16 @@ constexpr double kMaxGridNodes = 2e7;
 // A grid of spacing h whose nodes sit on multiples of h, with one empty node beyond the points on every
 // side, so every point has all 8 of its cell's corners inside.
 template <class T>
-GridOf<T> latticeAround(const std::vector<glm::dvec3>& points, const std::vector<double>& inverseMass,
-                        double h) {
+void latticeAround(const std::vector<glm::dvec3>& points, const std::vector<double>& inverseMass, double h,
+                   GridOf<T>& g) {
   glm::dvec3 lo(1e300), hi(-1e300);
   for (size_t p = 0; p < points.size(); ++p) {
     if (inverseMass[p] == 0.0) continue;
     lo = glm::min(lo, points[p]);
     hi = glm::max(hi, points[p]);
   }
-  GridOf<T> g;
-  if (!(lo.x <= hi.x)) return g;
+  g.values.clear();
+  if (!(lo.x <= hi.x)) return;
   for (;;) {
     const glm::dvec3 first = glm::floor(lo / h) - 1.0, last = glm::floor(hi / h) + 2.0;
     const glm::dvec3 n = last - first + 1.0;
@@ -35,8 +35,8 @@ GridOf<T> latticeAround(const std::vector<glm::dvec3>& points, const std::vector
       g.origin = first * h;
       g.voxel = h;
       g.size = glm::ivec3(n);
-      g.values.assign(size_t(g.size.x) * g.size.y * g.size.z, T(0.0));
-      return g;
+      g.values.assign(size_t(g.size.x) * g.size.y * g.size.z, T(0.0));  // reuses the last frame's memory
+      return;
     }
     h *= 2.0;
   }
@@ -442,11 +442,15 @@ void SpringHair::smoothVelocities(double fraction) {
   if (!(fraction > 0.0)) return;
   // Masses and momenta (m, m v) of the free points on the grid (W M), filtered (S), the node velocity
   // their quotient (D⁻¹), filtered again (S) and read back with the same tent weights (Wᵀ).
-  GridOf<glm::dvec4> grid = latticeAround<glm::dvec4>(x_, inverseMass_, smoothingSpacing_);
+  GridOf<glm::dvec4>& grid = velocityGrid_;
+  latticeAround(x_, inverseMass_, smoothingSpacing_, grid);
   if (grid.values.empty()) return;
-  std::vector<glm::dvec3> where;
-  std::vector<glm::dvec4> what;
-  std::vector<size_t> which;
+  std::vector<glm::dvec3>& where = smoothWhere_;
+  std::vector<glm::dvec4>& what = smoothWhat_;
+  std::vector<size_t>& which = smoothWhich_;
+  where.clear();
+  what.clear();
+  which.clear();
   for (size_t p = 0; p < x_.size(); ++p) {
     if (inverseMass_[p] == 0.0) continue;
     where.push_back(x_[p]);
@@ -454,10 +458,10 @@ void SpringHair::smoothVelocities(double fraction) {
     which.push_back(p);
   }
   splatValues(grid, where, what);
-  grid = smoothed(grid);
+  smoothInPlace(grid);
   for (glm::dvec4& node : grid.values)
     node = node.w > 0.0 ? glm::dvec4(glm::dvec3(node) / node.w, 1.0) : glm::dvec4(0.0);
-  grid = smoothed(grid);
+  smoothInPlace(grid);
   tbb::parallel_for(size_t(0), which.size(), [&](size_t k) {
     const size_t p = which[k];
     const glm::dvec3 target(grid.sample(where[k]));

@@ -155,6 +155,11 @@ class SpringHair {
   double densityStrength_ = 0.0, densityRefine_ = 0.5;
   size_t level_ = 0;
   Grid difference_;  // D_s − D_t of the current substep, at level_
+  // Velocity smoothing's grid and point lists, kept between frames so their memory is reused.
+  GridOf<glm::dvec4> velocityGrid_;
+  std::vector<glm::dvec3> smoothWhere_;
+  std::vector<glm::dvec4> smoothWhat_;
+  std::vector<size_t> smoothWhich_;
 };
 
 }  // namespace hairgen

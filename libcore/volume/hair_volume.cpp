@@ -175,25 +175,36 @@ void splatValues(GridOf<T>& d, const std::vector<glm::dvec3>& points, const std:
 }
 
 template <class T>
-GridOf<T> smoothed(const GridOf<T>& g) {
+void smoothInPlace(GridOf<T>& g) {
   // Separable [1 2 1]/4 along x, y and z, edges clamped (an edge node keeps 3/4 of itself and gives
-  // its neighbour 1/4, as that neighbour gives it: the matrix stays symmetric).
+  // its neighbour 1/4, as that neighbour gives it: the matrix stays symmetric). Line by line through a
+  // copy of the line; lines are independent, so any thread count gives the same bits.
   using Scalar = std::conditional_t<std::is_same_v<T, float>, float, double>;
   const Scalar quarter = Scalar(0.25), half = Scalar(0.5);
-  GridOf<T> out = g;
   const glm::ivec3 n = g.size;
   for (int axis = 0; axis < 3; ++axis) {
-    GridOf<T> in = out;
-    for (int k = 0; k < n.z; ++k)
-      for (int j = 0; j < n.y; ++j)
-        for (int i = 0; i < n.x; ++i) {
-          glm::ivec3 c(i, j, k), a = c, b = c;
-          a[axis] = std::max(c[axis] - 1, 0);
-          b[axis] = std::min(c[axis] + 1, n[axis] - 1);
-          out.values[out.index(i, j, k)] =
-              quarter * in.at(a.x, a.y, a.z) + half * in.at(i, j, k) + quarter * in.at(b.x, b.y, b.z);
-        }
+    const size_t stride = axis == 0 ? 1 : axis == 1 ? size_t(n.x) : size_t(n.x) * size_t(n.y);
+    const int length = n[axis], u = (axis + 1) % 3, w = (axis + 2) % 3;
+    tbb::parallel_for(0, n[w], [&](int cw) {
+      std::vector<T> line(static_cast<size_t>(length));
+      for (int cu = 0; cu < n[u]; ++cu) {
+        glm::ivec3 c(0);
+        c[u] = cu;
+        c[w] = cw;
+        T* first = &g.values[g.index(c.x, c.y, c.z)];
+        for (int t = 0; t < length; ++t) line[size_t(t)] = first[size_t(t) * stride];
+        for (int t = 0; t < length; ++t)
+          first[size_t(t) * stride] = quarter * line[size_t(std::max(t - 1, 0))] + half * line[size_t(t)] +
+                                      quarter * line[size_t(std::min(t + 1, length - 1))];
+      }
+    });
   }
+}
+
+template <class T>
+GridOf<T> smoothed(const GridOf<T>& g) {
+  GridOf<T> out = g;
+  smoothInPlace(out);
   return out;
 }
 
@@ -233,6 +244,8 @@ template struct GridOf<float>;
 template struct GridOf<glm::dvec4>;
 template GridOf<float> gridAround<float>(const std::vector<glm::vec3>&, double, int);
 template GridOf<glm::dvec4> gridAround<glm::dvec4>(const std::vector<glm::vec3>&, double, int);
+template void smoothInPlace<float>(GridOf<float>&);
+template void smoothInPlace<glm::dvec4>(GridOf<glm::dvec4>&);
 template GridOf<float> smoothed<float>(const GridOf<float>&);
 template GridOf<glm::dvec4> smoothed<glm::dvec4>(const GridOf<glm::dvec4>&);
 template void splatValues<glm::dvec4>(GridOf<glm::dvec4>&, const std::vector<glm::dvec3>&,

@@ -56,6 +56,9 @@ void splatValues(GridOf<T>& grid, const std::vector<glm::dvec3>& points, const s
 // weighted average stays a weighted average.
 template <class T>
 GridOf<T> smoothed(const GridOf<T>& grid);
+// The same filter on `grid` itself (no second grid; the same bits as smoothed()).
+template <class T>
+void smoothInPlace(GridOf<T>& grid);
 
 // Petrovic et al. §5.2: the force on a point at `p` from the density difference `difference` = D_s −
 // D_t of the memo's (3), E = ½ Σ (D_s − D_t)²: −∂E/∂p in grid units (p measured in voxels), the memo's
