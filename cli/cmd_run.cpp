@@ -77,6 +77,10 @@ void runShot(const CommonOptions& common, const Config& config, const Mesh& wick
   simOptions.configDigest = config.digest();
   simOptions.frames = frames;
   simOptions.force = common.force;
+  std::optional<Strands> target;  // Model springs' DensityTarget
+  if (d.model == DynamicsModel::kSprings && d.densityTarget.given())
+    target = readStrands(d.densityTarget.path);
+  simOptions.densityTarget = target ? &*target : nullptr;
   simulate(guides, config, simOptions, [&](int f, const Strands& frameGuides) {
     stats.add("simulate", clock.lap());
     writeStrands(framePath(simPattern, f), frameGuides);

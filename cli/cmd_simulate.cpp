@@ -53,14 +53,22 @@ void registerSimulate(CLI::App& app, int& exitCode) {
         restartName = framePath(options->output, frames.first - 1).string();
         if (std::filesystem::exists(restartName)) restart = readStrands(restartName);
       }
+      std::optional<Strands> target;  // Model springs' DensityTarget
+      if (d.model == DynamicsModel::kSprings && d.densityTarget.given())
+        target = readStrands(d.densityTarget.path);
       stats.time("read", clock.lap());
       note(options->common, "simulate: " + std::to_string(rest.strandCount()) + " guides, frames " +
                                 std::to_string(frames.first) + "-" + std::to_string(frames.last) + " at " +
                                 formatReal(d.frameRate) + " fps, " + std::to_string(d.substeps) +
                                 " substeps");
       Progress progress("simulate", "frames", size_t(frames.count()), !options->common.quiet);
-      SimulateOptions simOptions{config.digest(), frames,    restart ? &*restart : nullptr,
-                                 restartName,     &progress, options->common.force};
+      SimulateOptions simOptions{config.digest(),
+                                 frames,
+                                 restart ? &*restart : nullptr,
+                                 restartName,
+                                 &progress,
+                                 options->common.force,
+                                 target ? &*target : nullptr};
       double writing = 0.0;
       simulate(rest, config, simOptions, [&](int frame, const Strands& guides) {
         Stopwatch write;

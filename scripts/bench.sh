@@ -14,7 +14,7 @@ case "$group" in
   interpolate) filter='InterpolateCoupe3' ;;
   shade) filter='ShadeCoupe3' ;;
   render) filter='Render' ;;
-  simulate) filter='SimulateAnjyo' ;;
+  simulate) filter='SimulateAnjyo|SimulateSprings' ;;
   cache) filter='ReadCache|WriteCache' ;;
   all) filter='.' ;;
   *) echo "bench.sh: unknown group '$group' (grow, cantilever, interpolate, shade, render, simulate, cache, all)" >&2; exit 2 ;;

@@ -29,6 +29,10 @@ constexpr double kSecondsPerPoint = 25e-9;
 constexpr double kSecondsPerNode = 500e-9, kSecondsPerSplat = 60e-9;
 // Anjyo's dynamics: one segment's step, with its trigonometry, joint limit and collision tests.
 constexpr double kSecondsPerSegmentStep = 60e-9;
+// Model springs: one particle's substep with the stretch solve, the banded solve and the collisions,
+// and its share of the frame's velocity smoothing (SimulateSprings: ~0.12 CPU s a frame for 310k
+// segments at 2 substeps).
+constexpr double kSecondsPerSpringStep = 200e-9;
 // llvmpipe: per vertex pushed through a pass, and per fragment of the shading pass with its shadow
 // look-ups and overdraw (render benchmarks; 1,000 strands 0.5 m wide at 640x640 took 113 s).
 constexpr double kSecondsPerVertex = 150e-9, kSecondsPerFragment = 60e-9;
@@ -170,7 +174,8 @@ WorkEstimate estimateSimulate(const Dynamics& d, size_t segments, const FrameRan
   e.stage = "simulate";
   const double steps = double(frames.count()) * double(d.substeps);
   e.bytes = bytesOf(double(segments) * 200.0);  // state, rest, constants and a posed copy per segment
-  e.seconds = double(segments) * steps * kSecondsPerSegmentStep / cores(threads);
+  const double perStep = d.model == DynamicsModel::kSprings ? kSecondsPerSpringStep : kSecondsPerSegmentStep;
+  e.seconds = double(segments) * steps * perStep / cores(threads);
   e.memoryKey = "the guides' size";
   e.timeKey = "Dynamics.Substeps or Dynamics.Frames";
   e.detail = std::to_string(segments) + " segments, " + formatReal(steps) + " steps";

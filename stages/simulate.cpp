@@ -3,6 +3,7 @@
 #include <tbb/task_arena.h>
 
 #include "libcore/physics/anjyo_dynamics.h"
+#include "libcore/physics/spring_dynamics.h"
 #include "libcore/util/error.h"
 #include "stages/estimate.h"
 
@@ -13,6 +14,24 @@ HeadMotion headMotionOf(const Config& config) {
                     config.dynamics.frameRate);
 }
 
+namespace {
+
+// One substep's call for each model: Anjyo's keys its fluctuations by the frame, the springs smooth
+// their velocities after a frame's last substep.
+void stepHair(AnjyoHair& hair, const AccelerationField& field, double dt, int frame, int substep, int) {
+  hair.step(field, dt, frame, substep == 0);
+}
+void stepHair(SpringHair& hair, const AccelerationField& field, double dt, int, int substep, int substeps) {
+  hair.step(field, dt, substep == 0, substep == substeps - 1);
+}
+
+template <class Hair>
+void run(Hair& hair, double gravity, const Strands& restGuides, const Config& config,
+         const SimulateOptions& options,
+         const std::function<void(int frame, const Strands& guides)>& frameDone);
+
+}  // namespace
+
 void simulate(const Strands& restGuides, const Config& config, const SimulateOptions& options,
               const std::function<void(int frame, const Strands& guides)>& frameDone) {
   const Dynamics& d = config.dynamics;
@@ -20,9 +39,6 @@ void simulate(const Strands& restGuides, const Config& config, const SimulateOpt
     throw InputError(config.setup.file.string() +
                      ": the Setup names no Dynamics Info; add `DynamicsInfo FILE` "
                      "(Model, Frames, FrameRate, Wind, HeadKey, ...)");
-  if (d.model != DynamicsModel::kAnjyo)
-    throw InputError("Dynamics Model " + std::string(name(d.model)) +
-                     " is not available in this build of hairgen");
   const FrameRange frames = options.frames;
   if (frames.first < d.firstFrame || frames.last > d.lastFrame)
     throw InputError("frames " + std::to_string(frames.first) + "-" + std::to_string(frames.last) +
@@ -31,9 +47,28 @@ void simulate(const Strands& restGuides, const Config& config, const SimulateOpt
   requireFits(estimateSimulate(d, restGuides.pointCount() - restGuides.strandCount(), frames,
                                size_t(tbb::this_task_arena::max_concurrency())),
               options.force);
+  if (d.model == DynamicsModel::kSprings) {
+    if (d.densityTarget.given() && !options.densityTarget)
+      throw InputError(d.densityTarget.where, "the DensityTarget " + d.densityTarget.path.string() +
+                                                  " was not read; pass it in SimulateOptions");
+    SpringHair hair(restGuides, config.hairstyle, d, config.collision,
+                    d.densityTarget.given() ? options.densityTarget : nullptr);
+    run(hair, dynamicsGravity(config.hairstyle, d), restGuides, config, options, frameDone);
+  } else {
+    AnjyoHair hair(restGuides, config.hairstyle, d, config.collision, config.hairstyle.seed);
+    run(hair, config.hairstyle.gravity, restGuides, config, options, frameDone);
+  }
+}
 
+namespace {
+
+template <class Hair>
+void run(Hair& hair, double gravity, const Strands& restGuides, const Config& config,
+         const SimulateOptions& options,
+         const std::function<void(int frame, const Strands& guides)>& frameDone) {
+  const Dynamics& d = config.dynamics;
+  const FrameRange frames = options.frames;
   const HeadMotion head = headMotionOf(config);
-  AnjyoHair hair(restGuides, config.hairstyle, d, config.collision, config.hairstyle.seed);
   Strands guides;  // every frame's, reused: no fresh pages to fault in per frame
   auto emit = [&](int frame) {
     hair.posedInto(head.pose(frame), guides);
@@ -73,11 +108,13 @@ void simulate(const Strands& restGuides, const Config& config, const SimulateOpt
     for (int s = 0; s < d.substeps; ++s) {
       // The forces of the substep's start (Störmer-Verlet), in frames since the shot began.
       const double t = double(frame - 1) + double(s) / double(d.substeps);
-      const AccelerationField field = headFrameField(head.at(t), windAt(d.wind, t), config.hairstyle.gravity);
-      hair.step(field, dt, frame, s == 0);
+      const AccelerationField field = headFrameField(head.at(t), windAt(d.wind, t), gravity);
+      stepHair(hair, field, dt, frame, s, d.substeps);
     }
     emit(frame);
   }
 }
+
+}  // namespace
 
 }  // namespace hairgen

@@ -1,6 +1,8 @@
 // The simulate stage (DESIGN §8): the rest guides stepped through time under Dynamics Info — the wind,
 // the keyed head motion, gravity — one guide cache per frame. Model anjyo is Anjyo et al. 1992 §3
-// (libcore/physics/anjyo_dynamics.h).
+// (libcore/physics/anjyo_dynamics.h); Model springs is Petrovic et al. 2006 §5, mass-spring keyhairs
+// with velocity smoothing and density targeting (libcore/physics/spring_dynamics.h), toward the
+// DensityTarget cache the caller has read.
 //
 // Frame Frames.first is the rest state: the input guides, moved by the head's pose at that frame. Each
 // later frame is one step of 1/FrameRate seconds in Substeps substeps. Every frame carries its frame
@@ -27,6 +29,8 @@ struct SimulateOptions {
   std::string restartName;           // names it in errors
   Progress* progress = nullptr;      // advanced once per frame
   bool force = false;                // run work estimated to take absurdly long
+  const Strands* densityTarget = nullptr;  // Model springs: Dynamics DensityTarget as read (required
+                                           // when the Dynamics Info names one)
 };
 
 // Calls `frameDone(frame, guides)` for every frame of options.frames, in order; `guides` is valid until

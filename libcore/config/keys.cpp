@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <cmath>
 #include <iterator>
+#include <span>
 
 #include "libcore/util/text.h"
 
@@ -766,6 +767,77 @@ Key<Dynamics> restFrequencyKey() {
       });
 }
 
+// A value that defaults to one computed from other keys: `auto`, or a number in `range`.
+Key<Dynamics> autoRealKey(KeyText t, std::string what, bool Dynamics::*isAuto, double Dynamics::*member,
+                          Range range) {
+  const std::string name = t.name;
+  return customKey<Dynamics>(
+      t, "auto | " + what, range.describe(),
+      [=](SectionReader& r, Dynamics& d) {
+        const ConfigLine* line = r.line(name);
+        if (!line) return;
+        if (line->values.size() != 1) throw r.error(*line, name + " takes auto or a number");
+        if (toLower(line->values[0]) == "auto") return;
+        d.*isAuto = false;
+        d.*member = r.checkReal(*line, 0, range, what);
+      },
+      [=](const Dynamics& d) {
+        return std::vector<std::string>{d.*isAuto ? std::string("auto") : formatReal(d.*member)};
+      });
+}
+
+Key<Dynamics> densitySpacingsKey() {
+  return customKey<Dynamics>(
+      {"DensitySpacings", "m",
+       "springs: the density grids' spacings, coarse to fine; the next takes over when the energy at this "
+       "one falls to DensityRefine of its start"},
+      "h1 [h2 ...]", "(0, 10], not increasing",
+      [](SectionReader& r, Dynamics& d) {
+        if (!r.has("DensitySpacings")) return;
+        d.densitySpacings = r.realList("DensitySpacings", {0.0, 10.0, true, false});
+        for (size_t i = 1; i < d.densitySpacings.size(); ++i)
+          if (d.densitySpacings[i] > d.densitySpacings[i - 1])
+            throw InputError(r.where("DensitySpacings"),
+                             "DensitySpacings go from coarse to fine: " + formatReal(d.densitySpacings[i]) +
+                                 " follows the finer " + formatReal(d.densitySpacings[i - 1]));
+      },
+      [](const Dynamics& d) {
+        std::string out;
+        for (double h : d.densitySpacings) out += (out.empty() ? "" : " ") + formatReal(h);
+        return std::vector<std::string>{out};
+      });
+}
+
+// The keys only one model reads: naming one for the other model is an error (a key that is read is
+// used).
+void checkModelKeys(SectionReader& r, const Dynamics& d) {
+  static const char* anjyoOnly[] = {"Inertia", "PseudoForce", "Fluctuation", "RestFrequency"};
+  static const char* springsOnly[] = {
+      "Gravity",          "StretchStiffness", "BendStiffness",   "TwistStiffness",  "VelocitySmoothing",
+      "SmoothingSpacing", "DensityTarget",    "DensityStrength", "DensitySpacings", "DensityRefine"};
+  const bool springs = d.model == DynamicsModel::kSprings;
+  for (const char* key : springs ? std::span<const char*>(anjyoOnly) : std::span<const char*>(springsOnly))
+    if (r.has(key))
+      throw InputError(r.where(key), std::string(key) + " is a key of Model " +
+                                         (springs ? "anjyo" : "springs") +
+                                         ", and this Dynamics Info is Model " + name(d.model) +
+                                         "; remove it or change the Model");
+  for (const char* key : {"DensitySpacings", "DensityRefine"})
+    if (r.has(key) && !d.densityTarget.given())
+      throw InputError(r.where(key),
+                       std::string(key) +
+                           " sets up the density grids of a DensityTarget, and none is named; add "
+                           "`DensityTarget FILE` (a hair cache) or remove it");
+  if (r.has("SmoothingSpacing") && !(d.velocitySmoothing > 0.0))
+    throw InputError(r.where("SmoothingSpacing"),
+                     "SmoothingSpacing is the grid of VelocitySmoothing, which is 0; set VelocitySmoothing "
+                     "above 0 or remove it");
+  if (d.densityStrength > 0.0 && !d.densityTarget.given())
+    throw InputError(r.where("DensityStrength"),
+                     "DensityStrength pushes the hair toward a DensityTarget, and none is named; add "
+                     "`DensityTarget FILE` (a hair cache)");
+}
+
 Section<Dynamics> makeDynamics() {
   using D = Dynamics;
   return makeSection<D>(
@@ -777,8 +849,44 @@ Section<Dynamics> makeDynamics() {
        integerKey<D>({"Substeps", "", "integration steps per frame"}, &D::substeps, 1, 1000),
        realKey<D>({"Damping", "1/s", "the rate at which motion dies away (air, hair on hair)"}, &D::damping,
                   Range::closed(0.0, 1000.0)),
-       windKey(), headKeyKey(), headCentreKey(), inertiaKey(), pseudoForceKey(), fluctuationKey(),
-       restFrequencyKey()});
+       windKey(),
+       headKeyKey(),
+       headCentreKey(),
+       autoRealKey(
+           {"Gravity", "N/kg", "the gravity the moving hair feels, along -y; auto = Hairstyle's Gravity"},
+           "N/kg", &D::gravityAuto, &D::gravity, Range::closed(0.0, 1000.0)),
+       inertiaKey(),
+       pseudoForceKey(),
+       fluctuationKey(),
+       restFrequencyKey(),
+       autoRealKey({"StretchStiffness", "N",
+                    "springs: a segment's force per unit strain, E·A; auto = Young × π a b (effectively "
+                    "inextensible)"},
+                   "N", &D::stretchStiffnessAuto, &D::stretchStiffness, Range::positive()),
+       autoRealKey({"BendStiffness", "N·m²", "springs: E·I; auto = Young × π a b³/4"}, "N·m²",
+                   &D::bendStiffnessAuto, &D::bendStiffness, Range::nonNegative()),
+       autoRealKey(
+           {"TwistStiffness", "N·m²", "springs: μ·J; auto = Young/(2(1 + Poisson)) × π a b (a² + b²)/4"},
+           "N·m²", &D::twistStiffnessAuto, &D::twistStiffness, Range::nonNegative()),
+       realKey<D>({"VelocitySmoothing", "",
+                   "springs: the fraction of each particle's departure from the smoothed grid velocity "
+                   "removed per frame (Petrovic et al. §5.1)"},
+                  &D::velocitySmoothing, Range::closed(0.0, 1.0)),
+       realKey<D>({"SmoothingSpacing", "m", "springs: the velocity grid's spacing"}, &D::smoothingSpacing,
+                  {0.0, 10.0, true, false}),
+       pathKey<D>({"DensityTarget", "",
+                   "springs: a hair cache whose density the hair is pushed toward (Petrovic et al. §5.2)"},
+                  &D::densityTarget),
+       realKey<D>({"DensityStrength", "m/s²",
+                   "springs: the density force (Petrovic et al. §5.2) as a point's acceleration where the "
+                   "density differs from the target's by its mean from one node to the next; 0 = none"},
+                  &D::densityStrength, Range::closed(0.0, 1e9)),
+       densitySpacingsKey(),
+       realKey<D>({"DensityRefine", "",
+                   "springs: a density spacing hands over to the next finer one when its energy falls "
+                   "to this fraction of its start"},
+                  &D::densityRefine, {0.0, 1.0, true, false})},
+      checkModelKeys);
 }
 
 }  // namespace

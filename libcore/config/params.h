@@ -149,6 +149,13 @@ struct RenderSettings {
   double volumetricBlend = 1.0;  // 0 = Kajiya-Kay, 1 = volumetric
 };
 
+// A path named by a config file, with where it was named (for "missing file" errors).
+struct PathRef {
+  std::filesystem::path path;  // resolved against the naming file's directory
+  FileLoc where;
+  bool given() const { return !path.empty(); }
+};
+
 // Dynamics Info (DESIGN §8): hair in motion, `hairgen simulate`.
 enum class DynamicsModel { kAnjyo, kSprings };
 const char* name(DynamicsModel model);
@@ -199,13 +206,29 @@ struct Dynamics {
   // at the hair's own first bending mode, 1.875²·sqrt(E·I/(ρ·A·L⁴))/2π (README, Dynamics).
   bool restFrequencyAuto = true;
   double restFrequency = 0.0;
-};
-
-// A path named by a config file, with where it was named (for "missing file" errors).
-struct PathRef {
-  std::filesystem::path path;  // resolved against the naming file's directory
-  FileLoc where;
-  bool given() const { return !path.empty(); }
+  // The gravity the hair feels while it moves (N/kg, along −y), when not auto: Hairstyle's Gravity. The
+  // rest state is in equilibrium under this one, so a shot without gravity starts still.
+  bool gravityAuto = true;
+  double gravity = 9.81;
+  // Model springs, Petrovic et al. 2006 §5 (libcore/physics/spring_dynamics.h). Stiffnesses, when not
+  // auto: from Young, Poisson and the elliptic cross-section (a, b) as the thesis' rod has them.
+  bool stretchStiffnessAuto = true;  // E·π a b
+  double stretchStiffness = 0.0;     // N: force per unit strain of a segment
+  bool bendStiffnessAuto = true;     // E·π a b³/4
+  double bendStiffness = 0.0;        // N·m²: E·I
+  bool twistStiffnessAuto = true;    // E/(2(1 + σ))·π a b (a² + b²)/4
+  double twistStiffness = 0.0;       // N·m²: μ·J
+  // §5.1: each frame, every particle loses this fraction of its departure from the smoothed grid
+  // velocity at its place (0 = none, 1 = all); the grid's spacing in metres.
+  double velocitySmoothing = 0.0;
+  double smoothingSpacing = 0.01;
+  // §5.2: a hair cache whose density the hair is pushed toward (path relative to the Dynamics Info),
+  // the strength (m/s² per point per node of density difference), the grid spacings from coarse to
+  // fine (metres), and the fraction of its starting energy at which a spacing hands over to the next.
+  PathRef densityTarget;
+  double densityStrength = 0.0;
+  std::vector<double> densitySpacings{0.02};
+  double densityRefine = 0.5;
 };
 
 // Setup: which files make up a job.

@@ -134,17 +134,6 @@ SegmentFrame AnjyoHair::basisOf(size_t i) const {
   return {restDir_[i], pole_[i], side_[i]};
 }
 
-AccelerationField headFrameField(const HeadState& head, const glm::dvec3& wind, double gravity) {
-  AccelerationField f;
-  const glm::dmat3 toHead = glm::transpose(head.pose.rotation);
-  f.base = toHead * (glm::dvec3(0.0, -gravity, 0.0) + wind - head.acceleration);
-  f.omega = toHead * head.omega;
-  f.alpha = toHead * head.alpha;
-  f.centre = head.pose.centre;
-  f.rotating = f.omega != glm::dvec3(0.0) || f.alpha != glm::dvec3(0.0);
-  return f;
-}
-
 double firstBendingFrequency(const Hairstyle& style, double length) {
   const double a = style.hairRadius1, b = style.hairRadius2;
   const double inertia = M_PI * a * b * b * b / 4.0, area = M_PI * a * b;

@@ -114,6 +114,17 @@ HeadState HeadMotion::at(double frame) const {
   return s;
 }
 
+AccelerationField headFrameField(const HeadState& head, const glm::dvec3& wind, double gravity) {
+  AccelerationField f;
+  const glm::dmat3 toHead = glm::transpose(head.pose.rotation);
+  f.base = toHead * (glm::dvec3(0.0, -gravity, 0.0) + wind - head.acceleration);
+  f.omega = toHead * head.omega;
+  f.alpha = toHead * head.alpha;
+  f.centre = head.pose.centre;
+  f.rotating = f.omega != glm::dvec3(0.0) || f.alpha != glm::dvec3(0.0);
+  return f;
+}
+
 glm::dvec3 windAt(const std::vector<WindKey>& keys, double frame) {
   glm::dvec3 wind(0.0);
   for (size_t j = 0; j < keys.size(); ++j) {

@@ -53,6 +53,25 @@ class HeadMotion {
   double frameRate_ = 24.0;
 };
 
+// The acceleration the hair feels in the head's frame, per substep: base (gravity, wind and the centre's
+// acceleration, rotated into the head's frame), and the rotating frame's terms about `centre`.
+struct AccelerationField {
+  glm::dvec3 base{0.0};
+  glm::dvec3 omega{0.0}, alpha{0.0};  // the head's angular velocity and acceleration, head frame
+  glm::dvec3 centre{0.0};
+  bool rotating = false;
+  // At point r moving at v (head frame).
+  glm::dvec3 at(const glm::dvec3& r, const glm::dvec3& v) const {
+    if (!rotating) return base;
+    const glm::dvec3 x = r - centre;
+    return base - glm::cross(alpha, x) - glm::cross(omega, glm::cross(omega, x)) - 2.0 * glm::cross(omega, v);
+  }
+};
+
+// The head-frame field at a state of the head: gravity (−y, `gravity` N/kg), the wind, and the head's
+// acceleration, all turned into the head's frame.
+AccelerationField headFrameField(const HeadState& head, const glm::dvec3& wind, double gravity);
+
 // `mesh` moved by `pose`: positions, and normals turned with it.
 Mesh posedMesh(const Mesh& mesh, const Pose& pose);
 

@@ -17,8 +17,8 @@ namespace hairgen {
 namespace {
 
 // Σ over the 8 nodes around p of their trilinear weight times value(i, j, k) (p clamped to the grid).
-template <class T, class Value>
-T trilinear(const Grid& grid, const glm::dvec3& p, Value value) {
+template <class T, class G, class Value>
+T trilinear(const G& grid, const glm::dvec3& p, Value value) {
   glm::dvec3 g =
       glm::clamp((p - grid.origin) / grid.voxel, glm::dvec3(0.0), glm::dvec3(grid.size - 1) - 1e-9);
   glm::ivec3 c = glm::ivec3(glm::floor(g));
@@ -36,8 +36,9 @@ T trilinear(const Grid& grid, const glm::dvec3& p, Value value) {
 
 }  // namespace
 
-double Grid::sample(const glm::dvec3& p) const {
-  return trilinear<double>(*this, p, [&](int i, int j, int k) { return double(at(i, j, k)); });
+template <class T>
+typename GridOf<T>::Sample GridOf<T>::sample(const glm::dvec3& p) const {
+  return trilinear<Sample>(*this, p, [&](int i, int j, int k) { return Sample(at(i, j, k)); });
 }
 
 namespace {
@@ -68,11 +69,12 @@ glm::dvec3 sampleGradient(const Grid& grid, const std::vector<glm::vec3>& gradie
 
 }  // namespace
 
-Grid gridAround(const std::vector<glm::vec3>& points, double voxel, int padding) {
+template <class T>
+GridOf<T> gridAround(const std::vector<glm::vec3>& points, double voxel, int padding) {
   if (points.empty()) throw InputError("the coupe has no points to build a volume from");
   const Bounds box = bounds(points);
   const glm::dvec3 lo(box.min), hi(box.max);
-  Grid g;
+  GridOf<T> g;
   g.voxel = voxel;
   g.origin = lo - double(padding) * voxel;
   glm::dvec3 cells = glm::ceil((hi - lo) / voxel) + 1.0 + 2.0 * padding;
@@ -85,7 +87,7 @@ Grid gridAround(const std::vector<glm::vec3>& points, double voxel, int padding)
     throw InputError(std::string(text) + "; raise Render.VoxelSize, or check the cache is in metres");
   }
   g.size = glm::ivec3(cells);
-  g.values.assign(size_t(g.size.x) * g.size.y * g.size.z, 0.0f);
+  g.values.assign(size_t(g.size.x) * g.size.y * g.size.z, T(0.0f));
   return g;
 }
 
@@ -126,24 +128,128 @@ void splat(Grid& d, const std::vector<glm::vec3>& points) {
   for (size_t i = 0; i < sums.size(); ++i) d.values[i] += static_cast<float>(double(sums[i]) / kOne);
 }
 
-Grid smoothed(const Grid& g) {
-  // Separable [1 2 1]/4 along x, y and z, edges clamped.
-  Grid out = g;
+template <class T>
+void splatValues(GridOf<T>& d, const std::vector<glm::dvec3>& points, const std::vector<T>& values) {
+  // Slab s holds the points whose cell starts at node plane z = s − 1 (z = −1 for a point just below
+  // the grid): they add to planes z and z + 1 only, so slabs two apart never share a node and each
+  // phase (even slabs, then odd) may run its slabs at once. A counting sort keeps each slab's points in
+  // index order, so every node sums the same terms in the same order on any thread count.
+  const int slabs = d.size.z + 1;
+  constexpr uint32_t kOutside = ~0u;
+  std::vector<uint32_t> slabOf(points.size());
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, points.size(), 8192),
+                    [&](const tbb::blocked_range<size_t>& r) {
+                      for (size_t p = r.begin(); p != r.end(); ++p) {
+                        const double z = std::floor((points[p].z - d.origin.z) / d.voxel) + 1.0;
+                        slabOf[p] = z >= 0.0 && z < double(slabs) ? uint32_t(z) : kOutside;
+                      }
+                    });
+  std::vector<uint32_t> first(size_t(slabs) + 1, 0), order(points.size());
+  for (uint32_t s : slabOf)
+    if (s != kOutside) ++first[s + 1];
+  for (int s = 0; s < slabs; ++s) first[s + 1] += first[s];
+  std::vector<uint32_t> next(first.begin(), first.end() - 1);
+  for (size_t p = 0; p < points.size(); ++p)
+    if (slabOf[p] != kOutside) order[next[slabOf[p]]++] = uint32_t(p);
+  const glm::ivec3 size = d.size;
+  for (int phase = 0; phase < 2; ++phase) {
+    tbb::parallel_for(0, (slabs - phase + 1) / 2, [&](int half) {
+      const int s = 2 * half + phase;
+      for (uint32_t o = first[s]; o < first[s + 1]; ++o) {
+        const uint32_t p = order[o];
+        const glm::dvec3 g = (points[p] - d.origin) / d.voxel;
+        const glm::ivec3 c = glm::ivec3(glm::floor(g));
+        const glm::dvec3 f = g - glm::dvec3(c);
+        for (int dz = 0; dz < 2; ++dz)
+          for (int dy = 0; dy < 2; ++dy)
+            for (int dx = 0; dx < 2; ++dx) {
+              const glm::ivec3 n = c + glm::ivec3(dx, dy, dz);
+              if (glm::any(glm::lessThan(n, glm::ivec3(0))) || glm::any(glm::greaterThanEqual(n, size)))
+                continue;
+              const double w = (dx ? f.x : 1 - f.x) * (dy ? f.y : 1 - f.y) * (dz ? f.z : 1 - f.z);
+              d.values[d.index(n.x, n.y, n.z)] += w * values[p];
+            }
+      }
+    });
+  }
+}
+
+template <class T>
+void smoothInPlace(GridOf<T>& g) {
+  // Separable [1 2 1]/4 along x, y and z, edges clamped (an edge node keeps 3/4 of itself and gives
+  // its neighbour 1/4, as that neighbour gives it: the matrix stays symmetric). Line by line through a
+  // copy of the line; lines are independent, so any thread count gives the same bits.
+  using Scalar = std::conditional_t<std::is_same_v<T, float>, float, double>;
+  const Scalar quarter = Scalar(0.25), half = Scalar(0.5);
   const glm::ivec3 n = g.size;
   for (int axis = 0; axis < 3; ++axis) {
-    Grid in = out;
-    for (int k = 0; k < n.z; ++k)
-      for (int j = 0; j < n.y; ++j)
-        for (int i = 0; i < n.x; ++i) {
-          glm::ivec3 c(i, j, k), a = c, b = c;
-          a[axis] = std::max(c[axis] - 1, 0);
-          b[axis] = std::min(c[axis] + 1, n[axis] - 1);
-          out.values[out.index(i, j, k)] =
-              0.25f * in.at(a.x, a.y, a.z) + 0.5f * in.at(i, j, k) + 0.25f * in.at(b.x, b.y, b.z);
-        }
+    const size_t stride = axis == 0 ? 1 : axis == 1 ? size_t(n.x) : size_t(n.x) * size_t(n.y);
+    const int length = n[axis], u = (axis + 1) % 3, w = (axis + 2) % 3;
+    tbb::parallel_for(0, n[w], [&](int cw) {
+      std::vector<T> line(static_cast<size_t>(length));
+      for (int cu = 0; cu < n[u]; ++cu) {
+        glm::ivec3 c(0);
+        c[u] = cu;
+        c[w] = cw;
+        T* first = &g.values[g.index(c.x, c.y, c.z)];
+        for (int t = 0; t < length; ++t) line[size_t(t)] = first[size_t(t) * stride];
+        for (int t = 0; t < length; ++t)
+          first[size_t(t) * stride] = quarter * line[size_t(std::max(t - 1, 0))] + half * line[size_t(t)] +
+                                      quarter * line[size_t(std::min(t + 1, length - 1))];
+      }
+    });
   }
+}
+
+template <class T>
+GridOf<T> smoothed(const GridOf<T>& g) {
+  GridOf<T> out = g;
+  smoothInPlace(out);
   return out;
 }
+
+glm::dvec3 densityForce(const Grid& d, const glm::dvec3& p) {
+  const glm::dvec3 g = (p - d.origin) / d.voxel;
+  const glm::ivec3 c = glm::ivec3(glm::floor(g));
+  if (glm::any(glm::lessThan(c, glm::ivec3(0))) || glm::any(glm::greaterThanEqual(c + 1, d.size)))
+    return glm::dvec3(0.0);
+  const glm::dvec3 f = g - glm::dvec3(c);
+  auto at = [&](int dx, int dy, int dz) { return double(d.at(c.x + dx, c.y + dy, c.z + dz)); };
+  // The memo's weights of the cell's lower grid lines, a = 1 − f: F_x differences D_d across the cell
+  // in x, weighted by the point's tent weights in y and z; F_y and F_z likewise.
+  const glm::dvec3 a = 1.0 - f;
+  glm::dvec3 force(0.0);
+  if (f.x != 0.0)
+    force.x = a.y * a.z * (at(0, 0, 0) - at(1, 0, 0)) + (1 - a.y) * a.z * (at(0, 1, 0) - at(1, 1, 0)) +
+              a.y * (1 - a.z) * (at(0, 0, 1) - at(1, 0, 1)) +
+              (1 - a.y) * (1 - a.z) * (at(0, 1, 1) - at(1, 1, 1));
+  if (f.y != 0.0)
+    force.y = a.x * a.z * (at(0, 0, 0) - at(0, 1, 0)) + (1 - a.x) * a.z * (at(1, 0, 0) - at(1, 1, 0)) +
+              a.x * (1 - a.z) * (at(0, 0, 1) - at(0, 1, 1)) +
+              (1 - a.x) * (1 - a.z) * (at(1, 0, 1) - at(1, 1, 1));
+  if (f.z != 0.0)
+    force.z = a.x * a.y * (at(0, 0, 0) - at(0, 0, 1)) + (1 - a.x) * a.y * (at(1, 0, 0) - at(1, 0, 1)) +
+              a.x * (1 - a.y) * (at(0, 1, 0) - at(0, 1, 1)) +
+              (1 - a.x) * (1 - a.y) * (at(1, 1, 0) - at(1, 1, 1));
+  return force;
+}
+
+double densityEnergy(const Grid& d) {
+  double sum = 0.0;
+  for (float v : d.values) sum += double(v) * double(v);
+  return 0.5 * sum;
+}
+
+template struct GridOf<float>;
+template struct GridOf<glm::dvec4>;
+template GridOf<float> gridAround<float>(const std::vector<glm::vec3>&, double, int);
+template GridOf<glm::dvec4> gridAround<glm::dvec4>(const std::vector<glm::vec3>&, double, int);
+template void smoothInPlace<float>(GridOf<float>&);
+template void smoothInPlace<glm::dvec4>(GridOf<glm::dvec4>&);
+template GridOf<float> smoothed<float>(const GridOf<float>&);
+template GridOf<glm::dvec4> smoothed<glm::dvec4>(const GridOf<glm::dvec4>&);
+template void splatValues<glm::dvec4>(GridOf<glm::dvec4>&, const std::vector<glm::dvec3>&,
+                                      const std::vector<glm::dvec4>&);
 
 Grid signedDistance(const Grid& density, double iso) {
   const glm::ivec3 n = density.size;

@@ -5,6 +5,7 @@
 #pragma once
 
 #include <cstdint>
+#include <type_traits>
 #include <vector>
 
 #include <glm/glm.hpp>
@@ -13,28 +14,60 @@
 
 namespace hairgen {
 
-// Values at the nodes of a regular grid: node (i, j, k) sits at origin + h·(i, j, k).
-struct Grid {
+// Values at the nodes of a regular grid: node (i, j, k) sits at origin + h·(i, j, k). The density is a
+// grid of floats (Grid); dynamics (libcore/physics/spring_dynamics.h) keeps masses and momenta on the
+// same grids in doubles.
+template <class T>
+struct GridOf {
+  // What sample() returns: doubles for a float grid, T itself otherwise.
+  using Sample = std::conditional_t<std::is_same_v<T, float>, double, T>;
+
   glm::dvec3 origin{0.0};
   double voxel = 1.0;
   glm::ivec3 size{0};
-  std::vector<float> values;
+  std::vector<T> values;
   size_t index(int i, int j, int k) const { return (size_t(k) * size.y + j) * size.x + i; }
-  float at(int i, int j, int k) const { return values[index(i, j, k)]; }
-  // Trilinear value at a world point (clamped to the grid).
-  double sample(const glm::dvec3& p) const;
+  const T& at(int i, int j, int k) const { return values[index(i, j, k)]; }
+  // Trilinear value at a world point (clamped to the grid): the tent weights of the paper's (1), the
+  // same weights splat() and splatValues() give the point.
+  Sample sample(const glm::dvec3& p) const;
 };
+using Grid = GridOf<float>;
 
-// A grid around `points` with `padding` empty nodes on every side.
-Grid gridAround(const std::vector<glm::vec3>& points, double voxel, int padding);
+// A grid around `points` with `padding` empty nodes on every side, all values zero. Throws InputError
+// beyond 4e8 nodes.
+template <class T = float>
+GridOf<T> gridAround(const std::vector<glm::vec3>& points, double voxel, int padding);
 
 // Splats every point with the tent (trilinear) kernel of the paper's (1): each point adds weights
 // summing to exactly 1 to the 8 nodes around it, so the grid sums to the number of points inside it.
 // Parallel, and the same bits whatever the thread count.
 void splat(Grid& density, const std::vector<glm::vec3>& points);
 
-// One pass of a separable binomial [1 2 1]/4 filter (mass-preserving away from the edges).
-Grid smoothed(const Grid& grid);
+// Adds values[i] times point i's tent weights to the 8 nodes around it (the outer corners of a point
+// at the grid's edge fall away). Sums in a fixed order, whatever the thread count: points by z-slab of
+// the grid, even slabs then odd ones (the two never share a node), each slab's points in index order;
+// so the grid holds the same bits for 1 thread or 64. `values` has one entry per point.
+template <class T>
+void splatValues(GridOf<T>& grid, const std::vector<glm::dvec3>& points, const std::vector<T>& values);
+
+// One pass of a separable binomial [1 2 1]/4 filter, edges clamped. As a matrix it is symmetric,
+// non-negative and doubly stochastic (every row and column sums to 1): it keeps the total, and a
+// weighted average stays a weighted average.
+template <class T>
+GridOf<T> smoothed(const GridOf<T>& grid);
+// The same filter on `grid` itself (no second grid; the same bits as smoothed()).
+template <class T>
+void smoothInPlace(GridOf<T>& grid);
+
+// Petrovic et al. §5.2: the force on a point at `p` from the density difference `difference` = D_s −
+// D_t of the memo's (3), E = ½ Σ (D_s − D_t)²: −∂E/∂p in grid units (p measured in voxels), the memo's
+// F_x, F_y, F_z (points per node). Along an axis where p sits exactly on a grid line the derivative is
+// taken as 0, as the memo does. Zero outside the grid.
+glm::dvec3 densityForce(const Grid& difference, const glm::dvec3& p);
+
+// E = ½ Σ d² over the nodes of `difference`, summed in node order.
+double densityEnergy(const Grid& difference);
 
 // The signed distance to the isosurface density = `iso` (negative inside): the nodes next to the
 // shell start from its sub-voxel crossings, fast sweeping carries nearest points to the rest of the

@@ -1,0 +1,551 @@
+// Petrovic et al. 2006 §5, as spring_dynamics.h describes it.
+#include "libcore/physics/spring_dynamics.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include <tbb/parallel_for.h>
+
+#include "libcore/physics/strand_energy.h"
+#include "libcore/util/error.h"
+
+namespace hairgen {
+namespace {
+
+// The most nodes a velocity grid may have: past it the spacing is coarsened (doubled) until it fits.
+constexpr double kMaxGridNodes = 2e7;
+
+// A grid of spacing h whose nodes sit on multiples of h, with one empty node beyond the points on every
+// side, so every point has all 8 of its cell's corners inside.
+template <class T>
+void latticeAround(const std::vector<glm::dvec3>& points, const std::vector<double>& inverseMass, double h,
+                   GridOf<T>& g) {
+  glm::dvec3 lo(1e300), hi(-1e300);
+  for (size_t p = 0; p < points.size(); ++p) {
+    if (inverseMass[p] == 0.0) continue;
+    lo = glm::min(lo, points[p]);
+    hi = glm::max(hi, points[p]);
+  }
+  g.values.clear();
+  if (!(lo.x <= hi.x)) return;
+  for (;;) {
+    const glm::dvec3 first = glm::floor(lo / h) - 1.0, last = glm::floor(hi / h) + 2.0;
+    const glm::dvec3 n = last - first + 1.0;
+    if (n.x * n.y * n.z <= kMaxGridNodes) {
+      g.origin = first * h;
+      g.voxel = h;
+      g.size = glm::ivec3(n);
+      g.values.assign(size_t(g.size.x) * g.size.y * g.size.z, T(0.0));  // reuses the last frame's memory
+      return;
+    }
+    h *= 2.0;
+  }
+}
+
+// Out of `shape` to at most `depth` deep: along the ray from the centre for spheres and ellipsoids (the
+// direction penetration() measures along), along the nearest face's normal for cuboids.
+glm::dvec3 pushedOut(const CollisionShape& s, const glm::dvec3& p, double inside, double depth) {
+  const glm::dvec3 v = p - s.centre;
+  if (s.kind == ShapeKind::kCuboid) {
+    const glm::dvec3 local(glm::dot(v, s.axes[0]), glm::dot(v, s.axes[1]), glm::dot(v, s.axes[2]));
+    const glm::dvec3 dent = s.halfExtents - glm::abs(local);
+    const int axis = dent.x < dent.y ? (dent.x < dent.z ? 0 : 2) : (dent.y < dent.z ? 1 : 2);
+    return p + s.axes[axis] * ((local[axis] < 0.0 ? -1.0 : 1.0) * (inside - depth));
+  }
+  const double dist = glm::length(v);
+  if (!(dist > 0.0)) return p;
+  return s.centre + v * ((dist + inside - depth) / dist);
+}
+
+}  // namespace
+
+SpringStiffness springStiffness(const Hairstyle& style, const Dynamics& d) {
+  const double a = style.hairRadius1, b = style.hairRadius2, e = style.young;
+  const double shear = e / (2.0 * (1.0 + style.poisson));
+  SpringStiffness k;
+  k.stretch = d.stretchStiffnessAuto ? e * M_PI * a * b : d.stretchStiffness;
+  k.bend = d.bendStiffnessAuto ? e * M_PI * a * b * b * b / 4.0 : d.bendStiffness;
+  k.twist = d.twistStiffnessAuto ? shear * M_PI * a * b * (a * a + b * b) / 4.0 : d.twistStiffness;
+  return k;
+}
+
+double dynamicsGravity(const Hairstyle& style, const Dynamics& d) {
+  return d.gravityAuto ? style.gravity : d.gravity;
+}
+
+SpringHair::SpringHair(const Strands& rest, const Hairstyle& style, const Dynamics& dynamics,
+                       const Collision& collision, const Strands* densityTarget)
+    : rest_(rest),
+      damping_(dynamics.damping),
+      smoothing_(dynamics.velocitySmoothing),
+      smoothingSpacing_(dynamics.smoothingSpacing),
+      densityStrength_(densityTarget ? dynamics.densityStrength : 0.0),
+      densityRefine_(dynamics.densityRefine) {
+  const size_t points = rest.pointCount(), strands = rest.strandCount();
+  xRest_.resize(points);
+  for (size_t p = 0; p < points; ++p) xRest_[p] = glm::dvec3(rest.points[p]);
+  x_ = xRest_;
+  v_.assign(points, glm::dvec3(0.0));
+  mass_.assign(points, 0.0);
+  inverseMass_.assign(points, 0.0);
+  length_.assign(points, 0.0);
+  compliance_.assign(points, 0.0);
+  restTension_.assign(points, 0.0);
+  bend_.assign(points, 0.0);
+  target_.assign(points, glm::dvec3(0.0));
+  twistLength_.assign(points, 0.0);
+  twistCompliance_.assign(points, -1.0);
+  rootDirection_.assign(strands, glm::dvec3(0.0, -1.0, 0.0));
+  restTangents_ = tangentsOf(rest);
+  const SpringStiffness k = springStiffness(style, dynamics);
+  const double lineDensity = style.massDensity * M_PI * style.hairRadius1 * style.hairRadius2;  // kg/m
+  const glm::dvec3 load(0.0, -dynamicsGravity(style, dynamics), 0.0);
+  for (size_t s = 0; s < strands; ++s) {
+    const uint32_t p0 = rest.firstPoint[s], n = rest.pointsOf(s) - 1;  // n segments
+    if (rest.pointsOf(s) < 2) continue;
+    for (uint32_t j = 1; j <= n; ++j) {
+      const double l = glm::length(xRest_[p0 + j] - xRest_[p0 + j - 1]);
+      if (!(l > 0.0))
+        throw InputError("guide " + std::to_string(s) + " has two points at the same place (points " +
+                         std::to_string(j - 1) + " and " + std::to_string(j) + "); a segment needs a length");
+      length_[p0 + j] = l;
+      compliance_[p0 + j] = l / k.stretch;
+      mass_[p0 + j - 1] += 0.5 * lineDensity * l;
+      mass_[p0 + j] += 0.5 * lineDensity * l;
+    }
+    for (uint32_t j = 1; j <= n; ++j) inverseMass_[p0 + j] = 1.0 / mass_[p0 + j];
+    rootDirection_[s] = (xRest_[p0 + 1] - xRest_[p0]) / length_[p0 + 1];
+    auto dir = [&](uint32_t j) { return (xRest_[p0 + j] - xRest_[p0 + j - 1]) / length_[p0 + j]; };
+    // Joint j turns segment j + 1 against segment j (the root direction for j = 0): its share of length is
+    // the mean of the two, the root's the first segment's (a mirrored ghost segment).
+    for (uint32_t j = 0; j < n; ++j) {
+      const double share = j == 0 ? length_[p0 + 1] : 0.5 * (length_[p0 + j] + length_[p0 + j + 1]);
+      bend_[p0 + j] = k.bend / share;
+    }
+    // Rest tension, tip to root: the load of everything below segment j along its direction, where
+    // that pulls (a hanging segment). A segment the load would compress (hair rising from the scalp)
+    // gets none: a column in compression buckles, so its load goes to the bending springs' targets
+    // with the rest, and the rest shape is a stable equilibrium, not only an equilibrium.
+    glm::dvec3 below(0.0);
+    for (uint32_t j = n; j >= 1; --j) {
+      below += mass_[p0 + j] * load;
+      restTension_[p0 + j] = std::max(glm::dot(below, dir(j)), 0.0);
+    }
+    // What the tension leaves (per free point: −m g − f_T), carried by the bending springs: solve
+    // Bᵀ c = q from the tip (c_j = k_j (b̄_j − b_j), row i of Bᵀ: c_{i−1}/l_i − c_i (1/l_i + 1/l_{i+1}) +
+    // c_{i+1}/l_{i+1}), then b̄_j = b_j + c_j / k_j.
+    auto tensionForce = [&](uint32_t i) {
+      glm::dvec3 f = -restTension_[p0 + i] * dir(i);
+      if (i < n) f += restTension_[p0 + i + 1] * dir(i + 1);
+      return f;
+    };
+    std::vector<glm::dvec3> c(n + 2, glm::dvec3(0.0));  // c[j] for joints 0..n−1; c[n], c[n+1] = 0
+    for (uint32_t i = n; i >= 1; --i) {
+      const glm::dvec3 q = -mass_[p0 + i] * load - tensionForce(i);
+      const double li = length_[p0 + i], lnext = i < n ? length_[p0 + i + 1] : 1.0;
+      glm::dvec3 rhs = q;
+      if (i < n) rhs += c[i] * (1.0 / li + 1.0 / lnext) - c[i + 1] / lnext;
+      c[i - 1] = li * rhs;
+    }
+    for (uint32_t j = 0; j < n; ++j) {
+      const glm::dvec3 turn = dir(j + 1) - (j == 0 ? rootDirection_[s] : dir(j));
+      target_[p0 + j] = bend_[p0 + j] > 0.0 ? turn + c[j] / bend_[p0 + j] : turn;
+    }
+    // Twist springs from point i to i + 3 across the middle segment i+1 → i+2: the distance's rate of
+    // change with a twist ψ of the far segment about the middle one gives k = G·J / (l ḋ²).
+    for (uint32_t i = 0; i + 3 <= n; ++i) {
+      const glm::dvec3 a = xRest_[p0 + i], b = xRest_[p0 + i + 1], e = xRest_[p0 + i + 3];
+      const glm::dvec3 axis = dir(i + 2), span = e - a;
+      const double d = glm::length(span);
+      const double rate = glm::dot(span / d, glm::cross(axis, e - b));
+      const double l = length_[p0 + i + 2];
+      const double stiff = std::min(k.twist / (l * rate * rate), k.stretch / l);
+      if (!(rate * rate > 1e-12 * l * l) || !(stiff > 0.0)) continue;
+      twistLength_[p0 + i] = d;
+      twistCompliance_[p0 + i] = 1.0 / stiff;
+    }
+  }
+  for (const CollisionShape& shape : collision.shapes) {
+    if (!(shape.penalty > 0.0)) continue;  // a shape without penalty does not collide, as in grow
+    shapes_.push_back(shape);
+    const double r = shape.kind == ShapeKind::kSphere ? shape.halfExtents.x
+                     : shape.kind == ShapeKind::kEllipsoid
+                         ? std::max({shape.halfExtents.x, shape.halfExtents.y, shape.halfExtents.z})
+                         : glm::length(shape.halfExtents);
+    shapeReach2_.push_back(r * r);
+    std::vector<double> depth(points);
+    for (size_t p = 0; p < points; ++p) depth[p] = std::max(penetration(shape, xRest_[p]), 0.0);
+    restDepth_.push_back(std::move(depth));
+  }
+  if (densityTarget) {
+    // The target's points, each worth hair points / target points so the two densities hold the same
+    // total; every level's grid holds both shapes with room to move.
+    std::vector<glm::vec3> both = floatPoints();
+    both.insert(both.end(), densityTarget->points.begin(), densityTarget->points.end());
+    const double scale =
+        densityTarget->points.empty() ? 0.0 : double(rest.pointCount()) / double(densityTarget->pointCount());
+    for (double h : dynamics.densitySpacings) {
+      Grid target = gridAround(both, h, 3);
+      splat(target, densityTarget->points);
+      for (float& value : target.values) value = float(double(value) * scale);
+      // The target's mean density where it has any: the force's unit at this spacing.
+      double sum = 0.0;
+      size_t occupied = 0;
+      for (float value : target.values)
+        if (value > 0.0f) {
+          sum += value;
+          ++occupied;
+        }
+      targetMean_.push_back(occupied ? sum / double(occupied) : 1.0);
+      targets_.push_back(std::move(target));
+    }
+    for (size_t level = 0; level < targets_.size(); ++level) startEnergy_.push_back(densityEnergy(level));
+  }
+}
+
+std::vector<glm::vec3> SpringHair::floatPoints() const {
+  std::vector<glm::vec3> out(x_.size());
+  for (size_t p = 0; p < x_.size(); ++p) out[p] = glm::vec3(x_[p]);
+  return out;
+}
+
+Grid SpringHair::densityDifference(size_t level) const {
+  Grid d = targets_[level];
+  for (float& value : d.values) value = -value;
+  splat(d, floatPoints());
+  return d;
+}
+
+double SpringHair::densityEnergy(size_t level) const {
+  return hairgen::densityEnergy(densityDifference(level));
+}
+
+double SpringHair::kineticEnergy() const {
+  double sum = 0.0;
+  for (size_t p = 0; p < x_.size(); ++p) sum += 0.5 * mass_[p] * glm::dot(v_[p], v_[p]);
+  return sum;
+}
+
+double SpringHair::maxStretch() const {
+  double worst = 0.0;
+  for (size_t p = 0; p < x_.size(); ++p)
+    if (length_[p] > 0.0)
+      worst = std::max(worst, std::abs(glm::length(x_[p] - x_[p - 1]) / length_[p] - 1.0));
+  return worst;
+}
+
+void SpringHair::factor(double dt) {
+  // Per strand, over its free points 1..n: A = M(1 + cΔt) + Δt² Σ_j k_j B_jᵀ B_j, pentadiagonal, where
+  // row j of B (joint j) has 1/l_{j+1} at point j + 1, −1/l_{j+1} − 1/l_j at j and 1/l_j at j − 1.
+  dt_ = dt;
+  const size_t points = x_.size();
+  inverseD_.assign(points, 0.0);
+  lower1_.assign(points, 0.0);
+  lower2_.assign(points, 0.0);
+  tbb::parallel_for(size_t(0), rest_.strandCount(), [&](size_t s) {
+    const uint32_t p0 = rest_.firstPoint[s], count = rest_.pointsOf(s);
+    if (count < 2) return;
+    const uint32_t n = count - 1;
+    std::vector<double> diag(n + 1, 0.0), off1(n + 1, 0.0), off2(n + 1, 0.0);  // (i,i), (i,i+1), (i,i+2)
+    for (uint32_t i = 1; i <= n; ++i) diag[i] = mass_[p0 + i] * (1.0 + damping_ * dt);
+    const double dt2 = dt * dt;
+    for (uint32_t j = 0; j < n; ++j) {
+      // Coefficients of joint j on points j − 1, j, j + 1 (point 0 is fixed and drops out).
+      const double lNext = length_[p0 + j + 1], lThis = j > 0 ? length_[p0 + j] : 0.0;
+      double coef[3] = {j > 0 ? 1.0 / lThis : 0.0, -(1.0 / lNext + (j > 0 ? 1.0 / lThis : 0.0)), 1.0 / lNext};
+      if (j == 0) coef[1] = 0.0;  // joint 0: the root point and the root direction are fixed
+      const double w = dt2 * bend_[p0 + j];
+      for (int a = 0; a < 3; ++a) {
+        const int pa = int(j) - 1 + a;
+        if (pa < 1) continue;
+        for (int b = a; b < 3; ++b) {
+          const int pb = int(j) - 1 + b;
+          if (pb < 1) continue;
+          const double v = w * coef[a] * coef[b];
+          if (b == a)
+            diag[pa] += v;
+          else if (b == a + 1)
+            off1[pa] += v;
+          else
+            off2[pa] += v;
+        }
+      }
+    }
+    // L D Lᵀ with bandwidth 2.
+    std::vector<double> dd(n + 1, 0.0), l1(n + 1, 0.0), l2(n + 1, 0.0);
+    for (uint32_t i = 1; i <= n; ++i) {
+      if (i >= 3) l2[i] = off2[i - 2] / dd[i - 2];
+      if (i >= 2) l1[i] = (off1[i - 1] - (i >= 3 ? l2[i] * l1[i - 1] * dd[i - 2] : 0.0)) / dd[i - 1];
+      dd[i] =
+          diag[i] - (i >= 2 ? l1[i] * l1[i] * dd[i - 1] : 0.0) - (i >= 3 ? l2[i] * l2[i] * dd[i - 2] : 0.0);
+      inverseD_[p0 + i] = 1.0 / dd[i];
+      lower1_[p0 + i] = l1[i];
+      lower2_[p0 + i] = l2[i];
+    }
+  });
+}
+
+void SpringHair::step(const AccelerationField& field, double dt, bool firstSubstep, bool lastSubstep) {
+  if (dt != dt_) factor(dt);
+  if (!targets_.empty() && densityStrength_ > 0.0) {
+    if (firstSubstep) {
+      // The finest level all of whose coarser ones have come down to DensityRefine of their start.
+      level_ = 0;
+      while (level_ + 1 < targets_.size() && densityEnergy(level_) <= densityRefine_ * startEnergy_[level_])
+        ++level_;
+    }
+    difference_ = densityDifference(level_);
+  }
+  tbb::parallel_for(size_t(0), rest_.strandCount(), [&](size_t s) { stepStrand(s, field, dt); });
+  if (lastSubstep && smoothing_ > 0.0) smoothVelocities(smoothing_);
+}
+
+void SpringHair::projectStretch(size_t s, double dt, int iterations, std::vector<double>& lambda) {
+  // XPBD on all of the strand's segment constraints C_j = |e_j| − l_j at once: each iteration solves the
+  // tridiagonal (J W Jᵀ + α/Δt²) Δλ = −C − (α/Δt²) λ and moves the points by W Jᵀ Δλ.
+  const uint32_t p0 = rest_.firstPoint[s], n = rest_.pointsOf(s) - 1;
+  std::vector<glm::dvec3>& x = x_;
+  thread_local std::vector<glm::dvec3> u;
+  thread_local std::vector<double> diag, upper, rhs;
+  u.resize(n + 2);
+  diag.resize(n + 2);
+  upper.resize(n + 2);
+  rhs.resize(n + 2);
+  const double dt2 = dt * dt;
+  // `iterations` passes, and more (up to kMaxPasses) while a segment is still off its length by more
+  // than kStretchTolerance: a big push (a collision, a strong density force) needs a few Newton steps.
+  constexpr int kMaxPasses = 32;
+  constexpr double kStretchTolerance = 1e-3;
+  for (int it = 0; it < kMaxPasses; ++it) {
+    double worst = 0.0;
+    for (uint32_t j = 1; j <= n; ++j) {
+      const glm::dvec3 e = x[p0 + j] - x[p0 + j - 1];
+      const double len = glm::length(e);
+      worst = std::max(worst, std::abs(len - length_[p0 + j]) / length_[p0 + j]);
+      u[j] = e / len;
+      const double alpha = compliance_[p0 + j] / dt2;
+      diag[j] = inverseMass_[p0 + j - 1] + inverseMass_[p0 + j] + alpha;
+      rhs[j] = -(len - length_[p0 + j]) - alpha * lambda[j];
+    }
+    if (it >= iterations && worst <= kStretchTolerance) break;
+    for (uint32_t j = 1; j < n; ++j) upper[j] = -inverseMass_[p0 + j] * glm::dot(u[j], u[j + 1]);
+    // Thomas: forward elimination, back substitution.
+    for (uint32_t j = 2; j <= n; ++j) {
+      const double m = upper[j - 1] / diag[j - 1];
+      diag[j] -= m * upper[j - 1];
+      rhs[j] -= m * rhs[j - 1];
+    }
+    rhs[n] /= diag[n];
+    for (uint32_t j = n - 1; j >= 1; --j) rhs[j] = (rhs[j] - upper[j] * rhs[j + 1]) / diag[j];
+    for (uint32_t j = 1; j <= n; ++j) {
+      lambda[j] += rhs[j];
+      const double next = j < n ? rhs[j + 1] : 0.0;
+      x[p0 + j] += inverseMass_[p0 + j] * (rhs[j] * u[j] - (j < n ? next * u[j + 1] : glm::dvec3(0.0)));
+    }
+  }
+}
+
+void SpringHair::stepStrand(size_t s, const AccelerationField& field, double dt) {
+  const uint32_t p0 = rest_.firstPoint[s];
+  if (rest_.pointsOf(s) < 2) return;
+  const uint32_t n = rest_.pointsOf(s) - 1;
+  thread_local std::vector<glm::dvec3> turn, force, before;
+  thread_local std::vector<double> lambda;
+  turn.resize(n + 2);
+  force.resize(n + 1);
+  before.resize(n + 1);
+  // Bending: g_j = k_j (b̄_j − b_j), and each point's force Σ_j (B_j)_i g_j.
+  // Each segment's direction over its rest length (e_j / l_j), once.
+  thread_local std::vector<glm::dvec3> unit;
+  thread_local std::vector<double> inverseLength;
+  unit.resize(n + 2);
+  inverseLength.resize(n + 2);
+  unit[0] = rootDirection_[s];
+  inverseLength[n + 1] = 0.0;
+  for (uint32_t j = 1; j <= n; ++j) {
+    inverseLength[j] = 1.0 / length_[p0 + j];
+    unit[j] = (x_[p0 + j] - x_[p0 + j - 1]) * inverseLength[j];
+  }
+  unit[n + 1] = glm::dvec3(0.0);
+  for (uint32_t j = 0; j < n; ++j) turn[j] = bend_[p0 + j] * (target_[p0 + j] - (unit[j + 1] - unit[j]));
+  turn[n] = turn[n + 1] = glm::dvec3(0.0);  // no joint at the tip
+  for (uint32_t i = 1; i <= n; ++i) {
+    const uint32_t p = p0 + i;
+    // Row i of Bᵀ: joints i − 1, i and i + 1 (turn[n] is 0, and 1/l_{n+1} is 0).
+    glm::dvec3 f = turn[i - 1] * inverseLength[i] + turn[i + 1] * inverseLength[i + 1] -
+                   turn[i] * (inverseLength[i] + inverseLength[i + 1]);
+    // The rest tension along the segments, turning with them.
+    f -= restTension_[p] * unit[i];
+    if (i < n) f += restTension_[p + 1] * unit[i + 1];
+    f += mass_[p] * field.at(x_[p], v_[p]);
+    if (!difference_.values.empty() && densityStrength_ > 0.0) {
+      // The memo's F in units of the target's mean density, at most 1 long: where the shapes are far
+      // apart the push is DensityStrength toward the target, not a kick that flings the hair.
+      glm::dvec3 push = densityForce(difference_, x_[p]) / targetMean_[level_];
+      const double size = glm::length(push);
+      if (size > 1.0) push /= size;
+      f += mass_[p] * densityStrength_ * push;
+    }
+    force[i] = mass_[p] * v_[p] + dt * f;
+  }
+  // Backward Euler for the bending (and damping): A v⁺ = M v + Δt f, A = L D Lᵀ.
+  for (uint32_t i = 1; i <= n; ++i) {
+    const uint32_t p = p0 + i;
+    if (i >= 2) force[i] -= lower1_[p] * force[i - 1];
+    if (i >= 3) force[i] -= lower2_[p] * force[i - 2];
+  }
+  for (uint32_t i = 1; i <= n; ++i) force[i] *= inverseD_[p0 + i];
+  for (uint32_t i = n; i >= 1; --i) {
+    if (i + 1 <= n) force[i] -= lower1_[p0 + i + 1] * force[i + 1];
+    if (i + 2 <= n) force[i] -= lower2_[p0 + i + 2] * force[i + 2];
+  }
+  for (uint32_t i = 1; i <= n; ++i) {
+    before[i] = x_[p0 + i];
+    x_[p0 + i] += dt * force[i];
+  }
+  // Inextensible (to the stretch compliance), twist springs, collisions, and the stretch once more.
+  lambda.assign(n + 2, 0.0);
+  projectStretch(s, dt, 1, lambda);
+  bool twisted = false;
+  for (uint32_t i = 0; i + 3 <= n; ++i) {
+    const uint32_t a = p0 + i, b = p0 + i + 3;
+    if (twistCompliance_[a] < 0.0) continue;
+    twisted = true;
+    const glm::dvec3 e = x_[b] - x_[a];
+    const double len = glm::length(e);
+    const double wsum = inverseMass_[a] + inverseMass_[b] + twistCompliance_[a] / (dt * dt);
+    const double dl = -(len - twistLength_[a]) / wsum;
+    x_[a] -= inverseMass_[a] * dl * e / len;
+    x_[b] += inverseMass_[b] * dl * e / len;
+  }
+  bool moved = twisted;
+  for (size_t c = 0; c < shapes_.size(); ++c) {
+    for (uint32_t i = 1; i <= n; ++i) {
+      const uint32_t p = p0 + i;
+      const glm::dvec3 v = x_[p] - shapes_[c].centre;
+      if (glm::dot(v, v) >= shapeReach2_[c]) continue;
+      const double inside = penetration(shapes_[c], x_[p]), allowed = restDepth_[c][p];
+      if (inside > allowed + 1e-9) {
+        x_[p] = pushedOut(shapes_[c], x_[p], inside, allowed);
+        moved = true;
+      }
+    }
+  }
+  if (moved) {  // what the twist springs and the shapes did to the lengths
+    lambda.assign(n + 2, 0.0);
+    projectStretch(s, dt, 1, lambda);
+  }
+  for (uint32_t i = 1; i <= n; ++i) v_[p0 + i] = (x_[p0 + i] - before[i]) / dt;
+}
+
+void SpringHair::smoothVelocities(double fraction) {
+  if (!(fraction > 0.0)) return;
+  // Masses and momenta (m, m v) of the free points on the grid (W M), filtered (S), the node velocity
+  // their quotient (D⁻¹), filtered again (S) and read back with the same tent weights (Wᵀ).
+  GridOf<glm::dvec4>& grid = velocityGrid_;
+  latticeAround(x_, inverseMass_, smoothingSpacing_, grid);
+  if (grid.values.empty()) return;
+  std::vector<glm::dvec3>& where = smoothWhere_;
+  std::vector<glm::dvec4>& what = smoothWhat_;
+  std::vector<size_t>& which = smoothWhich_;
+  where.clear();
+  what.clear();
+  which.clear();
+  for (size_t p = 0; p < x_.size(); ++p) {
+    if (inverseMass_[p] == 0.0) continue;
+    where.push_back(x_[p]);
+    what.emplace_back(mass_[p] * v_[p], mass_[p]);
+    which.push_back(p);
+  }
+  splatValues(grid, where, what);
+  smoothInPlace(grid);
+  for (glm::dvec4& node : grid.values)
+    node = node.w > 0.0 ? glm::dvec4(glm::dvec3(node) / node.w, 1.0) : glm::dvec4(0.0);
+  smoothInPlace(grid);
+  tbb::parallel_for(size_t(0), which.size(), [&](size_t k) {
+    const size_t p = which[k];
+    const glm::dvec3 target(grid.sample(where[k]));
+    v_[p] += fraction * (target - v_[p]);
+  });
+}
+
+Strands SpringHair::posed(const Pose& pose) const {
+  Strands out;
+  posedInto(pose, out);
+  return out;
+}
+
+void SpringHair::posedInto(const Pose& pose, Strands& out) const {
+  std::vector<glm::vec3> points = std::move(out.points), tangents = std::move(out.tangents);
+  std::vector<double> state = std::move(out.simulationState);
+  out = rest_;
+  out.points = std::move(points);
+  out.tangents = std::move(tangents);
+  out.simulationState = std::move(state);
+  out.points.resize(rest_.pointCount());
+  out.tangents.resize(rest_.pointCount());
+  tbb::parallel_for(size_t(0), rest_.strandCount(), [&](size_t s) {
+    const uint32_t p0 = rest_.firstPoint[s], count = rest_.pointsOf(s);
+    for (uint32_t j = 0; j < count; ++j) {
+      const uint32_t p = p0 + j;
+      // The input point plus the motion: at rest exactly the input.
+      out.points[p] = glm::vec3(pose.apply(glm::dvec3(rest_.points[p]) + (x_[p] - xRest_[p])));
+      glm::dvec3 t(restTangents_[p]);
+      if (count >= 2) {
+        // Turned with its segment (the one it starts, or the last): the minimal rotation.
+        const uint32_t e = p0 + std::clamp(j + 1, 1u, count - 1);
+        const glm::dvec3 a = glm::normalize(xRest_[e] - xRest_[e - 1]), b = glm::normalize(x_[e] - x_[e - 1]);
+        const glm::dvec3 axis = glm::cross(a, b);
+        const double sinAngle = glm::length(axis), cosAngle = glm::dot(a, b);
+        if (sinAngle > 1e-15) {
+          const glm::dvec3 u = axis / sinAngle;
+          t = t * cosAngle + glm::cross(u, t) * sinAngle + u * glm::dot(u, t) * (1.0 - cosAngle);
+        }
+      }
+      out.tangents[p] = pose.isIdentity() ? glm::vec3(t) : glm::vec3(glm::normalize(pose.rotation * t));
+    }
+  });
+}
+
+std::vector<double> SpringHair::state() const {
+  std::vector<double> out;
+  stateInto(out);
+  return out;
+}
+
+void SpringHair::stateInto(std::vector<double>& out) const {
+  // Per segment, its end point: the roots are the head's and never move.
+  out.resize((x_.size() - rest_.strandCount()) * kStateValues);
+  size_t k = 0;
+  for (size_t p = 0; p < x_.size(); ++p) {
+    if (length_[p] == 0.0) continue;  // a root
+    double* v = &out[kStateValues * k++];
+    for (int c = 0; c < 3; ++c) {
+      v[c] = x_[p][c];
+      v[3 + c] = v_[p][c];
+    }
+  }
+}
+
+void SpringHair::restore(const std::vector<double>& state, const std::string& source) {
+  const size_t segments = x_.size() - rest_.strandCount();
+  if (state.size() != segments * kStateValues)
+    throw InputError({source, 0}, "its simulation state has " + std::to_string(state.size() / kStateValues) +
+                                      " segments, the guides " + std::to_string(segments) +
+                                      "; restart from a frame of the same guides (and the same Model)");
+  for (double value : state)
+    if (!std::isfinite(value)) throw InputError({source, 0}, "its simulation state holds a non-finite value");
+  size_t k = 0;
+  for (size_t p = 0; p < x_.size(); ++p) {
+    if (length_[p] == 0.0) {
+      x_[p] = xRest_[p];
+      v_[p] = glm::dvec3(0.0);
+      continue;
+    }
+    const double* v = &state[kStateValues * k++];
+    x_[p] = glm::dvec3(v[0], v[1], v[2]);
+    v_[p] = glm::dvec3(v[3], v[4], v[5]);
+  }
+}
+
+}  // namespace hairgen

@@ -1,0 +1,165 @@
+// Petrovic, Henne and Anderson 2006, "Volumetric Methods for Simulation and Rendering of Hair" (Pixar
+// Technical Memo 06-08) §5: keyhairs as point masses joined by springs (§5 opening), hair-hair
+// interaction by smoothing the particles' velocities on the density grid of the memo's (1) (§5.1), and a
+// weak force that pushes the hair toward the density of a target shape, −∂E/∂P for E = ½ Σ (D_s − D_t)²
+// (§5.2, the memo's (3) and the force after it).
+//
+// Units: SI (metres, kilograms, seconds). The hair lives in the head's frame, where the roots and the
+// collision shapes stand still and AccelerationField gives gravity, the wind and the moving frame's
+// terms (libcore/physics/head_motion.h); posedInto() carries it to the world.
+//
+// The model (README, "Volumetric dynamics (Model springs)"):
+// - Particles: every guide point, mass ρ·πab times half of each segment beside it; the root is fixed to
+//   the head.
+// - Stretch: each segment keeps its length with compliance l/(E·A) (XPBD), solved per strand by a few
+//   Newton steps on the tridiagonal system of all its segments at once, so a strand is as stiff at its
+//   tip as at its root (no Gauss-Seidel lag along 32 particles).
+// - Bending: a spring per joint on its turn vector b_j = e_{j+1}/l_{j+1} − e_j/l_j (the root joint turns
+//   the first segment against the head-fixed root direction: a clamp), energy ½ k_j |b_j − b̄_j|² with
+//   k_j = E·I / l̄_j (l̄ the joint's share of length), which is the rod's ½ E·I κ² l̄ for small turns.
+//   Linear in the positions, so backward Euler with the constant pentadiagonal matrix M(1 + c·Δt) +
+//   Δt²K, factored once per strand, integrates it at any substep.
+// - Twist: a spring between points i and i + 3 (the classic torsion spring of mass-spring hair), whose
+//   length changes with the twist of the middle segment; its stiffness makes the rod's ½ G·J ψ²/l for a
+//   twist ψ, so it acts only where the rest shape bends out of a plane (a straight or planar hair has no
+//   twist to lose at first order). Solved with the stretch constraints, with compliance.
+// - Rest (sag-free): the groomed guides are made an equilibrium of the rest load (gravity along −y at the
+//   shot's Gravity). A tip-to-root pass gives every segment the tension that carries the load below it
+//   along its length (an explicit force that turns with the segment), and the remainder, across the
+//   hair, is carried by the bending springs: their targets b̄ solve Bᵀ diag(k) (b̄ − B x_rest) = load,
+//   which is triangular and solved from the tip. The rest is exactly still under a still head.
+// - Collisions (§5): particle by particle, each pushed out of every Collision Info shape (with a
+//   penalty) to the depth it sat at in the rest shape (so the groomed shape is always allowed).
+// - Velocity smoothing (§5.1): masses and momenta of the free particles are splatted with the tent
+//   weights of (1) onto a grid, both filtered by the symmetric, doubly stochastic [1 2 1]/4 kernel S,
+//   the grid velocity is the filtered momentum over the filtered mass, filtered once more and read back
+//   at every particle with the same tent weights; each particle then moves the fraction s of the way to
+//   it. As a map on the velocities this is (1 − s)I + s·A with A = Wᵀ S D⁻¹ S W M self-adjoint in the
+//   mass inner product with eigenvalues in [0, 1] (README), so it never raises the kinetic energy.
+// - Density targeting (§5.2): the target's points (scaled to the hair's point count) and the hair's are
+//   splatted on one fixed grid per spacing; a particle's acceleration is DensityStrength times the memo's
+//   F (densityForce in libcore/volume/hair_volume.h) over the target's mean density where it has any,
+//   so the strength means the same on every grid: the acceleration of a point where the density is
+//   wrong by the target's mean from one node to the next. Spacings go from coarse to fine: at each frame
+//   the hair uses the finest spacing all of whose coarser ones have fallen to DensityRefine of their
+//   starting energy (a rule of the present state, so a restart needs nothing more).
+//
+// Guarantees: a step depends only on the state (positions and velocities, in doubles) and the inputs;
+// strands step in parallel and every grid sums in a fixed order, so the result is the same bits for any
+// thread count, and a run resumed from state() is the same bits as one that never stopped.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include "libcore/config/params.h"
+#include "libcore/model/strands.h"
+#include "libcore/physics/head_motion.h"
+#include "libcore/volume/hair_volume.h"
+
+namespace hairgen {
+
+// The stiffnesses the springs get: the Dynamics keys, or from Young, Poisson and the cross-section.
+struct SpringStiffness {
+  double stretch = 0.0;  // N, E·A
+  double bend = 0.0;     // N·m², E·I
+  double twist = 0.0;    // N·m², G·J
+};
+SpringStiffness springStiffness(const Hairstyle& style, const Dynamics& dynamics);
+
+// The gravity a shot's hair feels (N/kg): Dynamics Gravity, or Hairstyle's when auto.
+double dynamicsGravity(const Hairstyle& style, const Dynamics& dynamics);
+
+class SpringHair {
+ public:
+  // `rest`: the groomed guides, in the head's rest pose (the pose the wick and Collision Info describe).
+  // `densityTarget`: the target shape of §5.2 in the same frame, or null (then DensityStrength is
+  // ignored). Strands of one point stay put. Throws InputError for a segment of zero length.
+  SpringHair(const Strands& rest, const Hairstyle& style, const Dynamics& dynamics,
+             const Collision& collision, const Strands* densityTarget);
+
+  // One substep of `dt` seconds for every strand. At the first substep of a frame the density spacing
+  // is chosen; after the last (`lastSubstep`) the velocities are smoothed by VelocitySmoothing.
+  void step(const AccelerationField& field, double dt, bool firstSubstep, bool lastSubstep);
+
+  // §5.1 on the current velocities: every free particle moves `fraction` of the way to the smoothed
+  // grid velocity at its place. Never raises the kinetic energy.
+  void smoothVelocities(double fraction);
+
+  // The hair in world coordinates: the head frame moved by `pose`. At rest the input points exactly;
+  // tangents are the input's turned with their segment.
+  Strands posed(const Pose& pose) const;
+  void posedInto(const Pose& pose, Strands& out) const;
+
+  // What a restart needs: per segment, its end point's position and velocity in the head's frame
+  // (kStateValues doubles; the roots are the head's); and the inverse.
+  static constexpr size_t kStateValues = 6;
+  std::vector<double> state() const;
+  void stateInto(std::vector<double>& out) const;
+  void restore(const std::vector<double>& state, const std::string& source);
+
+  // Diagnostics (head frame): per point.
+  const std::vector<glm::dvec3>& positions() const { return x_; }
+  const std::vector<glm::dvec3>& velocities() const { return v_; }
+  std::vector<glm::dvec3>& velocities() { return v_; }  // for tests that set a motion
+  void setPositions(const std::vector<glm::dvec3>& x) { x_ = x; }
+  const std::vector<double>& masses() const { return mass_; }
+  double kineticEnergy() const;  // joules, summed in point order
+  // §5.2: E = ½ Σ (D_s − D_t)² of the current positions on the grid of spacing `level` (0 = coarsest);
+  // the level the last frame used; the number of levels (0 without a target).
+  double densityEnergy(size_t level) const;
+  size_t densityLevel() const { return level_; }
+  size_t densityLevels() const { return targets_.size(); }
+  // The largest |segment length / rest length − 1| now.
+  double maxStretch() const;
+
+ private:
+  void stepStrand(size_t strand, const AccelerationField& field, double dt);
+  void factor(double dt);
+  void projectStretch(size_t strand, double dt, int iterations, std::vector<double>& lambda);
+  Grid densityDifference(size_t level) const;  // D_s − D_t at the current positions
+  std::vector<glm::vec3> floatPoints() const;
+
+  Strands rest_;
+  std::vector<glm::dvec3> xRest_, x_, v_;
+  std::vector<double> mass_, inverseMass_;
+  // Per segment, indexed by its end point: rest length, stretch compliance l/(E·A) (m/N), rest tension
+  // (N, the load below it along its length).
+  std::vector<double> length_, compliance_, restTension_;
+  // Per joint, indexed by its point (the root's joint turns the first segment against the root
+  // direction): stiffness E·I/l̄ (N·m) and target turn vector b̄.
+  std::vector<double> bend_;
+  std::vector<glm::dvec3> target_;
+  std::vector<glm::dvec3> rootDirection_;  // per strand, head frame
+  // Twist springs, indexed by their first point i (to i + 3): rest distance and compliance (m/N), 0
+  // stiffness as compliance < 0.
+  std::vector<double> twistLength_, twistCompliance_;
+  std::vector<glm::vec3> restTangents_;
+  // The implicit solve, per free point: 1/D and the two sub-diagonals of L in M(1 + cΔt) + Δt²K = L D Lᵀ,
+  // for the step dt_.
+  std::vector<double> inverseD_, lower1_, lower2_;
+  double dt_ = 0.0;
+  // Collisions: the shapes that collide and per shape the depth every point sat at (at least 0).
+  std::vector<CollisionShape> shapes_;
+  std::vector<std::vector<double>> restDepth_;
+  std::vector<double> shapeReach2_;
+  double damping_ = 0.0, smoothing_ = 0.0, smoothingSpacing_ = 0.01;
+  // Density targeting: per level the target's density on that level's grid; their energies at the
+  // start; the strength, the refine fraction and the level in use.
+  std::vector<Grid> targets_;
+  std::vector<double> startEnergy_;
+  std::vector<double> targetMean_;  // per level, the target's mean density over the nodes it occupies
+  double densityStrength_ = 0.0, densityRefine_ = 0.5;
+  size_t level_ = 0;
+  Grid difference_;  // D_s − D_t of the current substep, at level_
+  // Velocity smoothing's grid and point lists, kept between frames so their memory is reused.
+  GridOf<glm::dvec4> velocityGrid_;
+  std::vector<glm::dvec3> smoothWhere_;
+  std::vector<glm::dvec4> smoothWhat_;
+  std::vector<size_t> smoothWhich_;
+};
+
+}  // namespace hairgen
