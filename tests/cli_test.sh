@@ -468,6 +468,50 @@ shot_run_equals_stages)
     echo "ffmpeg is not installed: the movie is not checked"
   fi
   ;;
+shards_merge)
+  # grow and interpolate in 4 shards, merged in any order, give the whole run's bytes; merge refuses a
+  # missing, an overlapping or a foreign shard, naming it.
+  setup="$src/configs/default/setup.txt"
+  small=(--quiet --set Hairstyle.HairDensity=20)
+  expect_rc 0 "$hairgen" grow "$setup" -o "$tmp/g.hair" "${small[@]}"
+  for k in 1 2 3 4; do expect_rc 0 "$hairgen" grow "$setup" --shard $k/4 -o "$tmp/g.$k.hair" "${small[@]}"; done
+  expect_rc 0 "$hairgen" info "$tmp/g.2.hair"
+  grep -q "shard 2/4" "$tmp/out" || fail "info does not show the shard: $(cat "$tmp/out")"
+  expect_rc 0 "$hairgen" merge "$tmp/g.3.hair" "$tmp/g.1.hair" "$tmp/g.4.hair" "$tmp/g.2.hair" -o "$tmp/gm.hair" -q
+  cmp "$tmp/g.hair" "$tmp/gm.hair" || fail "merged guides differ from the whole run's"
+  expect_rc 0 "$hairgen" interpolate "$setup" --guides "$tmp/g.hair" -o "$tmp/c.hair" "${small[@]}"
+  for k in 1 2 3 4; do
+    expect_rc 0 "$hairgen" interpolate "$setup" --guides "$tmp/g.hair" --shard $k/4 -o "$tmp/c.$k.hair" "${small[@]}"
+  done
+  expect_rc 0 "$hairgen" merge "$tmp"/c.[1-4].hair -o "$tmp/cm.hair" -q
+  cmp "$tmp/c.hair" "$tmp/cm.hair" || fail "merged coupe differs from the whole run's"
+  # The cantilever model (Anjyo's bob) splits the same way.
+  bob="$src/configs/anjyo/bob/setup.txt"
+  expect_rc 0 "$hairgen" grow "$bob" -o "$tmp/b.hair" --quiet
+  for k in 1 2 3; do expect_rc 0 "$hairgen" grow "$bob" --shard $k/3 -o "$tmp/b.$k.hair" --quiet; done
+  expect_rc 0 "$hairgen" merge "$tmp"/b.[1-3].hair -o "$tmp/bm.hair" -q
+  cmp "$tmp/b.hair" "$tmp/bm.hair" || fail "merged cantilever guides differ"
+  # Refusals, exit 2, naming the culprit; nothing written.
+  expect_rc 2 "$hairgen" merge "$tmp/g.1.hair" "$tmp/g.2.hair" "$tmp/g.4.hair" -o "$tmp/x.hair" -q
+  grep -q "a shard is missing: guides .* before $tmp/g.4.hair" "$tmp/err" || fail "missing: $(cat "$tmp/err")"
+  expect_rc 2 "$hairgen" merge "$tmp/g.1.hair" "$tmp/g.2.hair" "$tmp/g.3.hair" -o "$tmp/x.hair" -q
+  grep -q "a shard is missing: guides .*after $tmp/g.3.hair" "$tmp/err" || fail "missing last: $(cat "$tmp/err")"
+  expect_rc 0 "$hairgen" grow "$setup" --shard 2/3 -o "$tmp/g.2of3.hair" "${small[@]}"
+  expect_rc 2 "$hairgen" merge "$tmp"/g.[1-4].hair "$tmp/g.2of3.hair" -o "$tmp/x.hair" -q
+  grep -q "g.2of3.hair.*shard 2/3" "$tmp/err" || fail "another split: $(cat "$tmp/err")"
+  expect_rc 2 "$hairgen" merge "$tmp"/g.[1-4].hair "$tmp/g.2.hair" -o "$tmp/x.hair" -q
+  grep -q "g.2.hair.*overlaps" "$tmp/err" || fail "overlap: $(cat "$tmp/err")"
+  expect_rc 0 "$hairgen" grow "$setup" --shard 3/4 -o "$tmp/g.3x.hair" --quiet --set Hairstyle.HairDensity=20 --seed 7
+  expect_rc 2 "$hairgen" merge "$tmp/g.1.hair" "$tmp/g.2.hair" "$tmp/g.3x.hair" "$tmp/g.4.hair" -o "$tmp/x.hair" -q
+  grep -q "g.3x.hair: comes from another config" "$tmp/err" || fail "foreign: $(cat "$tmp/err")"
+  expect_rc 2 "$hairgen" merge "$tmp/g.1.hair" "$tmp/c.2.hair" -o "$tmp/x.hair" -q
+  expect_rc 2 "$hairgen" merge "$tmp/g.hair" -o "$tmp/x.hair" -q
+  grep -q "g.hair: is not a shard" "$tmp/err" || fail "not a shard: $(cat "$tmp/err")"
+  [ ! -e "$tmp/x.hair" ] || fail "a refused merge wrote its output"
+  expect_rc 2 "$hairgen" grow "$setup" --shard 5/4 -o "$tmp/x.hair" -q
+  expect_rc 2 "$hairgen" grow "$setup" --shard 1/4 -o "$tmp/x.glb" -q
+  expect_rc 2 "$hairgen" interpolate "$setup" --guides "$tmp/g.hair" --shard 0/4 -o "$tmp/x.hair" -q
+  ;;
 *) fail "unknown case" ;;
 esac
 echo "ok ($case)"
