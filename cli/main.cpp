@@ -27,6 +27,7 @@ int main(int argc, char** argv) {
   registerShade(app, exitCode);
   registerRender(app, exitCode);
   registerMerge(app, exitCode);
+  registerFarm(app, exitCode);
   registerDiff(app, exitCode);
   registerInfo(app, exitCode);
   registerConvert(app, exitCode);

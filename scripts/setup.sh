@@ -37,6 +37,13 @@ if [ ! -f tools/node_modules/gltf-validator/package.json ]; then
   npm install --silent --no-audit --no-fund --prefix tools gltf-validator@2.0.0-dev.3.10 >/dev/null
 fi
 
+# ajv-cli, an independent JSON Schema validator the tests check farm plans with (docs/farm-plan.schema.json).
+if [ ! -f tools/node_modules/ajv-cli/dist/index.js ]; then
+  echo "setup: installing ajv-cli (npm)" >&2
+  mkdir -p tools
+  npm install --silent --no-audit --no-fund --prefix tools ajv-cli@5.0.0 >/dev/null
+fi
+
 # TinyUSDZ's WebAssembly build (npm package tinyusdz), an independent USD reader the tests check the
 # .usda export with.
 if [ ! -f tools/node_modules/tinyusdz/tinyusdz.wasm ]; then

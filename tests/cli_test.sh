@@ -512,6 +512,31 @@ shards_merge)
   expect_rc 2 "$hairgen" grow "$setup" --shard 1/4 -o "$tmp/x.glb" -q
   expect_rc 2 "$hairgen" interpolate "$setup" --guides "$tmp/g.hair" --shard 0/4 -o "$tmp/x.hair" -q
   ;;
+farm_plan)
+  # A plan of the default coupe and of a shot: tasks, dependencies, requests; --dry-run prints the sbatch
+  # lines and submits nothing (no Slurm needed).
+  setup="$src/configs/default/setup.txt"
+  expect_rc 0 "$hairgen" farm plan "$setup" -o "$tmp/still" --shards 3 --quiet --set Hairstyle.HairDensity=20
+  plan="$tmp/still/plan.json"
+  for id in grow.1 grow.3 merge-guides interpolate.3 merge-coupe render; do
+    grep -q "\"id\": \"$id\"" "$plan" || fail "the still's plan has no task $id"
+  done
+  grep -q '"Hairstyle.HairDensity=20"' "$plan" || fail "the plan's commands lose the overrides"
+  expect_rc 0 "$hairgen" farm plan "$src/configs/anjyo/gust/setup.txt" -o "$tmp/shot" --frames 1-12 --chunk 5 --quiet
+  for id in simulate interpolate-frames.3 shade-frames.3 render.3; do
+    grep -q "\"id\": \"$id\"" "$tmp/shot/plan.json" || fail "the shot's plan has no task $id"
+  done
+  ! grep -q '"render.4"' "$tmp/shot/plan.json" || fail "12 frames in chunks of 5 make 3 render tasks"
+  expect_rc 0 "$hairgen" farm submit "$tmp/shot/plan.json" --scheduler slurm --dry-run --quiet
+  grep -q "^grow=\$('sbatch' '--parsable' .*'--array=0,1,2,3'" "$tmp/out" || fail "dry run: $(cat "$tmp/out")"
+  grep -q "^render=.*'--dependency=aftercorr:\$shade-frames'" "$tmp/out" || fail "render waits for its own chunk: $(cat "$tmp/out")"
+  grep -q "^merge-guides=.*'--dependency=afterok:\$grow'" "$tmp/out" || fail "merge waits for every shard: $(cat "$tmp/out")"
+  [ ! -e "$tmp/shot/slurm" ] || fail "a dry run wrote scripts"
+  expect_rc 2 "$hairgen" farm plan "$src/configs/default/setup.txt" -o "$tmp/x" --frames 1-4 --quiet
+  expect_rc 2 "$hairgen" farm submit "$src/tests/cli_test.sh" --scheduler slurm --dry-run
+  grep -q "is not a hairgen farm plan" "$tmp/err" || fail "not a plan: $(cat "$tmp/err")"
+  expect_rc 2 "$hairgen" farm submit "$plan" --scheduler pbs --dry-run
+  ;;
 *) fail "unknown case" ;;
 esac
 echo "ok ($case)"
