@@ -537,6 +537,50 @@ farm_plan)
   grep -q "is not a hairgen farm plan" "$tmp/err" || fail "not a plan: $(cat "$tmp/err")"
   expect_rc 2 "$hairgen" farm submit "$plan" --scheduler pbs --dry-run
   ;;
+farm_slurm)
+  # On a one-node Slurm (scripts/slurm-local.sh): the default coupe grown and interpolated in 4 shards,
+  # merged, and a 24-frame shot rendered in chunks of 5 equal `hairgen run` byte for byte; a cancelled
+  # render task fails --wait naming it, and submitting again redoes only that task.
+  slurm="$src/scripts/slurm-local.sh"
+  was_up=0; bash "$slurm" status && was_up=1
+  bash "$slurm" start >"$tmp/slurm.log" 2>&1; rc=$?
+  if [ "$rc" -ne 0 ]; then echo "SKIP: no local Slurm: $(cat "$tmp/slurm.log")"; exit 77; fi
+  [ "$was_up" -eq 1 ] || trap 'bash "$slurm" stop >/dev/null 2>&1; rm -rf "$tmp"' EXIT
+  setup="$src/configs/default/setup.txt"
+  small=(--quiet --set Hairstyle.HairDensity=20 --set "Render.Resolution=64 48")
+  expect_rc 0 "$hairgen" farm plan "$setup" -o "$tmp/farm" --shards 4 "${small[@]}"
+  expect_rc 0 "$hairgen" farm submit "$tmp/farm/plan.json" --scheduler slurm --wait
+  grep -q "^grow: job [0-9]* (4 tasks)" "$tmp/out" || fail "no job ids printed: $(cat "$tmp/out")"
+  expect_rc 0 "$hairgen" run "$setup" -o "$tmp/run" "${small[@]}"
+  for f in guides.hair coupe.hair beauty.exr; do cmp "$tmp/run/$f" "$tmp/farm/$f" || fail "farm's $f differs from run's"; done
+  # The shot.
+  gust="$src/configs/anjyo/gust/setup.txt"
+  shot=(--quiet --set Hairstyle.HairDensity=5 --set "Render.Resolution=40 40")
+  expect_rc 0 "$hairgen" farm plan "$gust" -o "$tmp/shot" --shards 4 --frames 1-24 --chunk 5 "${shot[@]}"
+  "$hairgen" farm submit "$tmp/shot/plan.json" --scheduler slurm --wait >"$tmp/sub.out" 2>"$tmp/sub.err" &
+  submitter=$!
+  for _ in $(seq 100); do grep -q "^render: job" "$tmp/sub.out" && break; sleep 0.1; done
+  job=$(sed -n 's/^render: job \([0-9]*\).*/\1/p' "$tmp/sub.out")
+  [ -n "$job" ] || fail "no render job: $(cat "$tmp/sub.out" "$tmp/sub.err")"
+  scancel "${job}_2"
+  wait "$submitter"; rc=$?
+  [ "$rc" -eq 1 ] || fail "--wait after a cancelled task exited $rc: $(cat "$tmp/sub.err")"
+  grep -q "task render.3 (job ${job}_2, log $tmp/shot/logs/render.2.log)\|render.3 (job ${job}_2" "$tmp/sub.err" ||
+    fail "--wait does not name the cancelled task: $(cat "$tmp/sub.err")"
+  [ ! -e "$tmp/shot/beauty.0011.exr" ] || fail "the cancelled chunk wrote frame 11"
+  find "$tmp/shot" -name '*.hair' -o -name '*.exr' -o -name '*.png' | sort | xargs stat -c '%n %.9Y' >"$tmp/before"
+  expect_rc 0 "$hairgen" farm submit "$tmp/shot/plan.json" --scheduler slurm --wait
+  [ "$(grep -c ': job ' "$tmp/out")" -eq 1 ] && grep -q "^render: job [0-9]* (1 task)" "$tmp/out" ||
+    fail "the resubmission redid more than the cancelled task: $(cat "$tmp/out")"
+  xargs stat -c '%n %.9Y' <<<"$(cut -d' ' -f1 "$tmp/before")" | cmp - "$tmp/before" || fail "a finished output was rewritten"
+  expect_rc 0 "$hairgen" run "$gust" -o "$tmp/shotrun" "${shot[@]}" --set "Dynamics.Frames=1 24"
+  for f in $(seq -f %04g 1 24); do
+    cmp "$tmp/shotrun/sim/guides.$f.hair" "$tmp/shot/sim/guides.$f.hair" || fail "simulated frame $f differs"
+    cmp "$tmp/shotrun/beauty.$f.exr" "$tmp/shot/beauty.$f.exr" || fail "frame $f differs from run's"
+  done
+  expect_rc 0 "$hairgen" farm submit "$tmp/shot/plan.json" --scheduler slurm --wait
+  grep -q "every task is done" "$tmp/err" "$tmp/out" || fail "a done plan was submitted again: $(cat "$tmp/out")"
+  ;;
 *) fail "unknown case" ;;
 esac
 echo "ok ($case)"
