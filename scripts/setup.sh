@@ -13,6 +13,7 @@ packages=(
   libegl-dev libgl-dev libopengl-dev libegl1 libopengl0 libegl-mesa0 libgl1-mesa-dri libgbm1
   libgtest-dev libgmock-dev libbenchmark-dev
   clang libclang-rt-14-dev llvm  # the fuzz build (scripts/fuzz.sh): libFuzzer, ASan, UBSan, llvm-symbolizer
+  slurm-wlm munge  # the farm's scheduler: a one-node Slurm for the tests (scripts/slurm-local.sh)
 )
 # Node.js with npm runs the glTF validator; the image may ship its own Node (then Debian's npm conflicts).
 command -v npm >/dev/null 2>&1 || packages+=(nodejs npm)
