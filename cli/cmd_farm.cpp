@@ -256,9 +256,11 @@ void submit(const FarmPlan& plan, const std::string& planFile, bool dryRun, bool
                        "case \"$SLURM_ARRAY_TASK_ID\" in\n";
     for (size_t k = 0; k < s.tasks.size(); ++k) {
       const FarmTask& t = plan.tasks[s.tasks[k]];
-      text += std::to_string(s.arrayIndex[k]) + ") # " + t.id + "\n  exec";
+      // The start and end lines time the task apart from the scheduler (scripts/bench.sh farm).
+      text += std::to_string(s.arrayIndex[k]) + ")\n  echo \"hairgen-farm: start " + t.id +
+              " $(date +%s.%N)\"\n ";
       for (const std::string& a : t.command) text += " " + shellQuote(a);
-      text += " ;;\n";
+      text += "\n  rc=$?\n  echo \"hairgen-farm: end " + t.id + " $(date +%s.%N) exit $rc\"\n  exit $rc ;;\n";
     }
     text += "esac\necho \"no task $SLURM_ARRAY_TASK_ID in " + s.group + "\" >&2\nexit 2\n";
     writeFileAtomic(script, text.data(), text.size());
@@ -286,11 +288,18 @@ void submit(const FarmPlan& plan, const std::string& planFile, bool dryRun, bool
 void waitForJobs(const FarmPlan& plan, const std::vector<Submission>& submitted, const std::string& logs) {
   std::string jobs;
   for (const Submission& s : submitted) jobs += (jobs.empty() ? "" : ",") + s.job;
-  for (;;) {
+  for (int failures = 0;;) {
     const ProcessResult r =
         runProcess({"squeue", "--noheader", "--jobs=" + jobs, "--array",
                     "--states=PENDING,RUNNING,COMPLETING,CONFIGURING,SUSPENDED,REQUEUED", "--format=%i %r"});
-    if (r.status != 0) break;  // every job has left the controller
+    // squeue fails when the controller is busy and when every job has long left it: a few tries tell
+    // the two apart.
+    if (r.status != 0) {
+      if (++failures == 5) break;
+      std::this_thread::sleep_for(std::chrono::seconds(1));
+      continue;
+    }
+    failures = 0;
     std::istringstream lines(r.out);
     std::string line;
     bool queued = false;

@@ -80,8 +80,8 @@ void registerInterpolate(CLI::App& app, int& exitCode) {
         const std::filesystem::path in = framePath(options->guides, f);
         const Strands guides = readStrandsAs(in, options->units);
         stats.add("read", clock.lap());
-        InterpolateOptions frameOptions{config.digest(),       in.string(),           nullptr,
-                                        options->common.force, head.pose(f).matrix(), {}};
+        InterpolateOptions frameOptions{config.digest(), in.string(), nullptr, options->common.force,
+                                        head.pose(f).matrix()};
         const Strands coupe = interpolate(wick, guides, config.hairstyle, config.collision, frameOptions);
         stats.add("interpolate", clock.lap());
         writeStrands(framePath(options->output, f), coupe);

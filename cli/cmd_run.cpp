@@ -79,7 +79,7 @@ void runShot(const CommonOptions& common, const Config& config, const Mesh& wick
     stats.add("write", clock.lap());
     if (!render) return progress.advance();
     InterpolateOptions interpolation{config.digest(), framePath(simPattern, f).string(), nullptr,
-                                     common.force,    motion.pose(f).matrix(),           {}};
+                                     common.force, motion.pose(f).matrix()};
     Strands coupe = interpolate(wick, frameGuides, config.hairstyle, config.collision, interpolation);
     if (shaded) coupe = repose(restCoupe, coupe);
     stats.add("interpolate", clock.lap());

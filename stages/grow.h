@@ -21,7 +21,7 @@ struct GrowOptions {
   bool force = false;            // run work estimated to take absurdly long (never work that cannot fit)
   // Grow only the guides of wick vertices [first, end) (`grow --shard K/N`), recorded in the provenance;
   // each guide is the one the whole run grows, so `hairgen merge` of the shards gives the whole file.
-  std::optional<ShardRange> shard;
+  std::optional<ShardRange> shard{};
 };
 
 // What minimisation did for one guide.

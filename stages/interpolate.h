@@ -28,7 +28,7 @@ struct InterpolateOptions {
   // Fill only wick triangles [first, end) (`interpolate --shard K/N`), recorded in the provenance. Every
   // random number is keyed by (seed, triangle, strand in it), so a shard's strands, ids and weights are
   // those of the whole run and `hairgen merge` of the shards gives the whole file.
-  std::optional<ShardRange> shard;
+  std::optional<ShardRange> shard{};
 };
 
 // Fills every wick triangle. Guide i must be the one grown from wick vertex i. The coupe is ordered by
