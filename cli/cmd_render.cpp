@@ -13,7 +13,9 @@
 #include "libcore/util/frames.h"
 #include "libcore/util/progress.h"
 #include "libcore/util/text.h"
+#include "stages/interpolate.h"
 #include "stages/render.h"
+#include "stages/shade.h"
 #include "stages/simulate.h"
 
 namespace hairgen::cli {
@@ -94,7 +96,7 @@ void writeRenderOutputs(const Config& config, const RenderOutput& out, const std
 void registerRender(CLI::App& app, int& exitCode) {
   struct Options {
     CommonOptions common;
-    std::string setup, hair, output, dom, preview, frames;
+    std::string setup, hair, output, dom, preview, frames, guides, rest;
     UnitOptions units;
     double scale = 1.0;
     bool frame = false, listDevices = false;
@@ -124,6 +126,17 @@ void registerRender(CLI::App& app, int& exitCode) {
          "Render these frames of a sequence in one process, one device: --hair, -o, --dom and --preview "
          "are patterns with ####, and the head moves with the Setup's HeadKeys")
       ->type_name("A-B");
+  cmd->add_option(
+         "--guides", options->guides,
+         "With --frames, instead of --hair: a simulated sequence's guides (sim/guides.####.hair), each "
+         "frame interpolated and, when the Setup shades, re-posed from --rest in memory, as `run` "
+         "does: a farm's frame chunk writes no per-frame coupes")
+      ->excludes("--hair")
+      ->needs("--frames");
+  cmd->add_option("--rest", options->rest,
+                  "With --guides: the shaded rest coupe whose normals and colours each frame takes (`shade` "
+                  "--rest); needed when the Setup shades")
+      ->needs("--guides");
   cmd->add_flag("--list-devices", options->listDevices, "List the EGL devices and platforms found, and exit");
   addCommonFlags(*cmd, options->common, true);
   cmd->footer(exitCodeHelp());
@@ -137,19 +150,21 @@ void registerRender(CLI::App& app, int& exitCode) {
         if (devices.empty()) std::cout << "no EGL platform found\n";
         return;
       }
-      if (options->setup.empty() || options->hair.empty() || options->output.empty())
+      const bool fromGuides = !options->guides.empty();
+      if (options->setup.empty() || (options->hair.empty() && !fromGuides) || options->output.empty())
         throw InputError("render needs SETUP, --hair FILE and -o IMAGE.exr (or --list-devices)");
       requireExtension(options->output, ".exr", "-o");
       if (!options->dom.empty()) requireExtension(options->dom, ".exr", "--dom");
       if (!options->preview.empty()) requireExtension(options->preview, ".png", "--preview");
       Stats stats("render");
       Stopwatch clock;
-      Config config = loadStageConfig(options->setup, options->common, SetupUse::kRender, stats);
+      Config config = loadStageConfig(options->setup, options->common,
+                                      fromGuides ? SetupUse::kRun : SetupUse::kRender, stats);
       const bool sequence = !options->frames.empty();
       const FrameRange frames = sequence ? parseFrameRange(options->frames, "--frames") : FrameRange{0, 0};
       if (sequence)
         for (const std::string* pattern :
-             {&options->hair, &options->output, &options->dom, &options->preview})
+             {&options->hair, &options->guides, &options->output, &options->dom, &options->preview})
           if (!pattern->empty() && !isFramePattern(*pattern))
             throw InputError(*pattern + ": with --frames, write #### where the frame number goes");
       auto frameFile = [&](const std::string& pattern, int f) {
@@ -158,6 +173,18 @@ void registerRender(CLI::App& app, int& exitCode) {
       std::optional<Mesh> head;
       if (config.setup.headModel.given()) head = readObj(config.setup.headModel.path);
       const HeadMotion motion = headMotionOf(config);
+      // From guides: what `run` does to a frame of a shot, in the same order, so the images are its.
+      const bool shaded = wantsShade(config.visuality, config.render);
+      if (fromGuides && shaded && options->rest.empty())
+        throw InputError(
+            "--guides: this Setup shades, so each frame takes its normals from the shaded rest "
+            "coupe: name it with --rest shaded.hair");
+      if (fromGuides && !shaded && !options->rest.empty())
+        throw InputError("--rest: this Setup does not shade; each frame is rendered as interpolated");
+      Mesh wick;
+      Strands rest;
+      if (fromGuides) wick = readObj(config.setup.wickModel.path);
+      if (!options->rest.empty()) rest = readStrands(options->rest);
       stats.time("read", clock.lap());
       RenderOptions renderOptions;
       renderOptions.frame = options->frame;
@@ -169,8 +196,14 @@ void registerRender(CLI::App& app, int& exitCode) {
           openDevice(options->common, config, stats);  // one for every frame
       Progress progress("render", "frames", size_t(frames.count()), sequence && !options->common.quiet);
       for (int f = frames.first; f <= frames.last; ++f) {
-        const std::string hairFile = frameFile(options->hair, f);
-        const Strands hair = readStrands(hairFile);
+        const std::string hairFile = frameFile(fromGuides ? options->guides : options->hair, f);
+        Strands hair = readStrands(hairFile);
+        if (fromGuides) {
+          const InterpolateOptions interpolation{config.digest(), hairFile, nullptr, options->common.force,
+                                                 motion.pose(f).matrix()};
+          hair = interpolate(wick, hair, config.hairstyle, config.collision, interpolation);
+          if (shaded) hair = repose(rest, hair);
+        }
         if (config.render.shadingModel == ShadingModel::kVolumetric && config.render.volumetricBlend > 0.0 &&
             hair.normals.empty())
           throw InputError({hairFile, 0},

@@ -132,11 +132,10 @@ FarmPlan planFarm(const Config& config, const Mesh& wick, const FarmPlanOptions&
   }
 
   // A shot: the guides simulated in one task (each frame restarts from the one before), then every chunk
-  // of frames interpolated, shaded like the rest coupe and rendered.
+  // of frames rendered from them in one task: interpolated, re-posed from the shaded rest coupe and
+  // rendered in memory, as run does, so no per-frame coupe is written.
   const FrameRange frames = *plan.frames;
-  const std::string simPattern = dir + "/sim/guides.####.hair",
-                    coupePattern = dir + "/frames/coupe.####.hair",
-                    shadedPattern = dir + "/frames/shaded.####.hair", exrPattern = dir + "/beauty.####.exr",
+  const std::string simPattern = dir + "/sim/guides.####.hair", exrPattern = dir + "/beauty.####.exr",
                     pngPattern = dir + "/beauty.####.png";
   auto frameFiles = [](const std::string& pattern, const FrameRange& f) {
     std::vector<std::string> files;
@@ -148,31 +147,30 @@ FarmPlan planFarm(const Config& config, const Mesh& wick, const FarmPlanOptions&
       config.dynamics, wick.vertexCount() * (guidePoints > 0 ? guidePoints - 1 : 0), frames, options.threads);
   add("simulate", "simulate", {"simulate", setup, "--guides", guides, "-o", simPattern}, {setup, guides},
       frameFiles(simPattern, frames), {"merge-guides"}, request(&simulation, 1.0, options.maxCpus), true);
-  const double perFrame = 1.0;  // the interpolate, shade and render estimates are of one frame
+  // A frame holds its coupe while it renders: the two estimates' memory together, their times summed.
+  WorkEstimate frame;
+  for (const char* stage : {"interpolate", "render"})
+    if (const WorkEstimate* e = estimate(stage)) {
+      frame.bytes += e->bytes;
+      frame.seconds += e->seconds;
+    }
   for (int first = frames.first, c = 1; first <= frames.last; first += options.chunk, ++c) {
     const FrameRange chunk{first, std::min(frames.last, first + options.chunk - 1)};
-    const std::string range = framesText(chunk), index = std::to_string(c);
-    const double frameShare = perFrame * chunk.count();
-    add("interpolate-frames." + index, "interpolate-frames",
-        {"interpolate", setup, "--guides", simPattern, "-o", coupePattern, "--frames", range},
-        frameFiles(simPattern, chunk), frameFiles(coupePattern, chunk), {"simulate"},
-        request(estimate("interpolate"), frameShare, options.maxCpus), true);
-    std::string hair = coupePattern, hairTask = "interpolate-frames." + index;
+    std::vector<std::string> args = {"render", setup, "--guides", simPattern};
+    std::vector<std::string> inputs = frameFiles(simPattern, chunk), deps = {"simulate"};
+    inputs.insert(inputs.begin(), setup);
     if (shaded) {
-      add("shade-frames." + index, "shade-frames",
-          {"shade", "--rest", rest, coupePattern, "-o", shadedPattern, "--frames", range},
-          frameFiles(coupePattern, chunk), frameFiles(shadedPattern, chunk), {hairTask, restTask},
-          request(estimate("shade"), 0.2 * frameShare, options.maxCpus), false);
-      hair = shadedPattern;
-      hairTask = "shade-frames." + index;
+      args.insert(args.end(), {"--rest", rest});
+      inputs.push_back(rest);
+      deps.push_back(restTask);
     }
+    args.insert(args.end(), {"-o", exrPattern, "--preview", pngPattern, "--frames", framesText(chunk)});
     std::vector<std::string> outputs = frameFiles(exrPattern, chunk), pngs = frameFiles(pngPattern, chunk);
     outputs.insert(outputs.end(), pngs.begin(), pngs.end());
-    std::vector<std::string> inputs = frameFiles(hair, chunk);
-    inputs.insert(inputs.begin(), setup);
-    add("render." + index, "render",
-        {"render", setup, "--hair", hair, "-o", exrPattern, "--preview", pngPattern, "--frames", range},
-        inputs, outputs, {hairTask}, request(estimate("render"), frameShare, options.maxCpus), true);
+    WorkEstimate work = frame;
+    work.seconds *= chunk.count();  // the memory is one frame's: frames render one after another
+    Request r = request(&work, 1.0, options.maxCpus);
+    add("render." + std::to_string(c), "render", args, inputs, outputs, deps, r, true);
   }
   return plan;
 }

@@ -1,6 +1,7 @@
 // A farm plan (DESIGN §8): the work of `hairgen run` on a Setup split into tasks a scheduler runs on
 // many machines: guides grown in shards and merged, the coupe interpolated in shards and merged, shaded,
-// then for a shot simulated and interpolated, shaded and rendered in chunks of frames. Every task is a
+// then for a shot simulated and rendered in chunks of frames (each frame interpolated and re-posed in
+// memory by `render --guides`, as run does). Every task is a
 // hairgen command line with its inputs, outputs, dependencies and CPU and memory requests (from the
 // stages' work estimates), and the plan is independent of any scheduler: Slurm is one back end
 // (`hairgen farm submit`). Its outputs equal `hairgen run`'s byte for byte.

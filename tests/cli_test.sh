@@ -458,10 +458,16 @@ shot_run_equals_stages)
   expect_rc 0 "$hairgen" shade "$setup" --hair "$tmp/rest.hair" -o "$tmp/rest-shaded.hair" "${small[@]}"
   expect_rc 0 "$hairgen" shade --rest "$tmp/rest-shaded.hair" "$tmp/c.####.hair" -o "$tmp/s.####.hair" --frames 1-4 --quiet
   expect_rc 0 "$hairgen" render "$setup" --hair "$tmp/s.####.hair" -o "$tmp/b.####.exr" --frames 1-4 "${small[@]}"
+  # render --guides interpolates and re-poses each frame in memory, as run does.
+  expect_rc 0 "$hairgen" render "$setup" --guides "$tmp/sim/g.####.hair" --rest "$tmp/rest-shaded.hair" \
+    -o "$tmp/m.####.exr" --frames 1-4 "${small[@]}"
   for f in 0001 0004; do
     cmp "$tmp/run/sim/guides.$f.hair" "$tmp/sim/g.$f.hair" || fail "run's simulated frame $f differs"
     cmp "$tmp/run/beauty.$f.exr" "$tmp/b.$f.exr" || fail "run's frame $f differs from the stages'"
+    cmp "$tmp/run/beauty.$f.exr" "$tmp/m.$f.exr" || fail "render --guides's frame $f differs from run's"
   done
+  expect_rc 2 "$hairgen" render "$setup" --guides "$tmp/sim/g.####.hair" -o "$tmp/m.####.exr" --frames 1-4 "${small[@]}"
+  grep -q -- "--rest" "$tmp/err" || fail "render --guides without --rest: $(cat "$tmp/err")"
   if command -v ffmpeg >/dev/null; then
     [ -s "$tmp/run/beauty.mp4" ] && [ -s "$tmp/run/beauty.gif" ] || fail "no preview movie"
   else
@@ -523,13 +529,15 @@ farm_plan)
   done
   grep -q '"Hairstyle.HairDensity=20"' "$plan" || fail "the plan's commands lose the overrides"
   expect_rc 0 "$hairgen" farm plan "$src/configs/anjyo/gust/setup.txt" -o "$tmp/shot" --frames 1-12 --chunk 5 --quiet
-  for id in simulate interpolate-frames.3 shade-frames.3 render.3; do
+  for id in simulate shade render.3; do
     grep -q "\"id\": \"$id\"" "$tmp/shot/plan.json" || fail "the shot's plan has no task $id"
   done
   ! grep -q '"render.4"' "$tmp/shot/plan.json" || fail "12 frames in chunks of 5 make 3 render tasks"
   expect_rc 0 "$hairgen" farm submit "$tmp/shot/plan.json" --scheduler slurm --dry-run --quiet
   grep -q "^grow=\$('sbatch' '--parsable' .*'--array=0,1,2,3'" "$tmp/out" || fail "dry run: $(cat "$tmp/out")"
-  grep -q "^render=.*'--dependency=aftercorr:\$shade-frames'" "$tmp/out" || fail "render waits for its own chunk: $(cat "$tmp/out")"
+  grep -q "^render=.*'--array=0,1,2'.*'--dependency=afterok:\$shade,afterok:\$simulate'" "$tmp/out" ||
+    fail "render waits for the simulation and the shaded rest coupe: $(cat "$tmp/out")"
+  ! grep -q "interpolate-frames\|/frames/" "$tmp/shot/plan.json" || fail "the shot's plan writes per-frame coupes"
   grep -q "^merge-guides=.*'--dependency=afterok:\$grow'" "$tmp/out" || fail "merge waits for every shard: $(cat "$tmp/out")"
   [ ! -e "$tmp/shot/slurm" ] || fail "a dry run wrote scripts"
   expect_rc 2 "$hairgen" farm plan "$src/configs/default/setup.txt" -o "$tmp/x" --frames 1-4 --quiet
