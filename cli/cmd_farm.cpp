@@ -135,6 +135,7 @@ struct Group {
 
 struct Submission {
   std::string group;
+  std::string name;                // the group, or the task of a group submitted task by task
   std::string job;                 // the array's job id
   std::vector<size_t> tasks;       // plan.tasks indices submitted
   std::vector<size_t> arrayIndex;  // their array indices
@@ -181,100 +182,114 @@ void submit(const FarmPlan& plan, const std::string& planFile, bool dryRun, bool
     }
   }
   std::vector<Submission> submitted;
-  std::map<size_t, size_t> submissionOfGroup;  // group → submitted index
+  std::map<size_t, size_t> submissionOfTask;  // plan task → submitted index
   for (size_t g = 0; g < groups.size(); ++g) {
-    Submission s;
-    s.group = groups[g].name;
-    int cpus = 1;
-    uint64_t memory = 1;
+    std::vector<size_t> undone;
     for (size_t i : groups[g].tasks)
-      if (!done[i]) {
+      if (!done[i]) undone.push_back(i);
+    if (undone.empty()) continue;
+    // A group whose tasks wait for one another (the simulation's chunks, each restarting from the last)
+    // is submitted task by task; any other as one array.
+    bool chained = false;
+    for (size_t i : undone)
+      for (const std::string& d : plan.tasks[i].deps) chained = chained || groupOf[taskIndex.at(d)] == g;
+    std::vector<std::vector<size_t>> batches;
+    if (chained)
+      for (size_t i : undone) batches.push_back({i});
+    else
+      batches.push_back(undone);
+    if (!dryRun) {
+      const fs::path script = scripts / (groups[g].name + ".sh");
+      std::string text = "#!/bin/sh\n# " + groups[g].name + " tasks of " + planFile +
+                         ", written by hairgen farm submit: array task i runs the group's task i.\n"
+                         "case \"$SLURM_ARRAY_TASK_ID\" in\n";
+      for (size_t i : groups[g].tasks) {
+        const FarmTask& t = plan.tasks[i];
+        // The start and end lines time the task apart from the scheduler (scripts/bench.sh farm).
+        text += std::to_string(indexInGroup[i]) + ")\n  echo \"hairgen-farm: start " + t.id +
+                " $(date +%s.%N)\"\n ";
+        for (const std::string& arg : t.command) text += " " + shellQuote(arg);
+        text +=
+            "\n  rc=$?\n  echo \"hairgen-farm: end " + t.id + " $(date +%s.%N) exit $rc\"\n  exit $rc ;;\n";
+      }
+      text += "esac\necho \"no task $SLURM_ARRAY_TASK_ID in " + groups[g].name + "\" >&2\nexit 2\n";
+      writeFileAtomic(script, text.data(), text.size());
+      fs::permissions(script, fs::perms::owner_exec | fs::perms::group_exec | fs::perms::others_exec,
+                      fs::perm_options::add);
+    }
+    for (const std::vector<size_t>& batch : batches) {
+      Submission s;
+      s.group = groups[g].name;
+      const std::string name = chained ? plan.tasks[batch.front()].id : s.group;
+      s.name = name;
+      int cpus = 1;
+      uint64_t memory = 1;
+      for (size_t i : batch) {
         s.tasks.push_back(i);
         s.arrayIndex.push_back(indexInGroup[i]);
         cpus = std::max(cpus, plan.tasks[i].cpus);
         memory = std::max(memory, plan.tasks[i].memoryMiB);
       }
-    if (s.tasks.empty()) continue;
-    if (nodeCpus > 0) cpus = std::min(cpus, nodeCpus);
-    if (nodeMiB > 0 && memory > nodeMiB)
-      throw InputError(s.group + " tasks need " + std::to_string(memory) +
-                       " MiB, more than the largest node's " + std::to_string(nodeMiB) + " MiB");
-    // Dependencies: the submitted arrays this one's tasks read.
-    std::vector<std::string> dependencies;
-    std::set<size_t> depGroups;
-    for (size_t i : s.tasks)
-      for (const std::string& d : plan.tasks[i].deps)
-        if (!done[taskIndex.at(d)]) depGroups.insert(groupOf[taskIndex.at(d)]);
-    for (size_t h : depGroups) {
-      const Submission& other = submitted[submissionOfGroup.at(h)];
-      // aftercorr when each task reads only the task of its own index in `h`, submitted too.
-      bool corresponding = true;
-      for (size_t i : s.tasks) {
-        for (const std::string& d : plan.tasks[i].deps) {
-          const size_t j = taskIndex.at(d);
-          if (groupOf[j] != h) continue;
-          const bool same = indexInGroup[j] == indexInGroup[i];
-          const bool inArray = std::find(other.tasks.begin(), other.tasks.end(), j) != other.tasks.end();
-          corresponding = corresponding && same && inArray;
+      if (nodeCpus > 0) cpus = std::min(cpus, nodeCpus);
+      if (nodeMiB > 0 && memory > nodeMiB)
+        throw InputError(name + " tasks need " + std::to_string(memory) +
+                         " MiB, more than the largest node's " + std::to_string(nodeMiB) + " MiB");
+      // Dependencies: the submitted jobs this batch's tasks read; aftercorr where each task reads only
+      // the task of its own index in another array.
+      std::set<size_t> depSubmissions;
+      for (size_t i : batch)
+        for (const std::string& d : plan.tasks[i].deps)
+          if (!done[taskIndex.at(d)]) depSubmissions.insert(submissionOfTask.at(taskIndex.at(d)));
+      std::vector<std::string> dependencies;
+      for (size_t h : depSubmissions) {
+        const Submission& other = submitted[h];
+        bool corresponding = other.tasks.size() > 1;
+        for (size_t i : batch) {
+          size_t reads = 0;
+          for (const std::string& d : plan.tasks[i].deps) {
+            const size_t j = taskIndex.at(d);
+            if (done[j] || submissionOfTask.at(j) != h) continue;
+            ++reads;
+            corresponding = corresponding && indexInGroup[j] == indexInGroup[i];
+          }
+          corresponding = corresponding && reads == 1;
         }
-        size_t readsFromH = 0;
-        for (const std::string& d : plan.tasks[i].deps) readsFromH += groupOf[taskIndex.at(d)] == h;
-        corresponding = corresponding && readsFromH == 1;
+        dependencies.push_back((corresponding ? "aftercorr:" : "afterok:") +
+                               (dryRun ? "$" + other.name : other.job));
       }
-      corresponding = corresponding && other.tasks.size() > 1;
-      dependencies.push_back((corresponding ? "aftercorr:" : "afterok:") +
-                             (dryRun ? "$" + other.group : other.job));
-    }
-    std::string array;
-    for (size_t a : s.arrayIndex) array += (array.empty() ? "" : ",") + std::to_string(a);
-    const fs::path script = scripts / (s.group + ".sh");
-    std::vector<std::string> sbatch = {"sbatch",
-                                       "--parsable",
-                                       "--job-name=hairgen-" + s.group,
-                                       "--array=" + array,
-                                       "--cpus-per-task=" + std::to_string(cpus),
-                                       "--mem=" + std::to_string(memory) + "M",
-                                       "--output=" + (logs / (s.group + ".%a.log")).string(),
-                                       "--requeue"};
-    if (!dependencies.empty()) {
-      std::string dep;
-      for (const std::string& d : dependencies) dep += (dep.empty() ? "" : ",") + d;
-      sbatch.push_back("--dependency=" + dep);
-      sbatch.push_back("--kill-on-invalid-dep=yes");
-    }
-    sbatch.push_back(script.string());
-    if (dryRun) {
-      std::string line = s.group + "=$(";
-      for (size_t k = 0; k < sbatch.size(); ++k) line += (k ? " " : "") + shellQuote(sbatch[k]);
-      std::cout << line << ")\n";
-      submissionOfGroup[g] = submitted.size();
+      std::string array;
+      for (size_t k : s.arrayIndex) array += (array.empty() ? "" : ",") + std::to_string(k);
+      std::vector<std::string> sbatch = {"sbatch",
+                                         "--parsable",
+                                         "--job-name=hairgen-" + name,
+                                         "--array=" + array,
+                                         "--cpus-per-task=" + std::to_string(cpus),
+                                         "--mem=" + std::to_string(memory) + "M",
+                                         "--output=" + (logs / (s.group + ".%a.log")).string(),
+                                         "--requeue"};
+      if (!dependencies.empty()) {
+        std::string dep;
+        for (const std::string& d : dependencies) dep += (dep.empty() ? "" : ",") + d;
+        sbatch.push_back("--dependency=" + dep);
+        sbatch.push_back("--kill-on-invalid-dep=yes");
+      }
+      sbatch.push_back((scripts / (s.group + ".sh")).string());
+      if (dryRun) {
+        std::string line = name + "=$(";
+        for (size_t k = 0; k < sbatch.size(); ++k) line += (k ? " " : "") + shellQuote(sbatch[k]);
+        std::cout << line << ")\n";
+      } else {
+        const ProcessResult r = runProcess(sbatch);
+        if (r.status != 0)
+          throw IoError("sbatch for " + name + " failed (exit " + std::to_string(r.status) + ")");
+        s.job = r.out.substr(0, r.out.find_first_of(";\n"));
+        std::cout << name << ": job " << s.job << " (" << s.tasks.size() << " task"
+                  << (s.tasks.size() == 1 ? "" : "s") << ")\n"
+                  << std::flush;
+      }
+      for (size_t i : s.tasks) submissionOfTask[i] = submitted.size();
       submitted.push_back(std::move(s));
-      continue;
     }
-    std::string text = "#!/bin/sh\n# " + s.group + " tasks of " + planFile +
-                       ", written by hairgen farm submit: array task i runs the group's task i.\n"
-                       "case \"$SLURM_ARRAY_TASK_ID\" in\n";
-    for (size_t k = 0; k < s.tasks.size(); ++k) {
-      const FarmTask& t = plan.tasks[s.tasks[k]];
-      // The start and end lines time the task apart from the scheduler (scripts/bench.sh farm).
-      text += std::to_string(s.arrayIndex[k]) + ")\n  echo \"hairgen-farm: start " + t.id +
-              " $(date +%s.%N)\"\n ";
-      for (const std::string& a : t.command) text += " " + shellQuote(a);
-      text += "\n  rc=$?\n  echo \"hairgen-farm: end " + t.id + " $(date +%s.%N) exit $rc\"\n  exit $rc ;;\n";
-    }
-    text += "esac\necho \"no task $SLURM_ARRAY_TASK_ID in " + s.group + "\" >&2\nexit 2\n";
-    writeFileAtomic(script, text.data(), text.size());
-    fs::permissions(script, fs::perms::owner_exec | fs::perms::group_exec | fs::perms::others_exec,
-                    fs::perm_options::add);
-    const ProcessResult r = runProcess(sbatch);
-    if (r.status != 0)
-      throw IoError("sbatch for " + s.group + " failed (exit " + std::to_string(r.status) + ")");
-    s.job = r.out.substr(0, r.out.find_first_of(";\n"));
-    std::cout << s.group << ": job " << s.job << " (" << s.tasks.size() << " task"
-              << (s.tasks.size() == 1 ? "" : "s") << ")\n"
-              << std::flush;
-    submissionOfGroup[g] = submitted.size();
-    submitted.push_back(std::move(s));
   }
   if (submitted.empty()) {
     note(common, "farm submit: every task is done; nothing to submit");

@@ -18,6 +18,8 @@ constexpr uint64_t kProcessMiB = 256;
 // A task gets one more CPU for every this many seconds of estimated work (up to FarmPlanOptions::maxCpus):
 // below it, threads would not pay for the time the scheduler takes to find free cores.
 constexpr double kSecondsPerCpu = 20.0;
+// A shot's simulation is split into at most this many chained tasks.
+constexpr int kSimulationChunks = 4;
 
 struct Request {
   int cpus = 1;
@@ -131,9 +133,10 @@ FarmPlan planFarm(const Config& config, const Mesh& wick, const FarmPlanOptions&
     return plan;
   }
 
-  // A shot: the guides simulated in one task (each frame restarts from the one before), then every chunk
-  // of frames rendered from them in one task: interpolated, re-posed from the shaded rest coupe and
-  // rendered in memory, as run does, so no per-frame coupe is written.
+  // A shot: the guides simulated chunk by chunk, each chunk restarting from the last frame of the one
+  // before (bitwise the same as one run), then every chunk of frames rendered from them in one task:
+  // interpolated, re-posed from the shaded rest coupe and rendered in memory, as run does, so no
+  // per-frame coupe is written.
   const FrameRange frames = *plan.frames;
   const std::string simPattern = dir + "/sim/guides.####.hair", exrPattern = dir + "/beauty.####.exr",
                     pngPattern = dir + "/beauty.####.png";
@@ -145,8 +148,6 @@ FarmPlan planFarm(const Config& config, const Mesh& wick, const FarmPlanOptions&
   const size_t guidePoints = pointsPerGuide(config.hairstyle);
   const WorkEstimate simulation = estimateSimulate(
       config.dynamics, wick.vertexCount() * (guidePoints > 0 ? guidePoints - 1 : 0), frames, options.threads);
-  add("simulate", "simulate", {"simulate", setup, "--guides", guides, "-o", simPattern}, {setup, guides},
-      frameFiles(simPattern, frames), {"merge-guides"}, request(&simulation, 1.0, options.maxCpus), true);
   // A frame holds its coupe while it renders: the two estimates' memory together, their times summed.
   WorkEstimate frame;
   for (const char* stage : {"interpolate", "render"})
@@ -154,10 +155,32 @@ FarmPlan planFarm(const Config& config, const Mesh& wick, const FarmPlanOptions&
       frame.bytes += e->bytes;
       frame.seconds += e->seconds;
     }
+  // At most kSimulationChunks chained simulation tasks: each link costs a scheduling round, and the
+  // simulation is fast (it needs chunks only to resume), so its chunks are longer than the render's.
+  const int simChunk = std::max(options.chunk, (frames.count() + kSimulationChunks - 1) / kSimulationChunks);
+  std::vector<FrameRange> simulated;
+  for (int first = frames.first; first <= frames.last; first += simChunk) {
+    const FrameRange chunk{first, std::min(frames.last, first + simChunk - 1)};
+    const size_t c = simulated.size() + 1;
+    std::vector<std::string> simInputs = {setup, guides}, simDeps = {"merge-guides"};
+    if (c > 1) {
+      simInputs.push_back(framePath(simPattern, chunk.first - 1).string());
+      simDeps.push_back("simulate." + std::to_string(c - 1));
+    }
+    add("simulate." + std::to_string(c), "simulate",
+        {"simulate", setup, "--guides", guides, "-o", simPattern, "--frames", framesText(chunk)}, simInputs,
+        frameFiles(simPattern, chunk), simDeps,
+        request(&simulation, double(chunk.count()) / frames.count(), options.maxCpus), true);
+    simulated.push_back(chunk);
+  }
   for (int first = frames.first, c = 1; first <= frames.last; first += options.chunk, ++c) {
     const FrameRange chunk{first, std::min(frames.last, first + options.chunk - 1)};
+    std::vector<std::string> simulates;  // the simulation chunks that hold this chunk's frames
+    for (size_t k = 0; k < simulated.size(); ++k)
+      if (simulated[k].first <= chunk.last && chunk.first <= simulated[k].last)
+        simulates.push_back("simulate." + std::to_string(k + 1));
     std::vector<std::string> args = {"render", setup, "--guides", simPattern};
-    std::vector<std::string> inputs = frameFiles(simPattern, chunk), deps = {"simulate"};
+    std::vector<std::string> inputs = frameFiles(simPattern, chunk), deps = simulates;
     inputs.insert(inputs.begin(), setup);
     if (shaded) {
       args.insert(args.end(), {"--rest", rest});

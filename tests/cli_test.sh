@@ -529,14 +529,16 @@ farm_plan)
   done
   grep -q '"Hairstyle.HairDensity=20"' "$plan" || fail "the plan's commands lose the overrides"
   expect_rc 0 "$hairgen" farm plan "$src/configs/anjyo/gust/setup.txt" -o "$tmp/shot" --frames 1-12 --chunk 5 --quiet
-  for id in simulate shade render.3; do
+  for id in simulate.1 simulate.3 shade render.3; do
     grep -q "\"id\": \"$id\"" "$tmp/shot/plan.json" || fail "the shot's plan has no task $id"
   done
   ! grep -q '"render.4"' "$tmp/shot/plan.json" || fail "12 frames in chunks of 5 make 3 render tasks"
   expect_rc 0 "$hairgen" farm submit "$tmp/shot/plan.json" --scheduler slurm --dry-run --quiet
   grep -q "^grow=\$('sbatch' '--parsable' .*'--array=0,1,2,3'" "$tmp/out" || fail "dry run: $(cat "$tmp/out")"
-  grep -q "^render=.*'--array=0,1,2'.*'--dependency=afterok:\$shade,afterok:\$simulate'" "$tmp/out" ||
+  grep -q "^render=.*'--array=0,1,2'.*'--dependency=afterok:\$shade,afterok:\$simulate.1,afterok:\$simulate.2,afterok:\$simulate.3'" "$tmp/out" ||
     fail "render waits for the simulation and the shaded rest coupe: $(cat "$tmp/out")"
+  grep -q "^simulate.3=.*'--array=2'.*'--dependency=afterok:\$merge-guides,afterok:\$simulate.2'" "$tmp/out" ||
+    fail "a simulation chunk waits for the one before: $(cat "$tmp/out")"
   ! grep -q "interpolate-frames\|/frames/" "$tmp/shot/plan.json" || fail "the shot's plan writes per-frame coupes"
   grep -q "^merge-guides=.*'--dependency=afterok:\$grow'" "$tmp/out" || fail "merge waits for every shard: $(cat "$tmp/out")"
   [ ! -e "$tmp/shot/slurm" ] || fail "a dry run wrote scripts"
