@@ -4,6 +4,7 @@
 #include "libcore/config/setup.h"
 #include "libcore/io/hair_cache.h"
 #include "libcore/io/obj_io.h"
+#include "libcore/model/shards.h"
 #include "libcore/util/file_util.h"
 #include "libcore/util/json.h"
 #include "stages/grow.h"
@@ -33,13 +34,18 @@ void writeDiagnostics(const std::string& file, const std::string& setup, const C
 
 }  // namespace
 
-GrowResult growStage(const CommonOptions& common, const Config& config, const Mesh& wick, Stats& stats) {
-  note(common, "grow: " + std::to_string(wick.vertexCount()) + " guides from " +
-                   config.setup.wickModel.path.string());
+GrowResult growStage(const CommonOptions& common, const Config& config, const Mesh& wick, Stats& stats,
+                     std::optional<ShardRange> shard) {
+  const size_t guides = shard ? shard->end - shard->first : wick.vertexCount();
+  note(common,
+       "grow: " + std::to_string(guides) + " guides from " + config.setup.wickModel.path.string() +
+           (shard ? " (shard " + std::to_string(shard->index) + "/" + std::to_string(shard->count) +
+                        ": vertices " + std::to_string(shard->first) + "-" + std::to_string(shard->end) + ")"
+                  : ""));
   Stopwatch clock;
-  Progress progress("grow", "guides", wick.vertexCount(), !common.quiet);
-  GrowResult result =
-      grow(wick, config.hairstyle, config.collision, GrowOptions{config.digest(), &progress, common.force});
+  Progress progress("grow", "guides", guides, !common.quiet);
+  GrowResult result = grow(wick, config.hairstyle, config.collision,
+                           GrowOptions{config.digest(), &progress, common.force, shard});
   double seconds = clock.lap();
   const std::string applied = config.setup.meshConversion.describe();
   if (!applied.empty()) result.guides.provenance.conversion = "wick: " + applied;
@@ -60,7 +66,7 @@ GrowResult growStage(const CommonOptions& common, const Config& config, const Me
 void registerGrow(CLI::App& app, int& exitCode) {
   struct Options {
     CommonOptions common;
-    std::string setup, output, diagnostics;
+    std::string setup, output, diagnostics, shard;
   };
   auto options = std::make_shared<Options>();
   CLI::App* cmd = app.add_subcommand(
@@ -76,17 +82,30 @@ void registerGrow(CLI::App& app, int& exitCode) {
          "Write per guide: follicle, generalised coordinates, energy terms at start and end, stages, "
          "evaluations, why it stopped")
       ->type_name("FILE.json");
+  cmd->add_option(
+         "--shard", options->shard,
+         "Grow only shard K of N: the guides of the K-th of N equal ranges of wick vertices, written "
+         "as .hair with the range in its provenance; `hairgen merge` joins the N shards into the "
+         "file a whole run writes")
+      ->type_name("K/N");
   addCommonFlags(*cmd, options->common, true);
   cmd->footer(exitCodeHelp());
   cmd->callback([options, &exitCode] {
     exitCode = runCommand("grow", options->common, [&] {
       Stats stats("grow");
-      hairFormatOf(options->output);
+      const HairFormat format = hairFormatOf(options->output);
+      std::optional<ShardSpec> shard;
+      if (!options->shard.empty()) shard = parseShardSpec(options->shard, "--shard");
+      if (shard && format != HairFormat::kHair)
+        throw InputError("-o " + options->output +
+                         ": a shard is written as .hair, whose provenance carries its range");
       Stopwatch clock;
       Config config = loadStageConfig(options->setup, options->common, SetupUse::kGrow, stats);
       const Scene scene = readScene(options->common, config, true, false, stats);
       stats.time("read", clock.lap());
-      GrowResult result = growStage(options->common, config, *scene.wick, stats);
+      std::optional<ShardRange> range;
+      if (shard) range = shardRange(shard->index, shard->count, scene.wick->vertexCount());
+      GrowResult result = growStage(options->common, config, *scene.wick, stats, range);
       if (!options->diagnostics.empty())
         writeDiagnostics(options->diagnostics, options->setup, config, result);
       writeStrands(options->output, result.guides);

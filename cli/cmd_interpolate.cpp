@@ -4,6 +4,7 @@
 #include "libcore/config/setup.h"
 #include "libcore/io/hair_cache.h"
 #include "libcore/io/obj_io.h"
+#include "libcore/model/shards.h"
 #include "libcore/util/frames.h"
 #include "libcore/util/text.h"
 #include "stages/interpolate.h"
@@ -14,7 +15,7 @@ namespace hairgen::cli {
 void registerInterpolate(CLI::App& app, int& exitCode) {
   struct Options {
     CommonOptions common;
-    std::string setup, guides, output, frames;
+    std::string setup, guides, output, frames, shard;
     UnitOptions units;
   };
   auto options = std::make_shared<Options>();
@@ -35,12 +36,24 @@ void registerInterpolate(CLI::App& app, int& exitCode) {
          "pattern")
       ->required();
   cmd->add_option("--frames", options->frames, "Interpolate these frames of a sequence")->type_name("A-B");
+  cmd->add_option(
+         "--shard", options->shard,
+         "Fill only shard K of N: the K-th of N equal ranges of wick triangles, with the whole run's "
+         "strand ids and random numbers, written as .hair with the range in its provenance; "
+         "`hairgen merge` joins the N shards into the file a whole run writes")
+      ->type_name("K/N")
+      ->excludes("--frames");
   addCommonFlags(*cmd, options->common, true);
   cmd->footer(exitCodeHelp());
   cmd->callback([options, &exitCode] {
     exitCode = runCommand("interpolate", options->common, [&] {
       Stats stats("interpolate");
-      hairFormatOf(options->output);
+      const HairFormat format = hairFormatOf(options->output);
+      std::optional<ShardSpec> shard;
+      if (!options->shard.empty()) shard = parseShardSpec(options->shard, "--shard");
+      if (shard && format != HairFormat::kHair)
+        throw InputError("-o " + options->output +
+                         ": a shard is written as .hair, whose provenance carries its range");
       Stopwatch clock;
       Config config = loadStageConfig(options->setup, options->common, SetupUse::kInterpolate, stats);
       const Scene scene = readScene(options->common, config, true, false, stats);
@@ -48,7 +61,10 @@ void registerInterpolate(CLI::App& app, int& exitCode) {
       if (options->frames.empty()) {
         Strands guides = readStrandsAs(options->guides, options->units);
         stats.time("read", clock.lap());
-        Strands coupe = interpolateStage(options->common, config, wick, guides, options->guides, stats);
+        std::optional<ShardRange> range;
+        if (shard) range = shardRange(shard->index, shard->count, wick.triangles.size());
+        Strands coupe =
+            interpolateStage(options->common, config, wick, guides, options->guides, stats, range);
         writeStrands(options->output, coupe);
         stats.time("write", clock.lap());
         note(options->common, "interpolate: wrote " + options->output);
@@ -85,18 +101,25 @@ void registerInterpolate(CLI::App& app, int& exitCode) {
 }
 
 Strands interpolateStage(const CommonOptions& common, const Config& config, const Mesh& wick,
-                         const Strands& guides, const std::string& guidesName, Stats& stats) {
-  note(common, "interpolate: " + std::to_string(wick.triangles.size()) + " triangles at " +
-                   formatReal(config.hairstyle.hairDensity) + " strands/cm²");
+                         const Strands& guides, const std::string& guidesName, Stats& stats,
+                         std::optional<ShardRange> shard) {
+  const size_t triangles = shard ? shard->end - shard->first : wick.triangles.size();
+  note(common,
+       "interpolate: " + std::to_string(triangles) + " triangles at " +
+           formatReal(config.hairstyle.hairDensity) + " strands/cm²" +
+           (shard ? " (shard " + std::to_string(shard->index) + "/" + std::to_string(shard->count) +
+                        ": triangles " + std::to_string(shard->first) + "-" + std::to_string(shard->end) + ")"
+                  : ""));
   Stopwatch clock;
-  Progress progress("interpolate", "triangles", wick.triangles.size(), !common.quiet);
-  Strands coupe = interpolate(wick, guides, config.hairstyle, config.collision,
-                              InterpolateOptions{config.digest(), guidesName, &progress, common.force});
+  Progress progress("interpolate", "triangles", triangles, !common.quiet);
+  InterpolateOptions interpolation{config.digest(), guidesName,      &progress,
+                                   common.force,    glm::dmat4(1.0), shard};
+  Strands coupe = interpolate(wick, guides, config.hairstyle, config.collision, interpolation);
   double seconds = clock.lap();
   const std::string applied = config.setup.meshConversion.describe();
   if (!applied.empty()) coupe.provenance.conversion = "wick: " + applied;
   stats.time("interpolate", seconds);
-  stats.counts()["triangles"] = wick.triangles.size();
+  stats.counts()["triangles"] = triangles;
   stats.counts()["strands"] = coupe.strandCount();
   stats.counts()["points"] = coupe.pointCount();
   note(common, "interpolate: " + std::to_string(coupe.strandCount()) + " strands, " +

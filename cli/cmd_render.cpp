@@ -13,7 +13,9 @@
 #include "libcore/util/frames.h"
 #include "libcore/util/progress.h"
 #include "libcore/util/text.h"
+#include "stages/interpolate.h"
 #include "stages/render.h"
+#include "stages/shade.h"
 #include "stages/simulate.h"
 
 namespace hairgen::cli {
@@ -96,7 +98,7 @@ void writeRenderOutputs(const Config& config, const RenderOutput& out, const std
 void registerRender(CLI::App& app, int& exitCode) {
   struct Options {
     CommonOptions common;
-    std::string setup, hair, output, dom, preview, frames;
+    std::string setup, hair, output, dom, preview, frames, guides, rest;
     UnitOptions units;
     double scale = 1.0;
     std::vector<double> translate;
@@ -135,6 +137,17 @@ void registerRender(CLI::App& app, int& exitCode) {
   cmd->add_flag("--motion", options->motion,
                 "With --frames, motion vectors too: the layer motion.u, motion.v, pixels moved since the "
                 "frame before (from the --hair pattern's previous frame while it is in the shot)");
+  cmd->add_option(
+         "--guides", options->guides,
+         "With --frames, instead of --hair: a simulated sequence's guides (sim/guides.####.hair), each "
+         "frame interpolated and, when the Setup shades, re-posed from --rest in memory, as `run` "
+         "does: a farm's frame chunk writes no per-frame coupes")
+      ->excludes("--hair")
+      ->needs("--frames");
+  cmd->add_option("--rest", options->rest,
+                  "With --guides: the shaded rest coupe whose normals and colours each frame takes (`shade` "
+                  "--rest); needed when the Setup shades")
+      ->needs("--guides");
   cmd->add_flag("--list-devices", options->listDevices, "List the EGL devices and platforms found, and exit");
   addCommonFlags(*cmd, options->common, true);
   cmd->footer(exitCodeHelp());
@@ -148,28 +161,41 @@ void registerRender(CLI::App& app, int& exitCode) {
         if (devices.empty()) std::cout << "no EGL platform found\n";
         return;
       }
-      if (options->setup.empty() || options->hair.empty() || options->output.empty())
+      const bool fromGuides = !options->guides.empty();
+      if (options->setup.empty() || (options->hair.empty() && !fromGuides) || options->output.empty())
         throw InputError("render needs SETUP, --hair FILE and -o IMAGE.exr (or --list-devices)");
       requireExtension(options->output, ".exr", "-o");
       if (!options->dom.empty()) requireExtension(options->dom, ".exr", "--dom");
       if (!options->preview.empty()) requireExtension(options->preview, ".png", "--preview");
       Stats stats("render");
       Stopwatch clock;
-      Config config = loadStageConfig(options->setup, options->common, SetupUse::kRender, stats);
+      Config config = loadStageConfig(options->setup, options->common,
+                                      fromGuides ? SetupUse::kRun : SetupUse::kRender, stats);
       const bool sequence = !options->frames.empty();
       if (options->motion && !sequence)
         throw InputError("--motion needs --frames: motion vectors are the movement since the frame before");
       const FrameRange frames = sequence ? parseFrameRange(options->frames, "--frames") : FrameRange{0, 0};
       if (sequence)
         for (const std::string* pattern :
-             {&options->hair, &options->output, &options->dom, &options->preview})
+             {&options->hair, &options->guides, &options->output, &options->dom, &options->preview})
           if (!pattern->empty() && !isFramePattern(*pattern))
             throw InputError(*pattern + ": with --frames, write #### where the frame number goes");
       auto frameFile = [&](const std::string& pattern, int f) {
         return sequence && !pattern.empty() ? framePath(pattern, f).string() : pattern;
       };
-      std::optional<Mesh> head = readScene(options->common, config, false, true, stats).head;
+      Scene scene = readScene(options->common, config, fromGuides, true, stats);
+      std::optional<Mesh> head = std::move(scene.head);
       const HeadMotion motion = headMotionOf(config);
+      // From guides: what `run` does to a frame of a shot, in the same order, so the images are its.
+      const bool shaded = wantsShade(config.visuality, config.render);
+      if (fromGuides && shaded && options->rest.empty())
+        throw InputError(
+            "--guides: this Setup shades, so each frame takes its normals from the shaded rest "
+            "coupe: name it with --rest shaded.hair");
+      if (fromGuides && !shaded && !options->rest.empty())
+        throw InputError("--rest: this Setup does not shade; each frame is rendered as interpolated");
+      Strands rest;
+      if (!options->rest.empty()) rest = readStrands(options->rest);
       stats.time("read", clock.lap());
       RenderOptions renderOptions;
       renderOptions.frame = options->frame;
@@ -219,24 +245,37 @@ void registerRender(CLI::App& app, int& exitCode) {
         }
         return h;
       };
+      // A frame's hair: its coupe file, or with --guides its guides interpolated (and re-posed from the
+      // shaded rest) as `run` does it, so the image is run's.
+      const std::string& pattern = fromGuides ? options->guides : options->hair;
+      auto loadFrame = [&](int f, std::string& file) {
+        file = frameFile(pattern, f);
+        if (!fromGuides) return readHair(file);
+        const InterpolateOptions interpolation{config.digest(), file, nullptr, options->common.force,
+                                               motion.pose(f).matrix()};
+        Strands coupe =
+            interpolate(*scene.wick, readStrands(file), config.hairstyle, config.collision, interpolation);
+        if (shaded) coupe = repose(rest, coupe);
+        return coupe;
+      };
       // A sequence aims an auto camera (or --frame) at its shot's first frame, so the camera holds still
       // and a range split into jobs sees through the same camera; when that frame's file is gone, at the
       // range's first.
       std::optional<Strands> framing;
       if (sequence && (options->frame || config.render.cameraAuto)) {
-        const std::string first = frameFile(options->hair, shotStart);
-        framing = readHair(fs::is_regular_file(first) ? first : frameFile(options->hair, frames.first));
+        std::string file;
+        framing =
+            loadFrame(fs::is_regular_file(frameFile(pattern, shotStart)) ? shotStart : frames.first, file);
         frameOptions.framing = &*framing;
       }
       if (options->motion && frames.first - 1 >= shotStart) {
-        hairFileBefore = frameFile(options->hair, frames.first - 1);
-        hairBefore = readHair(hairFileBefore);
+        hairBefore = loadFrame(frames.first - 1, hairFileBefore);
         headBefore = poseHead(frames.first - 1);
       }
       Progress progress("render", "frames", size_t(frames.count()), sequence && !options->common.quiet);
       for (int f = frames.first; f <= frames.last; ++f) {
-        const std::string hairFile = frameFile(options->hair, f);
-        Strands hair = readHair(hairFile);
+        std::string hairFile;
+        Strands hair = loadFrame(f, hairFile);
         if (options->motion && !hairBefore) {
           hairBefore = hair;  // nothing before the shot: no motion
           hairFileBefore = hairFile;

@@ -29,9 +29,15 @@ void registerShade(CLI::App& app, int& exitCode);
 void registerSimulate(CLI::App& app, int& exitCode);
 void registerDiff(CLI::App& app, int& exitCode);
 
-GrowResult growStage(const CommonOptions& common, const Config& config, const Mesh& wick, Stats& stats);
+void registerMerge(CLI::App& app, int& exitCode);
+void registerFarm(CLI::App& app, int& exitCode);
+
+// `shard`: only that range of the work (--shard K/N); none for the whole.
+GrowResult growStage(const CommonOptions& common, const Config& config, const Mesh& wick, Stats& stats,
+                     std::optional<ShardRange> shard = {});
 Strands interpolateStage(const CommonOptions& common, const Config& config, const Mesh& wick,
-                         const Strands& guides, const std::string& guidesName, Stats& stats);
+                         const Strands& guides, const std::string& guidesName, Stats& stats,
+                         std::optional<ShardRange> shard = {});
 ShadeResult shadeStage(const CommonOptions& common, const Config& config, Strands coupe, Stats& stats);
 // Opens the device, reads the Setup's custom shader files and calls the render stage; records the
 // device and the passes' times in `stats`.

@@ -26,6 +26,8 @@ int main(int argc, char** argv) {
   registerSimulate(app, exitCode);
   registerShade(app, exitCode);
   registerRender(app, exitCode);
+  registerMerge(app, exitCode);
+  registerFarm(app, exitCode);
   registerDiff(app, exitCode);
   registerInfo(app, exitCode);
   registerConvert(app, exitCode);

@@ -1,5 +1,6 @@
 #!/usr/bin/env bash
 # Benchmarks, one group or all: scripts/bench.sh [grow|cantilever|interpolate|shade|render|simulate|cache|all] [Google Benchmark flags]
+# scripts/bench.sh farm: a shot in one process and through a local Slurm (scripts/bench-farm.sh).
 # Builds Release first. Speed targets are checked here, never by timed unit tests.
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -7,6 +8,10 @@ group="${1:-all}"
 [[ $# -gt 0 ]] && shift
 bash scripts/setup.sh --no-build
 cmake -S . -B build -G Ninja -DCMAKE_BUILD_TYPE=Release >/dev/null
+if [ "$group" = farm ]; then
+  cmake --build build --target hairgen
+  exec bash scripts/bench-farm.sh "$@"
+fi
 cmake --build build --target hairgen_bench hairgen
 case "$group" in
   grow) filter='EnergyEvaluation|GrowCoupe3|GrowDefault' ;;
@@ -17,7 +22,7 @@ case "$group" in
   simulate) filter='SimulateAnjyo|SimulateSprings' ;;
   cache) filter='ReadCache|WriteCache' ;;
   all) filter='.' ;;
-  *) echo "bench.sh: unknown group '$group' (grow, cantilever, interpolate, shade, render, simulate, cache, all)" >&2; exit 2 ;;
+  *) echo "bench.sh: unknown group '$group' (grow, cantilever, interpolate, shade, render, simulate, cache, farm, all)" >&2; exit 2 ;;
 esac
 echo "machine: $(nproc) cores, $(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2 | sed 's/^ //')"
 exec build/tests/hairgen_bench --benchmark_filter="$filter" "$@"

@@ -14,6 +14,7 @@ packages=(
   libgtest-dev libgmock-dev libbenchmark-dev
   clang libclang-rt-14-dev llvm  # the fuzz build (scripts/fuzz.sh): libFuzzer, ASan, UBSan, llvm-symbolizer
   ffmpeg  # a shot's preview movie (beauty.mp4, beauty.gif)
+  slurm-wlm munge  # the farm's scheduler: a one-node Slurm for the tests (scripts/slurm-local.sh)
 )
 # Node.js with npm runs the glTF validator; the image may ship its own Node (then Debian's npm conflicts).
 command -v npm >/dev/null 2>&1 || packages+=(nodejs npm)
@@ -36,6 +37,13 @@ if [ ! -f tools/node_modules/gltf-validator/package.json ]; then
   echo "setup: installing gltf-validator (npm)" >&2
   mkdir -p tools
   npm install --silent --no-audit --no-fund --prefix tools gltf-validator@2.0.0-dev.3.10 >/dev/null
+fi
+
+# ajv-cli, an independent JSON Schema validator the tests check farm plans with (docs/farm-plan.schema.json).
+if [ ! -f tools/node_modules/ajv-cli/dist/index.js ]; then
+  echo "setup: installing ajv-cli (npm)" >&2
+  mkdir -p tools
+  npm install --silent --no-audit --no-fund --prefix tools ajv-cli@5.0.0 >/dev/null
 fi
 
 # TinyUSDZ's WebAssembly build (npm package tinyusdz), an independent USD reader the tests check the

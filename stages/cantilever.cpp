@@ -136,26 +136,29 @@ size_t cutHair(std::vector<glm::dvec3>& nodes, const Hairstyle& style, const Col
 GrowResult growCantilever(const Mesh& wick, const Hairstyle& style, const Collision& collision,
                           const GrowOptions& options) {
   const size_t count = wick.vertexCount();
+  const size_t first = options.shard ? options.shard->first : 0,
+               end = options.shard ? options.shard->end : count;
   const CollisionShape* head = nullptr;
   for (const CollisionShape& s : collision.shapes)
     if (s.kind == ShapeKind::kEllipsoid) {
       head = &s;
       break;
     }
-  std::vector<std::vector<glm::dvec3>> hairs(count);
-  tbb::parallel_for(size_t(0), count, [&](size_t i) {
+  std::vector<std::vector<glm::dvec3>> hairs(end - first);
+  tbb::parallel_for(first, end, [&](size_t i) {
+    std::vector<glm::dvec3>& hair = hairs[i - first];
     const glm::dvec3 rootPos(wick.positions[i]);
-    hairs[i] = bendHair(rootPos, style.growDirection(rootPos, glm::dvec3(wick.normals[i])), style, head);
-    cutHair(hairs[i], style, head);
+    hair = bendHair(rootPos, style.growDirection(rootPos, glm::dvec3(wick.normals[i])), style, head);
+    cutHair(hair, style, head);
     if (options.progress) options.progress->advance();
   });
   if (options.progress) options.progress->finish();
 
   GrowResult result;
-  result.reports.resize(count);
+  result.reports.resize(end - first);
   Strands& guides = result.guides;
-  for (size_t i = 0; i < count; ++i) {
-    const std::vector<glm::dvec3>& h = hairs[i];
+  for (size_t i = first; i < end; ++i) {
+    const std::vector<glm::dvec3>& h = hairs[i - first];
     for (size_t n = 0; n < h.size(); ++n) {
       if (!std::isfinite(h[n].x) || !std::isfinite(h[n].y) || !std::isfinite(h[n].z))
         throw NumericError("hair " + std::to_string(i) + " has a non-finite node");
@@ -167,11 +170,12 @@ GrowResult growCantilever(const Mesh& wick, const Hairstyle& style, const Collis
     }
     guides.firstPoint.push_back(static_cast<uint32_t>(guides.points.size()));
     guides.strandId.push_back(static_cast<uint32_t>(i));
-    result.reports[i].follicle = static_cast<uint32_t>(i);
-    result.reports[i].stop = RosenbrockStop::kEpsilon;
+    result.reports[i - first].follicle = static_cast<uint32_t>(i);
+    result.reports[i - first].stop = RosenbrockStop::kEpsilon;
   }
   guides.defaultThickness = static_cast<float>(style.hairRadius1 + style.hairRadius2);
   guides.provenance = madeByHairgen("grow", style.seed, options.configDigest);
+  guides.provenance.shard = options.shard;
   return result;
 }
 

@@ -64,49 +64,55 @@ GrowResult grow(const Mesh& wick, const Hairstyle& style, const Collision& colli
       throw InputError("wick vertex " + std::to_string(i) +
                        " has a zero or non-finite normal; a follicle needs a direction");
   }
-  requireFits(estimateGrow(style, collision, count, size_t(tbb::this_task_arena::max_concurrency())),
+  const size_t first = options.shard ? options.shard->first : 0,
+               end = options.shard ? options.shard->end : count;
+  if (first > end || end > count) throw InputError("the shard's guides lie outside the wick's vertices");
+  requireFits(estimateGrow(style, collision, end - first, size_t(tbb::this_task_arena::max_concurrency())),
               options.force);
   if (style.model == StylingModel::kCantilever) return growCantilever(wick, style, collision, options);
   const std::vector<double> envelopes = follicleEnvelopes(wick);
   GrowResult result;
-  result.reports.resize(count);
-  std::vector<std::string> failures(count);
-  tbb::parallel_for(size_t(0), count, [&](size_t i) {
+  result.reports.resize(end - first);
+  std::vector<std::string> failures(end - first);
+  tbb::parallel_for(first, end, [&](size_t i) {
     const double envelope = envelopes[i];
     const glm::dvec3 rootPos(wick.positions[i]);
     RodFrame root = follicleFrame(rootPos, style.growDirection(rootPos, glm::dvec3(wick.normals[i])));
     try {
-      result.reports[i] = growGuide(root, envelope, style, collision);
-      result.reports[i].follicle = static_cast<uint32_t>(i);
+      result.reports[i - first] = growGuide(root, envelope, style, collision);
+      result.reports[i - first].follicle = static_cast<uint32_t>(i);
     } catch (const NumericError& e) {
-      failures[i] = e.what();
+      failures[i - first] = e.what();
     }
     if (options.progress) options.progress->advance();
   });
   if (options.progress) options.progress->finish();
-  for (size_t i = 0; i < count; ++i)
-    if (!failures[i].empty()) throw NumericError("guide " + std::to_string(i) + ": " + failures[i]);
+  for (size_t i = first; i < end; ++i)
+    if (!failures[i - first].empty())
+      throw NumericError("guide " + std::to_string(i) + ": " + failures[i - first]);
 
   // Sample every guide; fixed order, so the output is the same for any thread count.
   const std::vector<double> s = sampleArcLengths(style.totalLength(), style.visualityStep, true);
   Strands& guides = result.guides;
-  guides.points.reserve(count * s.size());
-  guides.tangents.reserve(count * s.size());
+  guides.points.reserve((end - first) * s.size());
+  guides.tangents.reserve((end - first) * s.size());
   std::vector<glm::dvec3> positions, tangents;
-  for (size_t i = 0; i < count; ++i) {
+  for (size_t i = first; i < end; ++i) {
+    const GuideReport& report = result.reports[i - first];
     const glm::dvec3 rootPos(wick.positions[i]);
     RodFrame root = follicleFrame(rootPos, style.growDirection(rootPos, glm::dvec3(wick.normals[i])));
-    sampleRod(root, style.hairLengths, result.reports[i].coordinates, s, positions, &tangents);
+    sampleRod(root, style.hairLengths, report.coordinates, s, positions, &tangents);
     for (size_t k = 0; k < s.size(); ++k) {
       guides.points.push_back(glm::vec3(positions[k]));
       guides.tangents.push_back(glm::vec3(tangents[k]));
     }
     guides.firstPoint.push_back(static_cast<uint32_t>(guides.points.size()));
     guides.strandId.push_back(static_cast<uint32_t>(i));
-    result.evaluations += result.reports[i].evaluations;
+    result.evaluations += report.evaluations;
   }
   guides.defaultThickness = static_cast<float>(style.hairRadius1 + style.hairRadius2);  // a diameter
   guides.provenance = madeByHairgen("grow", style.seed, options.configDigest);
+  guides.provenance.shard = options.shard;
   return result;
 }
 

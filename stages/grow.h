@@ -2,6 +2,7 @@
 // gravity and penalty collisions (Lansink 2010 §4.1.1-4.1.4.2, DESIGN §5).
 #pragma once
 
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -18,6 +19,9 @@ struct GrowOptions {
   std::string configDigest;      // recorded in the guides' provenance
   Progress* progress = nullptr;  // advanced once per guide
   bool force = false;            // run work estimated to take absurdly long (never work that cannot fit)
+  // Grow only the guides of wick vertices [first, end) (`grow --shard K/N`), recorded in the provenance;
+  // each guide is the one the whole run grows, so `hairgen merge` of the shards gives the whole file.
+  std::optional<ShardRange> shard{};
 };
 
 // What minimisation did for one guide.
@@ -31,7 +35,8 @@ struct GuideReport {
 };
 
 struct GrowResult {
-  Strands guides;  // one strand per wick vertex, in vertex order; points every VisualityStep, tangents
+  Strands guides;  // one strand per wick vertex (of the shard), in vertex order; points every VisualityStep,
+                   // tangents
   std::vector<GuideReport> reports;
   long long evaluations = 0;
 };

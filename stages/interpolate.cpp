@@ -182,7 +182,13 @@ Strands interpolate(const Mesh& wick, const Strands& guides, const Hairstyle& st
                      std::to_string(firstStrand.back()) + " strands of " + std::to_string(firstPoint.back()) +
                      " points, more than 32-bit offsets and ids can hold; lower HairDensity");
 
-  const size_t strands = firstStrand.back(), points = firstPoint.back();
+  // A shard holds the strands of its triangles, its offsets counted from its first triangle's.
+  const size_t firstTriangle = options.shard ? options.shard->first : 0,
+               endTriangle = options.shard ? options.shard->end : triangleCount;
+  if (firstTriangle > endTriangle || endTriangle > triangleCount)
+    throw InputError("the shard's triangles lie outside the wick's triangles");
+  const uint64_t strandBase = firstStrand[firstTriangle], pointBase = firstPoint[firstTriangle];
+  const size_t strands = firstStrand[endTriangle] - strandBase, points = firstPoint[endTriangle] - pointBase;
   Strands coupe;
   coupe.points.resize(points);
   coupe.tangents.resize(points);
@@ -196,7 +202,7 @@ Strands interpolate(const Mesh& wick, const Strands& guides, const Hairstyle& st
   coupe.firstPoint[strands] = static_cast<uint32_t>(points);
 
   const glm::dvec3 centre(options.pose * glm::dvec4(strayCentre(collision), 1.0));
-  tbb::parallel_for(size_t(0), triangleCount, [&](size_t t) {
+  tbb::parallel_for(firstTriangle, endTriangle, [&](size_t t) {
     const glm::uvec3 tri = wick.triangles[t];
     const uint32_t n = vertices[t];
     // Guides with n vertices are read by index (grow samples every guide at the same fractions of its
@@ -217,12 +223,12 @@ Strands interpolate(const Mesh& wick, const Strands& guides, const Hairstyle& st
     }
 
     for (uint32_t k = 0; k < count[t]; ++k) {
-      const size_t s = firstStrand[t] + k;
+      const size_t s = firstStrand[t] - strandBase + k;
       const glm::dvec3 root =
           rootWeights(counterUniform(seed, t, k, kRootU1), counterUniform(seed, t, k, kRootU2));
       const glm::dvec3 tip = tipWeights(root, style.clump * counterUniform(seed, t, k, kTipV1),
                                         style.clump * counterUniform(seed, t, k, kTipV2), style.strayHairs);
-      const size_t p0 = firstPoint[t] + uint64_t(k) * n;
+      const size_t p0 = firstPoint[t] - pointBase + uint64_t(k) * n;
       blendStrand(g, n, root, tip, centre, &coupe.points[p0], &coupe.tangents[p0]);
       coupe.firstPoint[s] = static_cast<uint32_t>(p0);
       coupe.strandId[s] = static_cast<uint32_t>(uint64_t(k) * triangleCount + t);
@@ -243,6 +249,7 @@ Strands interpolate(const Mesh& wick, const Strands& guides, const Hairstyle& st
   coupe.defaultTransparency = guides.defaultTransparency;
   coupe.defaultColor = guides.defaultColor;
   coupe.provenance = madeByHairgen("interpolate", seed, options.configDigest);
+  coupe.provenance.shard = options.shard;
   coupe.provenance.frame = guides.provenance.frame;  // a frame's coupe is that frame's
   coupe.provenance.time = guides.provenance.time;
   return coupe;

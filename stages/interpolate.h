@@ -4,6 +4,7 @@
 #pragma once
 
 #include <cstdint>
+#include <optional>
 #include <string>
 
 #include <glm/glm.hpp>
@@ -24,6 +25,10 @@ struct InterpolateOptions {
   // and stray hairs scale about the posed head centre; counts, roots and weights come from the wick as
   // given, so every frame has the same strands, ids and weights as the rest frame (DESIGN §8).
   glm::dmat4 pose{1.0};
+  // Fill only wick triangles [first, end) (`interpolate --shard K/N`), recorded in the provenance. Every
+  // random number is keyed by (seed, triangle, strand in it), so a shard's strands, ids and weights are
+  // those of the whole run and `hairgen merge` of the shards gives the whole file.
+  std::optional<ShardRange> shard{};
 };
 
 // Fills every wick triangle. Guide i must be the one grown from wick vertex i. The coupe is ordered by

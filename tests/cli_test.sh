@@ -485,9 +485,13 @@ shot_run_equals_stages)
   expect_rc 0 "$hairgen" shade "$setup" --hair "$tmp/rest.hair" -o "$tmp/rest-shaded.hair" "${small[@]}"
   expect_rc 0 "$hairgen" shade --rest "$tmp/rest-shaded.hair" "$tmp/c.####.hair" -o "$tmp/s.####.hair" --frames 1-4 --quiet
   expect_rc 0 "$hairgen" render "$setup" --hair "$tmp/s.####.hair" -o "$tmp/b.####.exr" --frames 1-4 "${small[@]}"
+  # render --guides interpolates and re-poses each frame in memory, as run does.
+  expect_rc 0 "$hairgen" render "$setup" --guides "$tmp/sim/g.####.hair" --rest "$tmp/rest-shaded.hair" \
+    -o "$tmp/m.####.exr" --frames 1-4 "${small[@]}"
   for f in 0001 0004; do
     cmp "$tmp/run/sim/guides.$f.hair" "$tmp/sim/g.$f.hair" || fail "run's simulated frame $f differs"
     cmp "$tmp/run/beauty.$f.exr" "$tmp/b.$f.exr" || fail "run's frame $f differs from the stages'"
+    cmp "$tmp/run/beauty.$f.exr" "$tmp/m.$f.exr" || fail "render --guides's frame $f differs from run's"
   done
   # With motion vectors too: the same frames, and the same vectors as render --motion.
   expect_rc 0 "$hairgen" run "$setup" -o "$tmp/runm" --motion "${small[@]}"
@@ -497,6 +501,8 @@ shot_run_equals_stages)
   done
   expect_rc 2 "$hairgen" run "$src/configs/default/setup.txt" -o "$tmp/still" --motion --quiet
   expect_err "names no Dynamics Info"
+  expect_rc 2 "$hairgen" render "$setup" --guides "$tmp/sim/g.####.hair" -o "$tmp/m.####.exr" --frames 1-4 "${small[@]}"
+  grep -q -- "--rest" "$tmp/err" || fail "render --guides without --rest: $(cat "$tmp/err")"
   # scripts/setup.sh installs ffmpeg, so the movie is always checked.
   [ -s "$tmp/run/beauty.mp4" ] && [ -s "$tmp/run/beauty.gif" ] || fail "no preview movie"
   ffprobe -v error -count_frames -select_streams v:0 -show_entries stream=nb_read_frames -of csv=p=0 \
@@ -542,6 +548,138 @@ render_motion)
   expect_rc 2 "$hairgen" render "$setup" --hair "$tmp/sim/g.####.hair" -o "$tmp/y/b.####.exr" --frames 3-4 --motion "${small[@]}"
   expect_err "g.0002.hair"
   [ ! -e "$tmp/y" ] || [ -z "$(ls -A "$tmp/y")" ] || fail "a failed render left frames behind"
+  ;;
+shards_merge)
+  # grow and interpolate in 4 shards, merged in any order, give the whole run's bytes; merge refuses a
+  # missing, an overlapping or a foreign shard, naming it.
+  setup="$src/configs/default/setup.txt"
+  small=(--quiet --set Hairstyle.HairDensity=20)
+  expect_rc 0 "$hairgen" grow "$setup" -o "$tmp/g.hair" "${small[@]}"
+  for k in 1 2 3 4; do expect_rc 0 "$hairgen" grow "$setup" --shard $k/4 -o "$tmp/g.$k.hair" "${small[@]}"; done
+  expect_rc 0 "$hairgen" info "$tmp/g.2.hair"
+  grep -q "shard 2/4" "$tmp/out" || fail "info does not show the shard: $(cat "$tmp/out")"
+  expect_rc 0 "$hairgen" merge "$tmp/g.3.hair" "$tmp/g.1.hair" "$tmp/g.4.hair" "$tmp/g.2.hair" -o "$tmp/gm.hair" -q
+  cmp "$tmp/g.hair" "$tmp/gm.hair" || fail "merged guides differ from the whole run's"
+  expect_rc 0 "$hairgen" interpolate "$setup" --guides "$tmp/g.hair" -o "$tmp/c.hair" "${small[@]}"
+  for k in 1 2 3 4; do
+    expect_rc 0 "$hairgen" interpolate "$setup" --guides "$tmp/g.hair" --shard $k/4 -o "$tmp/c.$k.hair" "${small[@]}"
+  done
+  expect_rc 0 "$hairgen" merge "$tmp"/c.[1-4].hair -o "$tmp/cm.hair" -q
+  cmp "$tmp/c.hair" "$tmp/cm.hair" || fail "merged coupe differs from the whole run's"
+  # The cantilever model (Anjyo's bob) splits the same way.
+  bob="$src/configs/anjyo/bob/setup.txt"
+  expect_rc 0 "$hairgen" grow "$bob" -o "$tmp/b.hair" --quiet
+  for k in 1 2 3; do expect_rc 0 "$hairgen" grow "$bob" --shard $k/3 -o "$tmp/b.$k.hair" --quiet; done
+  expect_rc 0 "$hairgen" merge "$tmp"/b.[1-3].hair -o "$tmp/bm.hair" -q
+  cmp "$tmp/b.hair" "$tmp/bm.hair" || fail "merged cantilever guides differ"
+  # Refusals, exit 2, naming the culprit; nothing written.
+  expect_rc 2 "$hairgen" merge "$tmp/g.1.hair" "$tmp/g.2.hair" "$tmp/g.4.hair" -o "$tmp/x.hair" -q
+  grep -q "a shard is missing: guides .* before $tmp/g.4.hair" "$tmp/err" || fail "missing: $(cat "$tmp/err")"
+  expect_rc 2 "$hairgen" merge "$tmp/g.1.hair" "$tmp/g.2.hair" "$tmp/g.3.hair" -o "$tmp/x.hair" -q
+  grep -q "a shard is missing: guides .*after $tmp/g.3.hair" "$tmp/err" || fail "missing last: $(cat "$tmp/err")"
+  expect_rc 0 "$hairgen" grow "$setup" --shard 2/3 -o "$tmp/g.2of3.hair" "${small[@]}"
+  expect_rc 2 "$hairgen" merge "$tmp"/g.[1-4].hair "$tmp/g.2of3.hair" -o "$tmp/x.hair" -q
+  grep -q "g.2of3.hair.*shard 2/3" "$tmp/err" || fail "another split: $(cat "$tmp/err")"
+  expect_rc 2 "$hairgen" merge "$tmp"/g.[1-4].hair "$tmp/g.2.hair" -o "$tmp/x.hair" -q
+  grep -q "g.2.hair.*overlaps" "$tmp/err" || fail "overlap: $(cat "$tmp/err")"
+  expect_rc 0 "$hairgen" grow "$setup" --shard 3/4 -o "$tmp/g.3x.hair" --quiet --set Hairstyle.HairDensity=20 --seed 7
+  expect_rc 2 "$hairgen" merge "$tmp/g.1.hair" "$tmp/g.2.hair" "$tmp/g.3x.hair" "$tmp/g.4.hair" -o "$tmp/x.hair" -q
+  grep -q "g.3x.hair: comes from another config" "$tmp/err" || fail "foreign: $(cat "$tmp/err")"
+  expect_rc 2 "$hairgen" merge "$tmp/g.1.hair" "$tmp/c.2.hair" -o "$tmp/x.hair" -q
+  expect_rc 2 "$hairgen" merge "$tmp/g.hair" -o "$tmp/x.hair" -q
+  grep -q "g.hair: is not a shard" "$tmp/err" || fail "not a shard: $(cat "$tmp/err")"
+  [ ! -e "$tmp/x.hair" ] || fail "a refused merge wrote its output"
+  expect_rc 2 "$hairgen" grow "$setup" --shard 5/4 -o "$tmp/x.hair" -q
+  expect_rc 2 "$hairgen" grow "$setup" --shard 1/4 -o "$tmp/x.glb" -q
+  expect_rc 2 "$hairgen" interpolate "$setup" --guides "$tmp/g.hair" --shard 0/4 -o "$tmp/x.hair" -q
+  ;;
+farm_plan)
+  # A plan of the default coupe and of a shot: tasks, dependencies, requests; --dry-run prints the sbatch
+  # lines and submits nothing (no Slurm needed).
+  setup="$src/configs/default/setup.txt"
+  expect_rc 0 "$hairgen" farm plan "$setup" -o "$tmp/still" --shards 3 --quiet --set Hairstyle.HairDensity=20
+  plan="$tmp/still/plan.json"
+  for id in grow.1 grow.3 merge-guides interpolate.3 merge-coupe render; do
+    grep -q "\"id\": \"$id\"" "$plan" || fail "the still's plan has no task $id"
+  done
+  grep -q '"Hairstyle.HairDensity=20"' "$plan" || fail "the plan's commands lose the overrides"
+  expect_rc 0 "$hairgen" farm plan "$src/configs/anjyo/gust/setup.txt" -o "$tmp/shot" --frames 1-12 --chunk 5 --quiet
+  for id in simulate.1 simulate.3 shade render.3; do
+    grep -q "\"id\": \"$id\"" "$tmp/shot/plan.json" || fail "the shot's plan has no task $id"
+  done
+  ! grep -q '"render.4"' "$tmp/shot/plan.json" || fail "12 frames in chunks of 5 make 3 render tasks"
+  expect_rc 0 "$hairgen" farm submit "$tmp/shot/plan.json" --scheduler slurm --dry-run --quiet
+  grep -q "^grow=\$('sbatch' '--parsable' .*'--array=0,1,2,3'" "$tmp/out" || fail "dry run: $(cat "$tmp/out")"
+  grep -q "^render=.*'--array=0,1,2'.*'--dependency=afterok:\$shade,afterok:\$simulate.1,afterok:\$simulate.2,afterok:\$simulate.3'" "$tmp/out" ||
+    fail "render waits for the simulation and the shaded rest coupe: $(cat "$tmp/out")"
+  grep -q "^simulate.3=.*'--array=2'.*'--dependency=afterok:\$merge-guides,afterok:\$simulate.2'" "$tmp/out" ||
+    fail "a simulation chunk waits for the one before: $(cat "$tmp/out")"
+  ! grep -q "interpolate-frames\|/frames/" "$tmp/shot/plan.json" || fail "the shot's plan writes per-frame coupes"
+  grep -q "^merge-guides=.*'--dependency=afterok:\$grow'" "$tmp/out" || fail "merge waits for every shard: $(cat "$tmp/out")"
+  [ ! -e "$tmp/shot/slurm" ] || fail "a dry run wrote scripts"
+  expect_rc 2 "$hairgen" farm plan "$src/configs/default/setup.txt" -o "$tmp/x" --frames 1-4 --quiet
+  expect_rc 2 "$hairgen" farm submit "$src/tests/cli_test.sh" --scheduler slurm --dry-run
+  grep -q "is not a hairgen farm plan" "$tmp/err" || fail "not a plan: $(cat "$tmp/err")"
+  expect_rc 2 "$hairgen" farm submit "$plan" --scheduler pbs --dry-run
+  ;;
+farm_slurm)
+  # On a one-node Slurm (scripts/slurm-local.sh): the default coupe grown and interpolated in 4 shards,
+  # merged, and a 24-frame shot rendered in chunks of 5 equal `hairgen run` byte for byte; a cancelled
+  # render task fails --wait naming it, and submitting again redoes only that task.
+  slurm="$src/scripts/slurm-local.sh"
+  was_up=0; bash "$slurm" status && was_up=1
+  bash "$slurm" start >"$tmp/slurm.log" 2>&1; rc=$?
+  if [ "$rc" -ne 0 ]; then echo "SKIP: no local Slurm: $(cat "$tmp/slurm.log")"; exit 77; fi
+  [ "$was_up" -eq 1 ] || trap 'bash "$slurm" stop >/dev/null 2>&1; rm -rf "$tmp"' EXIT
+  setup="$src/configs/default/setup.txt"
+  small=(--quiet --set Hairstyle.HairDensity=20 --set "Render.Resolution=64 48")
+  expect_rc 0 "$hairgen" farm plan "$setup" -o "$tmp/farm" --shards 4 "${small[@]}"
+  expect_rc 0 "$hairgen" farm submit "$tmp/farm/plan.json" --scheduler slurm --wait
+  grep -q "^grow: job [0-9]* (4 tasks)" "$tmp/out" || fail "no job ids printed: $(cat "$tmp/out")"
+  expect_rc 0 "$hairgen" run "$setup" -o "$tmp/run" "${small[@]}"
+  for f in guides.hair coupe.hair beauty.exr; do cmp "$tmp/run/$f" "$tmp/farm/$f" || fail "farm's $f differs from run's"; done
+  # The shot.
+  gust="$src/configs/anjyo/gust/setup.txt"
+  shot=(--quiet --set Hairstyle.HairDensity=5 --set "Render.Resolution=40 40")
+  expect_rc 0 "$hairgen" farm plan "$gust" -o "$tmp/shot" --shards 4 --frames 1-24 --chunk 5 "${shot[@]}"
+  "$hairgen" farm submit "$tmp/shot/plan.json" --scheduler slurm --wait >"$tmp/sub.out" 2>"$tmp/sub.err" &
+  submitter=$!
+  for _ in $(seq 100); do grep -q "^render: job" "$tmp/sub.out" && break; sleep 0.1; done
+  job=$(sed -n 's/^render: job \([0-9]*\).*/\1/p' "$tmp/sub.out")
+  [ -n "$job" ] || fail "no render job: $(cat "$tmp/sub.out" "$tmp/sub.err")"
+  # Cancel chunk 3 (frames 11-15) mid-frame when the test sees it running, else while it waits.
+  for _ in $(seq 1200); do
+    state=$(squeue --noheader --array --jobs="${job}_2" --format=%T 2>/dev/null)
+    [ "$state" = RUNNING ] && { sleep 0.3; break; }
+    [ -z "$state" ] && break
+    sleep 0.05
+  done
+  echo "render.3 was ${state:-gone} when cancelled"
+  scancel "${job}_2"
+  wait "$submitter"; rc=$?
+  if [ "$rc" -eq 0 ]; then
+    echo "render.3 finished before it could be cancelled: its outputs are removed instead"
+    rm -f "$tmp"/shot/beauty.001[1-5].*
+  else
+    [ "$rc" -eq 1 ] || fail "--wait after a cancelled task exited $rc: $(cat "$tmp/sub.err")"
+    grep -q "task render.3 (job ${job}_2, log $tmp/shot/logs/render.2.log)\|render.3 (job ${job}_2" "$tmp/sub.err" ||
+      fail "--wait does not name the cancelled task: $(cat "$tmp/sub.err")"
+  fi
+  [ ! -e "$tmp/shot/beauty.0015.png" ] || fail "the cancelled chunk finished"
+  ! ls "$tmp/shot" | grep -q 'tmp-' || fail "the cancelled task left a temporary file: $(ls "$tmp/shot")"
+  find "$tmp/shot" -name '*.hair' -o -name '*.exr' -o -name '*.png' | grep -v 'beauty\.001[1-5]\.' | sort |
+    xargs stat -c '%n %.9Y' >"$tmp/before"
+  expect_rc 0 "$hairgen" farm submit "$tmp/shot/plan.json" --scheduler slurm --wait
+  [ "$(grep -c ': job ' "$tmp/out")" -eq 1 ] && grep -q "^render: job [0-9]* (1 task)" "$tmp/out" ||
+    fail "the resubmission redid more than the cancelled task: $(cat "$tmp/out")"
+  xargs stat -c '%n %.9Y' <<<"$(cut -d' ' -f1 "$tmp/before")" | cmp - "$tmp/before" || fail "a finished output was rewritten"
+  expect_rc 0 "$hairgen" run "$gust" -o "$tmp/shotrun" "${shot[@]}" --set "Dynamics.Frames=1 24"
+  for f in $(seq -f %04g 1 24); do
+    cmp "$tmp/shotrun/sim/guides.$f.hair" "$tmp/shot/sim/guides.$f.hair" || fail "simulated frame $f differs"
+    cmp "$tmp/shotrun/beauty.$f.exr" "$tmp/shot/beauty.$f.exr" || fail "frame $f differs from run's"
+  done
+  expect_rc 0 "$hairgen" farm submit "$tmp/shot/plan.json" --scheduler slurm --wait
+  grep -q "every task is done" "$tmp/err" "$tmp/out" || fail "a done plan was submitted again: $(cat "$tmp/out")"
   ;;
 *) fail "unknown case" ;;
 esac

@@ -3,9 +3,11 @@
 #include <algorithm>
 #include <bit>
 #include <cctype>
+#include <charconv>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
+#include <fstream>
 #include <functional>
 #include <limits>
 
@@ -194,6 +196,39 @@ class Reader {
   const std::string& name_;
 };
 
+// "shard=K/N" and "range=FIRST-END/TOTAL", checked for sense: 1 <= K <= N, FIRST <= END <= TOTAL.
+void parseShard(const std::string& key, const std::string& value, Provenance& p, const std::string& name) {
+  auto number = [&](std::string_view text) {
+    uint64_t v = 0;
+    auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), v);
+    if (ec != std::errc() || end != text.data() + text.size() || text.empty())
+      throw InputError({name, 0}, "PROV chunk: " + key + " '" + value + "' is malformed");
+    return v;
+  };
+  if (!p.shard) p.shard = ShardRange{};
+  ShardRange& r = *p.shard;
+  const size_t slash = value.find('/');
+  if (slash == std::string::npos)
+    throw InputError({name, 0}, "PROV chunk: " + key + " '" + value + "' is malformed");
+  const std::string_view v(value);
+  if (key == "shard") {
+    const uint64_t index = number(v.substr(0, slash)), count = number(v.substr(slash + 1));
+    if (index < 1 || index > count || count > std::numeric_limits<uint32_t>::max())
+      throw InputError({name, 0}, "PROV chunk: shard '" + value + "' is not K/N with 1 <= K <= N");
+    r.index = uint32_t(index);
+    r.count = uint32_t(count);
+  } else {
+    const size_t dash = value.find('-');
+    if (dash == std::string::npos || dash > slash)
+      throw InputError({name, 0}, "PROV chunk: range '" + value + "' is malformed");
+    r.first = number(v.substr(0, dash));
+    r.end = number(v.substr(dash + 1, slash - dash - 1));
+    r.total = number(v.substr(slash + 1));
+    if (r.first > r.end || r.end > r.total)
+      throw InputError({name, 0}, "PROV chunk: range '" + value + "' is not FIRST-END/TOTAL in order");
+  }
+}
+
 }  // namespace
 
 std::string provenanceText(const Provenance& p) {
@@ -212,6 +247,10 @@ std::string provenanceText(const Provenance& p) {
   if (!p.conversion.empty()) text += "conversion=" + line(p.conversion) + "\n";
   if (!p.metres) text += "units=unknown\n";
   if (!p.yUp) text += "up=unknown\n";
+  if (p.shard)
+    text += "shard=" + std::to_string(p.shard->index) + "/" + std::to_string(p.shard->count) +
+            "\nrange=" + std::to_string(p.shard->first) + "-" + std::to_string(p.shard->end) + "/" +
+            std::to_string(p.shard->total) + "\n";
   return text;
 }
 
@@ -256,6 +295,8 @@ Provenance parseProvenance(const std::string& text, const std::string& name) {
       p.metres = value == "m";
     else if (key == "up")
       p.yUp = value == "y";
+    else if (key == "shard" || key == "range")
+      parseShard(key, value, p, name);
   }
   return p;
 }
@@ -486,6 +527,50 @@ void writeHair(const std::filesystem::path& file, const Strands& strands) {
   });
   encodeHairTo(strands, w);
   out.commit();
+}
+
+Provenance readHairProvenance(const std::filesystem::path& file) {
+  requireRegularFile(file);
+  const std::string name = file.string();
+  std::ifstream in(file, std::ios::binary);
+  if (!in) throw IoError("cannot open " + name);
+  auto read = [&](void* to, size_t bytes, const char* what) {
+    if (!in.read(static_cast<char*>(to), std::streamsize(bytes)))
+      throw InputError({name, 0}, std::string("ends inside ") + what);
+  };
+  auto u32 = [&](const char* what) {
+    uint8_t b[4];
+    read(b, 4, what);
+    return uint32_t(b[0]) | uint32_t(b[1]) << 8 | uint32_t(b[2]) << 16 | uint32_t(b[3]) << 24;
+  };
+  char magic[4];
+  read(magic, 4, "the header");
+  if (std::memcmp(magic, "HAIR", 4) != 0) throw InputError({name, 0}, "is not a .hair file");
+  const uint64_t strands = u32("the header"), points = u32("the header"), flags = u32("the header");
+  uint64_t arrays = (flags & kSegments ? 2 * strands : 0) + (flags & kPoints ? 12 * points : 0) +
+                    (flags & kThickness ? 4 * points : 0) + (flags & kTransparency ? 4 * points : 0) +
+                    (flags & kColor ? 12 * points : 0);
+  in.seekg(std::streamoff(kHeaderSize + arrays));
+  char block[4];
+  if (!in.read(block, 4)) return {};  // no chunk block: made elsewhere
+  if (std::memcmp(block, "HGEN", 4) != 0) return {};
+  u32("the chunk block header");
+  const uint32_t chunks = u32("the chunk block header");
+  for (uint32_t c = 0; c < chunks; ++c) {
+    char tag[4];
+    read(tag, 4, "a chunk header");
+    const uint64_t low = u32("a chunk header"), high = u32("a chunk header");
+    const uint64_t length = low | high << 32;
+    if (std::memcmp(tag, "PROV", 4) == 0) {
+      if (length > (1u << 20))
+        throw InputError({name, 0}, "PROV chunk of " + std::to_string(length) + " bytes");
+      std::string text(length, '\0');
+      read(text.data(), length, "the PROV chunk");
+      return parseProvenance(text, name);
+    }
+    in.seekg(std::streamoff(length + 4), std::ios::cur);
+  }
+  return {};
 }
 
 }  // namespace hairgen

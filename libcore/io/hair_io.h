@@ -45,9 +45,15 @@ Strands decodeHair(const uint8_t* data, size_t size, const std::string& name, Ha
 Strands readHair(const std::filesystem::path& file, HairHeader* header = nullptr);
 void writeHair(const std::filesystem::path& file, const Strands& strands);  // atomic
 
+// Only the provenance of a .hair file, skipping its arrays (what a farm checks before redoing a task);
+// an empty provenance for a file without the chunk block. Throws InputError for a file too short for
+// what its header declares, and IoError when it cannot be read.
+Provenance readHairProvenance(const std::filesystem::path& file);
+
 // Provenance as the PROV chunk's "key=value\n" lines (PLY comments carry the same lines), and back.
 // Keys: producer, stage, seed, config; for a file made elsewhere also source, sourceInfo, conversion,
-// units=unknown, up=unknown (written only when set). Unknown keys are ignored.
+// units=unknown, up=unknown (written only when set); for a shard of a split stage shard=K/N and
+// range=FIRST-END/TOTAL. Unknown keys are ignored.
 std::string provenanceText(const Provenance& provenance);
 Provenance parseProvenance(const std::string& text, const std::string& name);
 

@@ -85,6 +85,12 @@ nlohmann::ordered_json describeStrands(const Strands& s) {
     j["provenance"]["frame"] = *p.frame;
     j["provenance"]["time"] = p.time;
   }
+  if (p.shard)
+    j["provenance"]["shard"] = {{"index", p.shard->index},
+                                {"count", p.shard->count},
+                                {"first", p.shard->first},
+                                {"end", p.shard->end},
+                                {"total", p.shard->total}};
   if (!s.simulationState.empty()) j["restartState"] = s.simulationState.size();
   return j;
 }
@@ -238,6 +244,11 @@ std::string formatDescription(const nlohmann::ordered_json& j) {
   if (p.contains("frame"))
     out << "  frame " << p["frame"] << " at " << p["time"].get<double>() << " s"
         << (j.contains("restartState") ? ", with the state a restart needs" : "") << "\n";
+  if (p.contains("shard")) {
+    const nlohmann::ordered_json& r = p["shard"];
+    out << "  shard " << r["index"] << "/" << r["count"] << ": items " << r["first"] << "-" << r["end"]
+        << " of " << r["total"] << " (join the shards with hairgen merge)\n";
+  }
   return out.str();
 }
 

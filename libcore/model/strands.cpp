@@ -65,6 +65,16 @@ void checkArray(const std::string& source, const char* name, const std::vector<T
 
 }  // namespace
 
+ShardRange shardRange(uint32_t index, uint32_t count, uint64_t total) {
+  ShardRange r;
+  r.index = index;
+  r.count = count;
+  r.total = total;
+  r.first = (index - 1) * total / count;
+  r.end = index * total / count;
+  return r;
+}
+
 Provenance madeByHairgen(std::string stage, uint64_t seed, std::string configDigest) {
   Provenance p;
   p.producer = "hairgen " HAIRGEN_VERSION;

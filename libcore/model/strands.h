@@ -11,6 +11,18 @@
 
 namespace hairgen {
 
+// A shard of a split stage (`--shard K/N`): the range of the stage's items it holds (grow: wick vertices,
+// interpolate: wick triangles), of `total`. `hairgen merge` joins shards into the single run's file.
+struct ShardRange {
+  uint32_t index = 0, count = 0;  // shard `index` of `count`, 1-based
+  uint64_t first = 0, end = 0;    // items [first, end)
+  uint64_t total = 0;             // items in the whole stage
+  bool operator==(const ShardRange&) const = default;
+};
+
+// Shard `index` (1-based) of `count` over `total` items: [⌊(index−1)·total/count⌋, ⌊index·total/count⌋).
+ShardRange shardRange(uint32_t index, uint32_t count, uint64_t total);
+
 // Where a cache came from, stored in it so a farm script can tell two caches apart.
 struct Provenance {
   std::string producer;  // "hairgen 0.1.0"; empty for files made elsewhere
@@ -25,10 +37,11 @@ struct Provenance {
   std::string conversion;  // what hairgen applied ("units mm (x0.001); up axis z turned to +y"), or ""
   bool metres = true;      // positions and widths are metres; false: the file's own, unknown units
   bool yUp = true;         // +y is up; false: the file's own, unknown axis
+  std::optional<ShardRange> shard;  // a shard of a split stage; none for a whole file
 
   bool empty() const {
     return producer.empty() && stage.empty() && configDigest.empty() && seed == 0 && source.empty() &&
-           sourceInfo.empty() && conversion.empty() && metres && yUp;
+           sourceInfo.empty() && conversion.empty() && metres && yUp && !shard;
   }
   bool operator==(const Provenance&) const = default;
 };
