@@ -273,6 +273,10 @@ void registerRender(CLI::App& app, int& exitCode) {
         headBefore = poseHead(frames.first - 1);
       }
       Progress progress("render", "frames", size_t(frames.count()), sequence && !options->common.quiet);
+      // One image: its passes are the progress (a 1080p coupe spends seconds in each on llvmpipe).
+      Progress passes("render", "passes", renderPassCount(options->motion),
+                      !sequence && !options->common.quiet);
+      if (!sequence) frameOptions.progress = &passes;
       for (int f = frames.first; f <= frames.last; ++f) {
         std::string hairFile;
         Strands hair = loadFrame(f, hairFile);
@@ -317,6 +321,7 @@ void registerRender(CLI::App& app, int& exitCode) {
         progress.advance();
       }
       progress.finish();
+      passes.finish();
       note(options->common,
            "render: wrote " + frameFile(options->output, frames.last) +
                (options->preview.empty() ? "" : " and " + frameFile(options->preview, frames.last)));

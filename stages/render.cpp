@@ -128,6 +128,7 @@ RenderOutput render(GlContext& gl, const Strands& hair, const Mesh* head, const 
     input.previous = previous;
   }
   input.shaders = shaders;
+  input.progress = options.progress;
   input.domResolution =
       options.domResolution > 0 ? options.domResolution : domResolutionFor(settings.resolution);
   input.keepDom = options.keepDom;

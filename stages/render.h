@@ -63,6 +63,7 @@ struct RenderOptions {
   // The hair the camera is aimed at (--frame, CameraPosition auto), as read; null: the hair rendered.
   // A sequence names its shot's first frame, so the camera holds still over the shot.
   const Strands* framing = nullptr;
+  Progress* progress = nullptr;  // advanced once per pass (renderPassCount)
 };
 
 // Hair made elsewhere, to hairgen's conventions: z-up turned to y-up (x, y, z) → (x, z, −y), then

@@ -41,21 +41,30 @@ RenderOutput renderHair(GlContext&, const RenderInput& in) {
   out.worldToNdc = scene.camera.proj * scene.camera.view;
   out.worldToLight = scene.light.proj * scene.light.view;
   out.timings.upload = seconds(clock);
+  auto passDone = [&] {
+    if (in.progress) in.progress->advance();
+  };
+  passDone();
 
   const LightDepth depth = lightDepthPass(scene);
   out.timings.lightDepth = seconds(clock);
+  passDone();
   const Texture opacity = deepOpacityPass(scene, depth);
   out.timings.opacity = seconds(clock);
+  passDone();
   const ShadedImage image = resolvePass(scene, shadingPass(scene, depth, opacity));
   out.timings.shading = seconds(clock);
+  passDone();
   std::optional<Texture> motion;
   if (scene.motion) {
     motion.emplace(motionResolvePass(scene, motionPass(scene)));
     out.timings.motion = seconds(clock);
+    passDone();
   }
   readBack(image, motion ? &*motion : nullptr, in.keepDom ? &depth : nullptr, in.keepDom ? &opacity : nullptr,
            out);
   out.timings.readback = seconds(clock);
+  passDone();
   return out;
 }
 

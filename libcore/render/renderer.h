@@ -17,6 +17,7 @@
 #include "libcore/model/strands.h"
 #include "libcore/render/custom_shaders.h"
 #include "libcore/render/shader_interface.h"
+#include "libcore/util/progress.h"
 
 namespace hairgen {
 
@@ -65,7 +66,14 @@ struct RenderInput {
   int domResolution = 1024;  // texels per side of the light's maps
   bool keepDom = false;
   std::optional<PreviousFrame> previous;  // motion vectors in the beauty image when given
+  Progress* progress = nullptr;           // advanced once per pass (renderPassCount of them)
 };
+
+// The passes renderHair reports to its Progress: upload, light depth, opacity, shading, (motion,)
+// read-back.
+inline size_t renderPassCount(bool motion) {
+  return motion ? 6 : 5;
+}
 
 // The light's maps for an image: half the image's larger side, at least 1024 and at most 4096 texels
 // (the shadow lookup filters 2×2 texels, so this keeps shadows as sharp as the image needs).
