@@ -31,6 +31,7 @@ void registerDiff(CLI::App& app, int& exitCode);
 
 void registerMerge(CLI::App& app, int& exitCode);
 void registerFarm(CLI::App& app, int& exitCode);
+void registerMovie(CLI::App& app, int& exitCode);
 
 // `shard`: only that range of the work (--shard K/N); none for the whole.
 GrowResult growStage(const CommonOptions& common, const Config& config, const Mesh& wick, Stats& stats,

@@ -28,6 +28,7 @@ int main(int argc, char** argv) {
   registerRender(app, exitCode);
   registerMerge(app, exitCode);
   registerFarm(app, exitCode);
+  registerMovie(app, exitCode);
   registerDiff(app, exitCode);
   registerInfo(app, exitCode);
   registerConvert(app, exitCode);

@@ -7,6 +7,7 @@
 #include <cmath>
 
 #include "libcore/util/error.h"
+#include "libcore/util/text.h"
 #include "stages/estimate.h"
 #include "stages/shade.h"
 
@@ -173,6 +174,7 @@ FarmPlan planFarm(const Config& config, const Mesh& wick, const FarmPlanOptions&
         request(&simulation, double(chunk.count()) / frames.count(), options.maxCpus), true);
     simulated.push_back(chunk);
   }
+  std::vector<std::string> renders;
   for (int first = frames.first, c = 1; first <= frames.last; first += options.chunk, ++c) {
     const FrameRange chunk{first, std::min(frames.last, first + options.chunk - 1)};
     std::vector<std::string> simulates;  // the simulation chunks that hold this chunk's frames
@@ -194,7 +196,14 @@ FarmPlan planFarm(const Config& config, const Mesh& wick, const FarmPlanOptions&
     work.seconds *= chunk.count();  // the memory is one frame's: frames render one after another
     Request r = request(&work, 1.0, options.maxCpus);
     add("render." + std::to_string(c), "render", args, inputs, outputs, deps, r, true);
+    renders.push_back("render." + std::to_string(c));
   }
+  // The preview movie from every frame's PNG, as run makes it.
+  const std::string mp4 = dir + "/beauty.mp4", gif = dir + "/beauty.gif";
+  add("movie", "movie",
+      {"movie", pngPattern, "--frames", framesText(frames), "--fps", formatReal(config.dynamics.frameRate),
+       "-o", mp4, "--gif", gif},
+      frameFiles(pngPattern, frames), {mp4, gif}, renders, Request{}, false);
   return plan;
 }
 

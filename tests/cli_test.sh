@@ -604,7 +604,7 @@ farm_plan)
   done
   grep -q '"Hairstyle.HairDensity=20"' "$plan" || fail "the plan's commands lose the overrides"
   expect_rc 0 "$hairgen" farm plan "$src/configs/anjyo/gust/setup.txt" -o "$tmp/shot" --frames 1-12 --chunk 5 --quiet
-  for id in simulate.1 simulate.3 shade render.3; do
+  for id in simulate.1 simulate.3 shade render.3 movie; do
     grep -q "\"id\": \"$id\"" "$tmp/shot/plan.json" || fail "the shot's plan has no task $id"
   done
   ! grep -q '"render.4"' "$tmp/shot/plan.json" || fail "12 frames in chunks of 5 make 3 render tasks"
@@ -612,6 +612,7 @@ farm_plan)
   grep -q "^grow=\$('sbatch' '--parsable' .*'--array=0,1,2,3'" "$tmp/out" || fail "dry run: $(cat "$tmp/out")"
   grep -q "^render=.*'--array=0,1,2'.*'--dependency=afterok:\$shade,afterok:\$simulate.1,afterok:\$simulate.2,afterok:\$simulate.3'" "$tmp/out" ||
     fail "render waits for the simulation and the shaded rest coupe: $(cat "$tmp/out")"
+  grep -q "^movie=.*'--dependency=afterok:\$render'" "$tmp/out" || fail "the movie waits for every frame: $(cat "$tmp/out")"
   grep -q "^simulate.3=.*'--array=2'.*'--dependency=afterok:\$merge-guides,afterok:\$simulate.2'" "$tmp/out" ||
     fail "a simulation chunk waits for the one before: $(cat "$tmp/out")"
   ! grep -q "interpolate-frames\|/frames/" "$tmp/shot/plan.json" || fail "the shot's plan writes per-frame coupes"
@@ -670,8 +671,13 @@ farm_slurm)
   find "$tmp/shot" -name '*.hair' -o -name '*.exr' -o -name '*.png' | grep -v 'beauty\.001[1-5]\.' | sort |
     xargs stat -c '%n %.9Y' >"$tmp/before"
   expect_rc 0 "$hairgen" farm submit "$tmp/shot/plan.json" --scheduler slurm --wait
-  [ "$(grep -c ': job ' "$tmp/out")" -eq 1 ] && grep -q "^render: job [0-9]* (1 task)" "$tmp/out" ||
-    fail "the resubmission redid more than the cancelled task: $(cat "$tmp/out")"
+  # Only the cancelled chunk is redone, and the movie that waited on it.
+  [ "$(grep -c ': job ' "$tmp/out")" -eq 2 ] && grep -q "^render: job [0-9]* (1 task)" "$tmp/out" &&
+    grep -q "^movie: job [0-9]* (1 task)" "$tmp/out" ||
+    fail "the resubmission redid more than the cancelled task and the movie: $(cat "$tmp/out")"
+  ffprobe -v error -count_frames -select_streams v:0 -show_entries stream=nb_read_frames -of csv=p=0 \
+    "$tmp/shot/beauty.mp4" | grep -qx 24 || fail "the farm's movie does not hold the shot's 24 frames"
+  [ -s "$tmp/shot/beauty.gif" ] || fail "the farm made no GIF"
   xargs stat -c '%n %.9Y' <<<"$(cut -d' ' -f1 "$tmp/before")" | cmp - "$tmp/before" || fail "a finished output was rewritten"
   expect_rc 0 "$hairgen" run "$gust" -o "$tmp/shotrun" "${shot[@]}" --set "Dynamics.Frames=1 24"
   for f in $(seq -f %04g 1 24); do

@@ -1,0 +1,53 @@
+// hairgen movie PATTERN --frames A-B -o beauty.mp4 [--gif beauty.gif] [--fps R]: a shot's preview movie
+// from its PNG frames, as `hairgen run` makes it; the last task of a farm plan for a shot.
+#include "cli/commands.h"
+#include "cli/common.h"
+#include "libcore/io/movie.h"
+#include "libcore/util/file_util.h"
+#include "libcore/util/frames.h"
+
+namespace hairgen::cli {
+
+void registerMovie(CLI::App& app, int& exitCode) {
+  struct Options {
+    CommonOptions common;
+    std::string pattern, frames, output, gif;
+    double fps = 24.0;
+  };
+  auto options = std::make_shared<Options>();
+  CLI::App* cmd = app.add_subcommand(
+      "movie",
+      "Encode a shot's PNG frames into the preview movie `run` writes (H.264 MP4 with Debian's ffmpeg, "
+      "and a small GIF): the farm's last task for a shot");
+  cmd->add_option("PATTERN", options->pattern,
+                  "The frames, #### standing for the frame number (beauty.####.png)")
+      ->required();
+  cmd->add_option("--frames", options->frames, "The frames to encode")->type_name("A-B")->required();
+  cmd->add_option("-o,--output", options->output, "The MP4 to write (written atomically)")->required();
+  cmd->add_option("--gif", options->gif, "Also a GIF for a README or a review page")->type_name("FILE.gif");
+  cmd->add_option("--fps", options->fps, "Frames per second (the Dynamics FrameRate)")
+      ->check(CLI::Range(0.001, 10000.0));
+  addCommonFlags(*cmd, options->common, false);
+  cmd->footer(exitCodeHelp());
+  cmd->callback([options, &exitCode] {
+    exitCode = runCommand("movie", options->common, [&] {
+      Stats stats("movie");
+      if (!isFramePattern(options->pattern))
+        throw InputError(options->pattern + ": write #### where the frame number goes");
+      const FrameRange frames = parseFrameRange(options->frames, "--frames");
+      for (int f = frames.first; f <= frames.last; ++f) requireRegularFile(framePath(options->pattern, f));
+      Stopwatch clock;
+      MovieOptions movie;
+      movie.frameRate = options->fps;
+      if (!writeMovie(options->pattern, frames, options->output, options->gif, movie))
+        throw IoError("ffmpeg is not installed (scripts/setup.sh installs it), so no movie was made");
+      stats.time("movie", clock.lap());
+      stats.counts()["frames"] = frames.count();
+      note(options->common,
+           "movie: wrote " + options->output + (options->gif.empty() ? "" : " and " + options->gif));
+      stats.write(options->common);
+    });
+  });
+}
+
+}  // namespace hairgen::cli
