@@ -9,9 +9,6 @@
 
 namespace hairgen {
 
-namespace {
-
-// The minimal rotation taking unit a to unit b, applied to v.
 glm::dvec3 transport(const glm::dvec3& a, const glm::dvec3& b, const glm::dvec3& v) {
   glm::dvec3 axis = glm::cross(a, b);
   double s = glm::length(axis), c = glm::dot(a, b);
@@ -19,8 +16,6 @@ glm::dvec3 transport(const glm::dvec3& a, const glm::dvec3& b, const glm::dvec3&
   axis /= s;
   return v * c + glm::cross(axis, v) * s + axis * glm::dot(axis, v) * (1.0 - c);
 }
-
-}  // namespace
 
 std::vector<glm::vec3> transportFrames(const Strands& s) {
   const std::vector<glm::vec3> tangents = tangentsOf(s);

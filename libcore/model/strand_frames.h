@@ -10,6 +10,10 @@
 
 namespace hairgen {
 
+// The minimal rotation taking unit a to unit b, applied to v (v itself when a and b agree, −v when they
+// are opposite).
+glm::dvec3 transport(const glm::dvec3& a, const glm::dvec3& b, const glm::dvec3& v);
+
 // Parallel-transport frames: at the root (t, u, t×u) with u the direction from the root toward the
 // centroid of all roots, made normal to t (fixed to the follicle and moving rigidly with the coupe),
 // then carried vertex to vertex by the minimal rotation between tangents. Returns u per vertex.

@@ -1,5 +1,6 @@
 // Anjyo et al. 1992 §3, as anjyo_dynamics.h describes it.
 #include "libcore/physics/anjyo_dynamics.h"
+#include "libcore/model/strand_frames.h"
 
 #include <algorithm>
 #include <cmath>
@@ -410,13 +411,7 @@ void AnjyoHair::posedInto(const Pose& pose, Strands& out) const {
       const size_t i = first + std::min(j, k - 1);
       if (k > 0 && (theta_[i] != 0.0 || phi_[i] != 0.0)) {
         // Turned with its segment: the minimal rotation from the rest direction to the current one.
-        const glm::dvec3 a = restDir_[i], b = directionOf(i);
-        const glm::dvec3 axis = glm::cross(a, b);
-        const double sinAngle = glm::length(axis), cosAngle = glm::dot(a, b);
-        if (sinAngle > 1e-15) {
-          const glm::dvec3 u = axis / sinAngle;
-          t = t * cosAngle + glm::cross(u, t) * sinAngle + u * glm::dot(u, t) * (1.0 - cosAngle);
-        }
+        t = transport(restDir_[i], directionOf(i), t);
       }
       out.tangents[p] = pose.isIdentity() ? glm::vec3(t) : glm::vec3(glm::normalize(pose.rotation * t));
     }

@@ -1,5 +1,6 @@
 // Petrovic et al. 2006 §5, as spring_dynamics.h describes it.
 #include "libcore/physics/spring_dynamics.h"
+#include "libcore/model/strand_frames.h"
 
 #include <algorithm>
 #include <cmath>
@@ -494,13 +495,7 @@ void SpringHair::posedInto(const Pose& pose, Strands& out) const {
       if (count >= 2) {
         // Turned with its segment (the one it starts, or the last): the minimal rotation.
         const uint32_t e = p0 + std::clamp(j + 1, 1u, count - 1);
-        const glm::dvec3 a = glm::normalize(xRest_[e] - xRest_[e - 1]), b = glm::normalize(x_[e] - x_[e - 1]);
-        const glm::dvec3 axis = glm::cross(a, b);
-        const double sinAngle = glm::length(axis), cosAngle = glm::dot(a, b);
-        if (sinAngle > 1e-15) {
-          const glm::dvec3 u = axis / sinAngle;
-          t = t * cosAngle + glm::cross(u, t) * sinAngle + u * glm::dot(u, t) * (1.0 - cosAngle);
-        }
+        t = transport(glm::normalize(xRest_[e] - xRest_[e - 1]), glm::normalize(x_[e] - x_[e - 1]), t);
       }
       out.tangents[p] = pose.isIdentity() ? glm::vec3(t) : glm::vec3(glm::normalize(pose.rotation * t));
     }
