@@ -94,11 +94,7 @@ void registerGrow(CLI::App& app, int& exitCode) {
     exitCode = runCommand("grow", options->common, [&] {
       Stats stats("grow");
       const HairFormat format = hairFormatOf(options->output);
-      std::optional<ShardSpec> shard;
-      if (!options->shard.empty()) shard = parseShardSpec(options->shard, "--shard");
-      if (shard && format != HairFormat::kHair)
-        throw InputError("-o " + options->output +
-                         ": a shard is written as .hair, whose provenance carries its range");
+      const std::optional<ShardSpec> shard = shardOption(options->shard, options->output, format);
       Stopwatch clock;
       Config config = loadStageConfig(options->setup, options->common, SetupUse::kGrow, stats);
       const Scene scene = readScene(options->common, config, true, false, stats);

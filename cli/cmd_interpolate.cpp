@@ -49,11 +49,7 @@ void registerInterpolate(CLI::App& app, int& exitCode) {
     exitCode = runCommand("interpolate", options->common, [&] {
       Stats stats("interpolate");
       const HairFormat format = hairFormatOf(options->output);
-      std::optional<ShardSpec> shard;
-      if (!options->shard.empty()) shard = parseShardSpec(options->shard, "--shard");
-      if (shard && format != HairFormat::kHair)
-        throw InputError("-o " + options->output +
-                         ": a shard is written as .hair, whose provenance carries its range");
+      const std::optional<ShardSpec> shard = shardOption(options->shard, options->output, format);
       Stopwatch clock;
       Config config = loadStageConfig(options->setup, options->common, SetupUse::kInterpolate, stats);
       const Scene scene = readScene(options->common, config, true, false, stats);

@@ -203,4 +203,12 @@ std::string exitCodeHelp() {
   return text;
 }
 
+std::optional<ShardSpec> shardOption(const std::string& shard, const std::string& output, HairFormat format) {
+  if (shard.empty()) return std::nullopt;
+  const ShardSpec spec = parseShardSpec(shard, "--shard");
+  if (format != HairFormat::kHair)
+    throw InputError("-o " + output + ": a shard is written as .hair, whose provenance carries its range");
+  return spec;
+}
+
 }  // namespace hairgen::cli

@@ -12,7 +12,9 @@
 
 #include "libcore/config/params.h"
 #include "libcore/config/setup.h"
+#include "libcore/io/hair_cache.h"
 #include "libcore/model/mesh.h"
+#include "libcore/model/shards.h"
 #include "libcore/model/strands.h"
 #include "libcore/model/units.h"
 #include "libcore/util/error.h"
@@ -109,5 +111,9 @@ void note(const CommonOptions& options, const std::string& line);
 
 // The exit-code table shown in --help.
 std::string exitCodeHelp();
+
+// --shard K/N of grow and interpolate: none when not given; a shard is written as .hair (its provenance
+// carries the range), so another output format is an InputError.
+std::optional<ShardSpec> shardOption(const std::string& shard, const std::string& output, HairFormat format);
 
 }  // namespace hairgen::cli

@@ -84,6 +84,17 @@ Provenance madeByHairgen(std::string stage, uint64_t seed, std::string configDig
   return p;
 }
 
+void Strands::assignRestKeepingBuffers(const Strands& rest) {
+  std::vector<glm::vec3> keptPoints = std::move(points), keptTangents = std::move(tangents);
+  std::vector<double> keptState = std::move(simulationState);
+  *this = rest;
+  points = std::move(keptPoints);
+  tangents = std::move(keptTangents);
+  simulationState = std::move(keptState);
+  points.resize(rest.pointCount());
+  tangents.resize(rest.pointCount());
+}
+
 void Strands::addStrand(const std::vector<glm::vec3>& strandPoints) {
   points.insert(points.end(), strandPoints.begin(), strandPoints.end());
   firstPoint.push_back(static_cast<uint32_t>(points.size()));

@@ -88,6 +88,11 @@ struct Strands {
   size_t pointCount() const { return points.size(); }
   uint32_t pointsOf(size_t strand) const { return firstPoint[strand + 1] - firstPoint[strand]; }
 
+  // Becomes a copy of `rest` whose points, tangents and simulation state are to be filled: those arrays
+  // keep their storage (sized to rest's points), so a frame posed into the same Strands each time
+  // allocates nothing.
+  void assignRestKeepingBuffers(const Strands& rest);
+
   // Appends a strand's points; the optional arrays are left to the caller.
   void addStrand(const std::vector<glm::vec3>& strandPoints);
 

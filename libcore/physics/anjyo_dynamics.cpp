@@ -390,17 +390,8 @@ Strands AnjyoHair::posed(const Pose& pose) const {
 }
 
 void AnjyoHair::posedInto(const Pose& pose, Strands& out) const {
-  // Every attribute but the points and tangents is the rest's; assigning into existing arrays of the
-  // same size copies without allocating.
-  std::vector<glm::vec3> points = std::move(out.points), tangents = std::move(out.tangents);
-  std::vector<double> state = std::move(out.simulationState);
-  out = rest_;
-  out.points = std::move(points);
-  out.tangents = std::move(tangents);
-  out.simulationState = std::move(state);
-  out.points.resize(rest_.pointCount());
+  out.assignRestKeepingBuffers(rest_);  // every attribute but the points and tangents is the rest's
   const std::vector<glm::dvec3> now = nodes();
-  out.tangents.resize(out.pointCount());
   tbb::parallel_for(size_t(0), rest_.strandCount(), [&](size_t s) {
     const uint32_t p0 = rest_.firstPoint[s], first = firstSegment_[s], k = firstSegment_[s + 1] - first;
     for (uint32_t j = 0; j <= k; ++j) {

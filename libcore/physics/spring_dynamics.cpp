@@ -477,14 +477,7 @@ Strands SpringHair::posed(const Pose& pose) const {
 }
 
 void SpringHair::posedInto(const Pose& pose, Strands& out) const {
-  std::vector<glm::vec3> points = std::move(out.points), tangents = std::move(out.tangents);
-  std::vector<double> state = std::move(out.simulationState);
-  out = rest_;
-  out.points = std::move(points);
-  out.tangents = std::move(tangents);
-  out.simulationState = std::move(state);
-  out.points.resize(rest_.pointCount());
-  out.tangents.resize(rest_.pointCount());
+  out.assignRestKeepingBuffers(rest_);  // every attribute but the points and tangents is the rest's
   tbb::parallel_for(size_t(0), rest_.strandCount(), [&](size_t s) {
     const uint32_t p0 = rest_.firstPoint[s], count = rest_.pointsOf(s);
     for (uint32_t j = 0; j < count; ++j) {
