@@ -72,11 +72,20 @@ void run(Hair& hair, double gravity, const Strands& restGuides, const Config& co
   Strands guides;  // every frame's, reused: no fresh pages to fault in per frame
   auto emit = [&](int frame) {
     hair.posedInto(head.pose(frame), guides);
-    hair.stateInto(guides.simulationState);
+    // The restart state: lent to the frame's guides where the model keeps it in the cache's layout,
+    // copied where it does not.
+    constexpr bool lends = requires {
+      hair.swapState(guides.simulationState);
+    };
+    if constexpr (lends)
+      hair.swapState(guides.simulationState);
+    else
+      hair.stateInto(guides.simulationState);
     guides.provenance = madeByHairgen("simulate", config.hairstyle.seed, options.configDigest);
     guides.provenance.frame = frame;
     guides.provenance.time = double(frame - d.firstFrame) / d.frameRate;
     frameDone(frame, guides);
+    if constexpr (lends) hair.swapState(guides.simulationState);  // taken back before the next step
     if (options.progress) options.progress->advance();
   };
 

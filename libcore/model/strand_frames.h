@@ -14,6 +14,16 @@ namespace hairgen {
 // are opposite).
 glm::dvec3 transport(const glm::dvec3& a, const glm::dvec3& b, const glm::dvec3& v);
 
+// The same rotation by Rodrigues' formula in a × b and a · b, with no square root: v cos + (w × v) +
+// w (w · v) / (1 + cos), w = a × b. For what turns every vertex of every frame; not bit for bit
+// `transport` (which the stored shading frames keep).
+inline glm::dvec3 transportFast(const glm::dvec3& a, const glm::dvec3& b, const glm::dvec3& v) {
+  const glm::dvec3 w = glm::cross(a, b);
+  const double c = glm::dot(a, b);
+  if (c < -1.0 + 1e-12) return -v;  // opposite: any half turn; transport's
+  return c * v + glm::cross(w, v) + w * (glm::dot(w, v) / (1.0 + c));
+}
+
 // Parallel-transport frames: at the root (t, u, t×u) with u the direction from the root toward the
 // centroid of all roots, made normal to t (fixed to the follicle and moving rigidly with the coupe),
 // then carried vertex to vertex by the minimal rotation between tangents. Returns u per vertex.

@@ -91,8 +91,8 @@ void Strands::assignRestKeepingBuffers(const Strands& rest) {
   points = std::move(keptPoints);
   tangents = std::move(keptTangents);
   simulationState = std::move(keptState);
-  points.resize(rest.pointCount());
-  tangents.resize(rest.pointCount());
+  points.resize(rest.firstPoint.back());  // `rest` may hold its attributes only, not its points
+  tangents.resize(rest.firstPoint.back());
 }
 
 void Strands::addStrand(const std::vector<glm::vec3>& strandPoints) {

@@ -131,10 +131,6 @@ glm::dvec3 turnOut(const CollisionShape& shape, const glm::dvec3& node, const gl
 
 }  // namespace
 
-SegmentFrame AnjyoHair::basisOf(size_t i) const {
-  return {restDir_[i], pole_[i], side_[i]};
-}
-
 double firstBendingFrequency(const Hairstyle& style, double length) {
   const double a = style.hairRadius1, b = style.hairRadius2;
   const double inertia = M_PI * a * b * b * b / 4.0, area = M_PI * a * b;
@@ -146,6 +142,7 @@ double firstBendingFrequency(const Hairstyle& style, double length) {
 AnjyoHair::AnjyoHair(const Strands& rest, const Hairstyle& style, const Dynamics& dynamics,
                      const Collision& collision, uint64_t seed)
     : rest_(rest),
+      restPoints_(rest.points),
       restAcceleration_(0.0, -style.gravity, 0.0),
       damping_(dynamics.damping),
       jointLimit_(glm::radians(style.jointLimit)),
@@ -162,16 +159,18 @@ AnjyoHair::AnjyoHair(const Strands& rest, const Hairstyle& style, const Dynamics
   for (size_t s = 0; s < strands; ++s)
     firstSegment_[s + 1] = firstSegment_[s] + std::max(rest.pointsOf(s), 1u) - 1;
   const size_t segments = firstSegment_.back();
-  theta_.assign(segments, 0.0);
-  phi_.assign(segments, 0.0);
-  restDir_.resize(segments);
-  pole_.resize(segments);
-  side_.resize(segments);
-  length_.resize(segments);
-  coefficient_.resize(segments);
-  restTurn_.assign(segments, 0.0);
+  segments_.resize(segments);
+  state_.assign(segments * kStateValues, 0.0);
+  for (size_t i = 0; i < segments; ++i) {
+    state_[kStateValues * i + kCosTheta] = 1.0;
+    state_[kStateValues * i + kCosPhi] = 1.0;
+  }
   restForward_.resize(rest.pointCount());
   restTangents_ = tangentsOf(rest);
+  // posedInto writes the points and tangents; the rest's are kept apart, so that handing every other
+  // attribute to a frame's guides copies no points.
+  rest_.points = {};
+  rest_.tangents = {};
   shapes_ = collision.shapes;
   for (size_t c = 0; c < shapes_.size() && head_ < 0; ++c)
     if (shapes_[c].kind == ShapeKind::kEllipsoid) head_ = int(c);
@@ -185,12 +184,9 @@ AnjyoHair::AnjyoHair(const Strands& rest, const Hairstyle& style, const Dynamics
       if (!(d > 0.0))
         throw InputError("guide " + std::to_string(s) + " has two points at the same place (points " +
                          std::to_string(j) + " and " + std::to_string(j + 1) + "); a segment needs a length");
-      const size_t i = firstSegment_[s] + j;
-      const SegmentFrame basis = frameFor((b - a) / d);
-      restDir_[i] = basis.rest;
-      pole_[i] = basis.pole;
-      side_[i] = basis.side;
-      length_[i] = d;
+      Segment& segment = segments_[firstSegment_[s] + j];
+      segment.frame = frameFor((b - a) / d);
+      segment.length = d;
       total += d;
     }
     longest = std::max(longest, total);
@@ -199,23 +195,15 @@ AnjyoHair::AnjyoHair(const Strands& rest, const Hairstyle& style, const Dynamics
     // and the inertia grows toward the root as 1/i (§3.2.1): at a given fraction of the length the
     // response is the same however finely the hair is cut into segments.
     for (uint32_t j = 0; j < k; ++j) {
-      const size_t i = firstSegment_[s] + j;
       const double root = int(j) < dynamics.rootSegments ? dynamics.rootInertia : 1.0;
-      coefficient_[i] =
+      segments_[firstSegment_[s] + j].coefficient =
           3.0 * std::pow(double(j + 1) / double(k), dynamics.inertiaExponent) / (2.0 * root * total);
     }
   }
-  thetaPrev_ = theta_;
-  phiPrev_ = phi_;
-  sinTheta_.assign(segments, 0.0);
-  cosTheta_.assign(segments, 1.0);
-  sinPhi_.assign(segments, 0.0);
-  cosPhi_.assign(segments, 1.0);
   const double frequency =
       dynamics.restFrequencyAuto ? firstBendingFrequency(style, longest) : dynamics.restFrequency;
   springOmega2_ = std::pow(2.0 * M_PI * frequency, 2);
-  springOverC_.resize(segments);
-  for (size_t i = 0; i < segments; ++i) springOverC_[i] = springOmega2_ / coefficient_[i];
+  for (Segment& segment : segments_) segment.springOverC = springOmega2_ / segment.coefficient;
   for (const CollisionShape& c : shapes_) {
     const double r = c.kind == ShapeKind::kSphere ? c.halfExtents.x
                      : c.kind == ShapeKind::kEllipsoid
@@ -243,15 +231,15 @@ AnjyoHair::AnjyoHair(const Strands& rest, const Hairstyle& style, const Dynamics
     restForward_[p0] = node;
     glm::dvec3 before(0.0);
     for (uint32_t j = 0; j < k; ++j) {
-      const size_t i = firstSegment_[s] + j;
-      const glm::dvec3 dir = directionOf(i);  // at rest
-      if (j > 0) restTurn_[i] = std::acos(std::clamp(glm::dot(before, dir), -1.0, 1.0));
+      Segment& segment = segments_[firstSegment_[s] + j];
+      const glm::dvec3 dir = directionOf(firstSegment_[s] + j);  // at rest
+      const double restTurn = j > 0 ? std::acos(std::clamp(glm::dot(before, dir), -1.0, 1.0)) : 0.0;
       // The turn allowed at the node before segment i: JointAngleLimit from its node on, or the rest's.
       const bool limited = j > 0 && int(j) >= jointFrom_ && jointLimit_ < M_PI;
-      const double allowed = limited ? std::max(jointLimit_, restTurn_[i]) : M_PI;
-      cosAllowed_.push_back(limited ? std::cos(allowed) : -2.0);
-      sinAllowed_.push_back(std::sin(allowed));
-      node += length_[i] * dir;
+      const double allowed = limited ? std::max(jointLimit_, restTurn) : M_PI;
+      segment.cosAllowed = limited ? std::cos(allowed) : -2.0;
+      segment.sinAllowed = std::sin(allowed);
+      node += segment.length * dir;
       restForward_[p0 + j + 1] = node;
       before = dir;
     }
@@ -277,17 +265,20 @@ void AnjyoHair::stepStrand(size_t s, const AccelerationField& field, double dt, 
   glm::dvec3 newBefore(0.0);           // the direction just placed before this one
   for (uint32_t j = 0; j < k; ++j) {
     const size_t i = first + j;
-    const SegmentFrame basis = basisOf(i);
-    const double st = sinTheta_[i], ct = cosTheta_[i], sp = sinPhi_[i], cp = cosPhi_[i];
+    const Segment& segment = segments_[i];
+    const SegmentFrame& basis = segment.frame;
+    double* state = &state_[kStateValues * i];
+    const double st = state[kSinTheta], ct = state[kCosTheta], sp = state[kSinPhi], cp = state[kCosPhi];
+    const double theta0 = state[kTheta], phi0 = state[kPhi];
     const glm::dvec3 across = cp * basis.rest + sp * basis.side;  // the longitude's horizontal direction
     const glm::dvec3 dir = ct * across + st * basis.pole;
     const glm::dvec3 thetaDir = -st * across + ct * basis.pole, phiDir = -sp * basis.rest + cp * basis.side;
-    const double d = length_[i];
+    const double d = segment.length;
     glm::dvec3 departure = field.base - restAcceleration_;
     if (field.rotating) {
       // The segment's turn over the last step, to first order, gives its midpoint's velocity.
       const glm::dvec3 turnRate =
-          ((theta_[i] - thetaPrev_[i]) * thetaDir + (phi_[i] - phiPrev_[i]) * ct * phiDir) / dt;
+          ((theta0 - state[kThetaPrev]) * thetaDir + (phi0 - state[kPhiPrev]) * ct * phiDir) / dt;
       const glm::dvec3 mid = node + 0.5 * d * dir;
       departure = field.at(mid, nodeVelocity + 0.5 * d * turnRate) - restAcceleration_;
       nodeVelocity += d * turnRate;
@@ -308,21 +299,21 @@ void AnjyoHair::stepStrand(size_t s, const AccelerationField& field, double dt, 
     }
     // The spring toward the rest direction, as an acceleration the projective equations turn into
     // θ'' = −ω²θ for a small departure θ.
-    const double c = coefficient_[i];
-    const glm::dvec3 push = departure + springOverC_[i] * (basis.rest - dir);
+    const double c = segment.coefficient;
+    const glm::dvec3 push = departure + segment.springOverC * (basis.rest - dir);
     const double thetaAcc = c * glm::dot(push, thetaDir);
     const double phiAcc = c * ct * glm::dot(push, phiDir);
     // (4)' and (5)', with the damping as a loss of the last step's motion.
-    double theta = theta_[i] + keep * (theta_[i] - thetaPrev_[i]) + dt2 * thetaAcc;
-    double phi = phi_[i] + keep * (phi_[i] - phiPrev_[i]) + dt2 * phiAcc;
+    double theta = theta0 + keep * (theta0 - state[kThetaPrev]) + dt2 * thetaAcc;
+    double phi = phi0 + keep * (phi0 - state[kPhiPrev]) + dt2 * phiAcc;
     if (fluctuate) {  // §3.2.3: a random turn, the most at the tip
       const double scale = fluctuation_ * double(j + 1) / double(k);
       theta += scale * (2.0 * counterUniform(seed_, s, kFluctuationKey ^ block, 2 * j) - 1.0);
       phi += scale * (2.0 * counterUniform(seed_, s, kFluctuationKey ^ block, 2 * j + 1) - 1.0);
     }
     double nst = st, nct = ct, nsp = sp, ncp = cp;
-    turn(nst, nct, theta - theta_[i]);
-    turn(nsp, ncp, phi - phi_[i]);
+    turn(nst, nct, theta - theta0);
+    turn(nsp, ncp, phi - phi0);
     glm::dvec3 placed = nct * (ncp * basis.rest + nsp * basis.side) + nst * basis.pole;
     bool adjusted = false;
     // Out of every collision shape (no deeper than the node sat at rest), then the joint angle at the
@@ -340,43 +331,45 @@ void AnjyoHair::stepStrand(size_t s, const AccelerationField& field, double dt, 
         moved = true;
       }
       const double cosTurn = glm::dot(newBefore, placed);
-      if (cosTurn < cosAllowed_[i] - 1e-12) {
+      if (cosTurn < segment.cosAllowed - 1e-12) {
         glm::dvec3 side = placed - cosTurn * newBefore;
         const double len = glm::length(side);
         side = len > 1e-12 ? side / len : basis.pole;
-        placed = cosAllowed_[i] * newBefore + sinAllowed_[i] * side;
+        placed = segment.cosAllowed * newBefore + segment.sinAllowed * side;
         moved = true;
       }
       adjusted = adjusted || moved;
       if (!moved) break;
     }
     if (adjusted) anglesNear(basis, placed, theta, phi, nst, nct, nsp, ncp);
-    thetaPrev_[i] = theta_[i];
-    phiPrev_[i] = phi_[i];
-    theta_[i] = theta;
-    phi_[i] = phi;
-    sinTheta_[i] = nst;
-    cosTheta_[i] = nct;
-    sinPhi_[i] = nsp;
-    cosPhi_[i] = ncp;
+    state[kThetaPrev] = theta0;
+    state[kPhiPrev] = phi0;
+    state[kTheta] = theta;
+    state[kPhi] = phi;
+    state[kSinTheta] = nst;
+    state[kCosTheta] = nct;
+    state[kSinPhi] = nsp;
+    state[kCosPhi] = ncp;
     node += d * (nct * (ncp * basis.rest + nsp * basis.side) + nst * basis.pole);
     newBefore = placed;
   }
 }
 
 glm::dvec3 AnjyoHair::directionOf(size_t i) const {
-  return cosTheta_[i] * (cosPhi_[i] * restDir_[i] + sinPhi_[i] * side_[i]) + sinTheta_[i] * pole_[i];
+  const SegmentFrame& b = segments_[i].frame;
+  const double* v = &state_[kStateValues * i];
+  return v[kCosTheta] * (v[kCosPhi] * b.rest + v[kSinPhi] * b.side) + v[kSinTheta] * b.pole;
 }
 
 std::vector<glm::dvec3> AnjyoHair::nodes() const {
-  std::vector<glm::dvec3> out(rest_.pointCount());
+  std::vector<glm::dvec3> out(restPoints_.size());
   tbb::parallel_for(size_t(0), rest_.strandCount(), [&](size_t s) {
     const uint32_t p0 = rest_.firstPoint[s], first = firstSegment_[s], k = firstSegment_[s + 1] - first;
     glm::dvec3 node = restForward_[p0];
     out[p0] = node;
     for (uint32_t j = 0; j < k; ++j) {
       const size_t i = first + j;
-      node += length_[i] * directionOf(i);
+      node += segments_[i].length * directionOf(i);
       out[p0 + j + 1] = node;
     }
   });
@@ -391,64 +384,37 @@ Strands AnjyoHair::posed(const Pose& pose) const {
 
 void AnjyoHair::posedInto(const Pose& pose, Strands& out) const {
   out.assignRestKeepingBuffers(rest_);  // every attribute but the points and tangents is the rest's
-  const std::vector<glm::dvec3> now = nodes();
+  const bool still = pose.isIdentity();
   tbb::parallel_for(size_t(0), rest_.strandCount(), [&](size_t s) {
     const uint32_t p0 = rest_.firstPoint[s], first = firstSegment_[s], k = firstSegment_[s + 1] - first;
+    glm::dvec3 node = restForward_[p0], dir(0.0);
+    bool moved = false;  // whether the segment at hand has left its rest direction
     for (uint32_t j = 0; j <= k; ++j) {
       const uint32_t p = p0 + j;
-      // The input point plus the motion: at rest exactly the input.
-      out.points[p] = glm::vec3(pose.apply(glm::dvec3(rest_.points[p]) + (now[p] - restForward_[p])));
-      glm::dvec3 t(restTangents_[p]);
-      const size_t i = first + std::min(j, k - 1);
-      if (k > 0 && (theta_[i] != 0.0 || phi_[i] != 0.0)) {
-        // Turned with its segment: the minimal rotation from the rest direction to the current one.
-        t = transport(restDir_[i], directionOf(i), t);
+      if (j > 0) node += segments_[first + j - 1].length * dir;
+      if (j < k) {  // the segment the point starts (the last point takes the last segment's)
+        const double* v = &state_[kStateValues * (first + j)];
+        dir = directionOf(first + j);
+        moved = v[kTheta] != 0.0 || v[kPhi] != 0.0;
       }
-      out.tangents[p] = pose.isIdentity() ? glm::vec3(t) : glm::vec3(glm::normalize(pose.rotation * t));
+      // The input point plus the motion: at rest exactly the input.
+      out.points[p] = glm::vec3(pose.apply(glm::dvec3(restPoints_[p]) + (node - restForward_[p])));
+      glm::dvec3 t(restTangents_[p]);
+      // Turned with its segment: the minimal rotation from the rest direction to the current one.
+      if (k > 0 && moved) t = transportFast(segments_[first + std::min(j, k - 1)].frame.rest, dir, t);
+      out.tangents[p] = glm::vec3(still ? t : pose.rotation * t);  // a rotation keeps it unit
     }
   });
 }
 
-std::vector<double> AnjyoHair::state() const {
-  std::vector<double> out;
-  stateInto(out);
-  return out;
-}
-
-void AnjyoHair::stateInto(std::vector<double>& out) const {
-  out.resize(theta_.size() * kStateValues);
-  tbb::parallel_for(size_t(0), theta_.size(), [&](size_t i) {
-    double* v = &out[kStateValues * i];
-    v[0] = theta_[i];
-    v[1] = phi_[i];
-    v[2] = thetaPrev_[i];
-    v[3] = phiPrev_[i];
-    v[4] = sinTheta_[i];
-    v[5] = cosTheta_[i];
-    v[6] = sinPhi_[i];
-    v[7] = cosPhi_[i];
-  });
-}
-
 void AnjyoHair::restore(const std::vector<double>& state, const std::string& source) {
-  if (state.size() != theta_.size() * kStateValues)
+  if (state.size() != state_.size())
     throw InputError({source, 0}, "its simulation state has " + std::to_string(state.size() / kStateValues) +
-                                      " segments, the guides " + std::to_string(theta_.size()) +
+                                      " segments, the guides " + std::to_string(segments_.size()) +
                                       "; restart from a frame of the same guides");
-  for (size_t i = 0; i < theta_.size(); ++i) {
-    const double* v = &state[kStateValues * i];
-    for (size_t j = 0; j < kStateValues; ++j)
-      if (!std::isfinite(v[j]))
-        throw InputError({source, 0}, "its simulation state holds a non-finite value");
-    theta_[i] = v[0];
-    phi_[i] = v[1];
-    thetaPrev_[i] = v[2];
-    phiPrev_[i] = v[3];
-    sinTheta_[i] = v[4];
-    cosTheta_[i] = v[5];
-    sinPhi_[i] = v[6];
-    cosPhi_[i] = v[7];
-  }
+  for (double v : state)
+    if (!std::isfinite(v)) throw InputError({source, 0}, "its simulation state holds a non-finite value");
+  state_ = state;
 }
 
 }  // namespace hairgen

@@ -68,31 +68,39 @@ class AnjyoHair {
 
   // What a restart needs, kStateValues doubles per segment: θ, φ, the previous substep's θ, φ, and the
   // sin and cos of θ and φ as the steps carried them (turned by each step's increment, not recomputed,
-  // so a resumed run computes exactly what the unbroken one did); and the inverse.
+  // so a resumed run computes exactly what the unbroken one did); and the inverse. The hair keeps its
+  // state in this layout, so `swapState` can lend it to a frame's cache without a copy: swap it out,
+  // write the cache, swap it back (stepping in between is an error).
   static constexpr size_t kStateValues = 8;
-  std::vector<double> state() const;
-  void stateInto(std::vector<double>& out) const;
+  std::vector<double> state() const { return state_; }
+  void stateInto(std::vector<double>& out) const { out = state_; }
+  void swapState(std::vector<double>& other) { state_.swap(other); }
   void restore(const std::vector<double>& state, const std::string& source);
 
-  size_t segmentCount() const { return theta_.size(); }
+  size_t segmentCount() const { return segments_.size(); }
   // Diagnostics for tests: every node's position (head frame), and each joint's turn in radians.
   std::vector<glm::dvec3> nodes() const;
 
  private:
   void stepStrand(size_t strand, const AccelerationField& field, double dt, int frame, bool fluctuate);
-  SegmentFrame basisOf(size_t segment) const;
   glm::dvec3 directionOf(size_t segment) const;  // from the carried sin and cos
 
-  Strands rest_;
-  std::vector<uint32_t> firstSegment_;                         // per strand, + 1
-  std::vector<double> theta_, phi_, thetaPrev_, phiPrev_;      // 0 at rest
-  std::vector<double> sinTheta_, cosTheta_, sinPhi_, cosPhi_;  // carried with θ and φ by every step
-  std::vector<glm::dvec3> restDir_, pole_, side_;              // each segment's frame (README, Dynamics)
-  std::vector<double> length_, coefficient_;                   // d_i and c_i u_i m_i (1/m)
-  std::vector<double> restTurn_;                 // radians: the turn at the node before segment i at rest
-  std::vector<double> cosAllowed_, sinAllowed_;  // the turn allowed there (cos −2 where there is no limit)
-  std::vector<double> springOverC_;              // ω² / c_i: the spring as an acceleration
-  std::vector<double> shapeReach2_;              // per shape: beyond this squared distance nothing reaches it
+  // What a step reads of a segment, together: its frame (README, Dynamics), d_i, c_i u_i m_i (1/m),
+  // ω² / c_i (the rest spring as an acceleration), and the turn allowed at the node before it (cos −2
+  // where there is no limit).
+  struct Segment {
+    SegmentFrame frame;
+    double length, coefficient, springOverC, cosAllowed, sinAllowed;
+  };
+  // The state's values of a segment, in the restart layout.
+  enum StateValue { kTheta, kPhi, kThetaPrev, kPhiPrev, kSinTheta, kCosTheta, kSinPhi, kCosPhi };
+
+  Strands rest_;  // every attribute of the rest guides but their points and tangents
+  std::vector<glm::vec3> restPoints_;
+  std::vector<uint32_t> firstSegment_;  // per strand, + 1
+  std::vector<Segment> segments_;
+  std::vector<double> state_;        // kStateValues per segment: 0 at rest but the cosines, 1
+  std::vector<double> shapeReach2_;  // per shape: beyond this squared distance nothing reaches it
   // Per shape, a test cheaper than penetration() that rules out most points (exact for ellipsoids,
   // always "maybe" for the other shapes). `v` is the point less the shape's centre.
   struct ShapeTest {

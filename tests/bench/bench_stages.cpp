@@ -219,6 +219,7 @@ void SimulateAnjyo(benchmark::State& state) {
   SimulateOptions options;
   options.frames = {1, 25};
   size_t frames = 0;
+  const std::clock_t start = std::clock();
   for (auto _ : state)
     simulate(guides, config, options, [&](int, const Strands& g) {
       benchmark::DoNotOptimize(g.points.data());
@@ -226,6 +227,8 @@ void SimulateAnjyo(benchmark::State& state) {
     });
   state.counters["frames/s"] = benchmark::Counter(double(frames), benchmark::Counter::kIsRate);
   state.counters["segments"] = double(guides.pointCount() - guides.strandCount());
+  // As for SimulateSprings: CPU seconds of every thread per frame, what a shared machine's load leaves out.
+  state.counters["cpu_s_per_frame"] = double(std::clock() - start) / CLOCKS_PER_SEC / double(frames);
 }
 BENCHMARK(SimulateAnjyo)->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(3.0);
 
