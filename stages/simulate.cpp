@@ -17,12 +17,21 @@ HeadMotion headMotionOf(const Config& config) {
 namespace {
 
 // One substep's call for each model: Anjyo's keys its fluctuations by the frame, the springs smooth
-// their velocities after a frame's last substep.
-void stepHair(AnjyoHair& hair, const AccelerationField& field, double dt, int frame, int substep, int) {
-  hair.step(field, dt, frame, substep == 0);
+// their velocities after a frame's last substep. Given `posed`, the frame's last substep also poses the
+// new state into it where the model can in the same pass (Anjyo's), and says whether it did.
+bool stepHair(AnjyoHair& hair, const AccelerationField& field, double dt, int frame, int substep, int,
+              const Pose* pose, Strands* posed) {
+  if (!posed) {
+    hair.step(field, dt, frame, substep == 0);
+    return false;
+  }
+  hair.stepAndPose(field, dt, frame, substep == 0, *pose, *posed);
+  return true;
 }
-void stepHair(SpringHair& hair, const AccelerationField& field, double dt, int, int substep, int substeps) {
+bool stepHair(SpringHair& hair, const AccelerationField& field, double dt, int, int substep, int substeps,
+              const Pose*, Strands*) {
   hair.step(field, dt, substep == 0, substep == substeps - 1);
+  return false;
 }
 
 template <class Hair>
@@ -70,8 +79,8 @@ void run(Hair& hair, double gravity, const Strands& restGuides, const Config& co
   const FrameRange frames = options.frames;
   const HeadMotion head = headMotionOf(config);
   Strands guides;  // every frame's, reused: no fresh pages to fault in per frame
-  auto emit = [&](int frame) {
-    hair.posedInto(head.pose(frame), guides);
+  auto emit = [&](int frame, bool posed) {
+    if (!posed) hair.posedInto(head.pose(frame), guides);
     // The restart state: lent to the frame's guides where the model keeps it in the cache's layout,
     // copied where it does not.
     constexpr bool lends = requires {
@@ -110,17 +119,20 @@ void run(Hair& hair, double gravity, const Strands& restGuides, const Config& co
       throw InputError(where, "holds other strands than the guides; restart from a frame of the same guides");
     hair.restore(before->simulationState, options.restartName);
   } else {
-    emit(d.firstFrame);
+    emit(d.firstFrame, false);
   }
   const double dt = 1.0 / (d.frameRate * d.substeps);
   for (int frame = std::max(frames.first, d.firstFrame + 1); frame <= frames.last; ++frame) {
+    const Pose pose = head.pose(frame);
+    bool posed = false;
     for (int s = 0; s < d.substeps; ++s) {
       // The forces of the substep's start (Störmer-Verlet), in frames since the shot began.
       const double t = double(frame - 1) + double(s) / double(d.substeps);
       const AccelerationField field = headFrameField(head.at(t), windAt(d.wind, t), gravity);
-      stepHair(hair, field, dt, frame, s, d.substeps);
+      const bool last = s == d.substeps - 1;
+      posed = stepHair(hair, field, dt, frame, s, d.substeps, &pose, last ? &guides : nullptr);
     }
-    emit(frame);
+    emit(frame, posed);
   }
 }
 

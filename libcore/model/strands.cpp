@@ -122,12 +122,7 @@ void Strands::validate(const std::string& source) const {
   checkArray(source, "root UVs", rootUv, s);
   checkArray(source, "guide ids", guideIds, s);
   checkArray(source, "guide weights", guideWeights, s);
-  size_t segments = 0;
-  for (size_t i = 0; i < s; ++i) segments += pointsOf(i) > 0 ? pointsOf(i) - 1 : 0;
-  if (!simulationState.empty() && (segments == 0 || simulationState.size() % segments != 0))
-    throw InputError({source, 0}, "the simulation state holds " + std::to_string(simulationState.size()) +
-                                      " values, not a whole number per segment of " +
-                                      std::to_string(segments));
+  // The simulation state's layout is its model's, checked where simulate restarts from it.
   checkArray(source, "simulation state", simulationState, simulationState.size());
   if (!std::isfinite(defaultThickness) || !std::isfinite(defaultTransparency) || !finite(defaultColor))
     throw InputError({source, 0}, "header defaults are not finite");

@@ -79,9 +79,9 @@ struct Strands {
 
   Provenance provenance;
 
-  // What `hairgen simulate` needs to resume from this frame (a fixed number of doubles per segment:
-  // the angles of the last step and the step before, and what the steps carried with them); empty for
-  // anything else. Opaque to every other stage.
+  // What `hairgen simulate` needs to resume from this frame, in its model's layout (Anjyo's angles of
+  // the last step and the step before and what the steps carried with them, the springs' positions and
+  // velocities); empty for anything else. Opaque to every other stage.
   std::vector<double> simulationState;
 
   size_t strandCount() const { return firstPoint.empty() ? 0 : firstPoint.size() - 1; }

@@ -16,6 +16,12 @@ namespace {
 
 constexpr uint64_t kFluctuationKey = 0x666c756374ull;  // "fluct": apart from every other stream
 
+// Whether this processor runs the lanes 8 wide (anjyo_lanes.cpp's `wide`).
+bool hasWideLanes() {
+  static const bool has = __builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512dq");
+  return has;
+}
+
 SegmentFrame frameFor(const glm::dvec3& rest) {
   // A pole across the segment: horizontal where it can be, so that for hanging hair θ swings it in
   // its vertical plane and φ about the vertical.
@@ -160,11 +166,25 @@ AnjyoHair::AnjyoHair(const Strands& rest, const Hairstyle& style, const Dynamics
     firstSegment_[s + 1] = firstSegment_[s] + std::max(rest.pointsOf(s), 1u) - 1;
   const size_t segments = firstSegment_.back();
   segments_.resize(segments);
-  state_.assign(segments * kStateValues, 0.0);
-  for (size_t i = 0; i < segments; ++i) {
-    state_[kStateValues * i + kCosTheta] = 1.0;
-    state_[kStateValues * i + kCosPhi] = 1.0;
+  // Blocks of kLanes strands for stepLanes, each as long as its longest strand.
+  const size_t blocks = (strands + kLanes - 1) / kLanes;
+  blockFirst_.assign(blocks + 1, 0);
+  for (size_t b = 0; b < blocks; ++b) {
+    uint32_t most = 0;
+    for (size_t s = b * kLanes; s < std::min(strands, (b + 1) * kLanes); ++s)
+      most = std::max(most, firstSegment_[s + 1] - firstSegment_[s]);
+    blockFirst_[b + 1] = blockFirst_[b] + most;
   }
+  // At rest every value is 0 but the cosines, 1.
+  state_.assign(kStateHeader + blockFirst_.back() * kStateValues * kLanes, 0.0);
+  state_[0] = kStateTag;
+  state_[1] = double(kLanes);
+  state_[2] = double(kStateValues);
+  for (size_t i = 0; i < blockFirst_.back(); ++i)
+    for (size_t l = 0; l < kLanes; ++l) {
+      state_[kStateHeader + (i * kStateValues + kCosTheta) * kLanes + l] = 1.0;
+      state_[kStateHeader + (i * kStateValues + kCosPhi) * kLanes + l] = 1.0;
+    }
   restForward_.resize(rest.pointCount());
   restTangents_ = tangentsOf(rest);
   // posedInto writes the points and tangents; the rest's are kept apart, so that handing every other
@@ -232,7 +252,7 @@ AnjyoHair::AnjyoHair(const Strands& rest, const Hairstyle& style, const Dynamics
     glm::dvec3 before(0.0);
     for (uint32_t j = 0; j < k; ++j) {
       Segment& segment = segments_[firstSegment_[s] + j];
-      const glm::dvec3 dir = directionOf(firstSegment_[s] + j);  // at rest
+      const glm::dvec3 dir = directionOf(s, j);  // at rest
       const double restTurn = j > 0 ? std::acos(std::clamp(glm::dot(before, dir), -1.0, 1.0)) : 0.0;
       // The turn allowed at the node before segment i: JointAngleLimit from its node on, or the rest's.
       const bool limited = j > 0 && int(j) >= jointFrom_ && jointLimit_ < M_PI;
@@ -246,13 +266,69 @@ AnjyoHair::AnjyoHair(const Strands& rest, const Hairstyle& style, const Dynamics
     for (uint32_t p = p0; p < rest.firstPoint[s + 1]; ++p)
       for (size_t c = 0; c < shapes_.size(); ++c) restDepth_[c][p] = penetration(shapes_[c], restForward_[p]);
   }
+  // The same points lane by lane, for posing.
+  lanePoints_.resize(blockFirst_.back() + blocks);
+  for (size_t b = 0; b < blocks; ++b)
+    for (size_t l = 0; l < kLanes; ++l) {
+      const size_t s = std::min(b * kLanes + l, strands - 1);  // past the last strand: the last one's
+      if (rest.pointsOf(s) == 0) continue;
+      for (size_t j = 0; j <= blockFirst_[b + 1] - blockFirst_[b]; ++j) {
+        const size_t p = rest.firstPoint[s] + std::min<size_t>(j, rest.pointsOf(s) - 1);
+        LanePoint& to = lanePoints_[blockFirst_[b] + b + j];
+        for (int c = 0; c < 3; ++c) {
+          to.point[c][l] = rest.points[p][c];
+          to.forward[c][l] = restForward_[p][c];
+          to.tangent[c][l] = restTangents_[p][c];
+        }
+      }
+    }
+  // The same segments lane by lane, for stepLanes.
+  lanes_.assign(blockFirst_.back(), LaneSegment{});
+  for (size_t s = 0; s < strands; ++s)
+    for (uint32_t j = 0; j < firstSegment_[s + 1] - firstSegment_[s]; ++j) {
+      const Segment& from = segments_[firstSegment_[s] + j];
+      LaneSegment& to = lanes_[blockFirst_[s / kLanes] + j];
+      const size_t l = s % kLanes;
+      for (int c = 0; c < 3; ++c) {
+        to.rest[c][l] = from.frame.rest[c];
+        to.pole[c][l] = from.frame.pole[c];
+        to.side[c][l] = from.frame.side[c];
+      }
+      to.length[l] = from.length;
+      to.coefficient[l] = from.coefficient;
+      to.springOverC[l] = from.springOverC;
+      to.cosAllowed[l] = from.cosAllowed;
+    }
 }
 
-void AnjyoHair::step(const AccelerationField& field, double dt, int frame, bool firstSubstep) {
-  const bool fluctuate = firstSubstep && fluctuation_ > 0.0 && frame > firstFrame_ &&
-                         (frame - firstFrame_) % fluctuationEvery_ == 0;
-  tbb::parallel_for(size_t(0), rest_.strandCount(),
-                    [&](size_t s) { stepStrand(s, field, dt, frame, fluctuate); });
+bool AnjyoHair::fluctuates(int frame, bool firstSubstep) const {
+  return firstSubstep && fluctuation_ > 0.0 && frame > firstFrame_ &&
+         (frame - firstFrame_) % fluctuationEvery_ == 0;
+}
+
+void AnjyoHair::stepAndPose(const AccelerationField& field, double dt, int frame, bool firstSubstep,
+                            const Pose& pose, Strands& out, Kernel kernel) {
+  if (fluctuates(frame, firstSubstep) || kernel == Kernel::kStrands) {
+    step(field, dt, frame, firstSubstep, kernel);
+    posedInto(pose, out, kernel);
+    return;
+  }
+  out.assignRestKeepingBuffers(rest_);
+  const bool wide = kernel != Kernel::kLanes && hasWideLanes();
+  tbb::parallel_for(size_t(0), blockFirst_.size() - 1,
+                    [&](size_t b) { stepLanes(b * kLanes, field, dt, wide, &pose, &out); });
+}
+
+void AnjyoHair::step(const AccelerationField& field, double dt, int frame, bool firstSubstep, Kernel kernel) {
+  const bool fluctuate = fluctuates(frame, firstSubstep);
+  if (fluctuate || kernel == Kernel::kStrands) {
+    tbb::parallel_for(size_t(0), rest_.strandCount(),
+                      [&](size_t s) { stepStrand(s, field, dt, frame, fluctuate); });
+    return;
+  }
+  const bool wide = kernel != Kernel::kLanes && hasWideLanes();
+  tbb::parallel_for(size_t(0), blockFirst_.size() - 1,
+                    [&](size_t b) { stepLanes(b * kLanes, field, dt, wide); });
 }
 
 void AnjyoHair::stepStrand(size_t s, const AccelerationField& field, double dt, int frame, bool fluctuate) {
@@ -267,9 +343,10 @@ void AnjyoHair::stepStrand(size_t s, const AccelerationField& field, double dt, 
     const size_t i = first + j;
     const Segment& segment = segments_[i];
     const SegmentFrame& basis = segment.frame;
-    double* state = &state_[kStateValues * i];
-    const double st = state[kSinTheta], ct = state[kCosTheta], sp = state[kSinPhi], cp = state[kCosPhi];
-    const double theta0 = state[kTheta], phi0 = state[kPhi];
+    double* state = &state_[stateAt(s, j)];  // value v at state[v * kLanes]
+    auto value = [&](StateValue v) -> double& { return state[v * kLanes]; };
+    const double st = value(kSinTheta), ct = value(kCosTheta), sp = value(kSinPhi), cp = value(kCosPhi);
+    const double theta0 = value(kTheta), phi0 = value(kPhi);
     const glm::dvec3 across = cp * basis.rest + sp * basis.side;  // the longitude's horizontal direction
     const glm::dvec3 dir = ct * across + st * basis.pole;
     const glm::dvec3 thetaDir = -st * across + ct * basis.pole, phiDir = -sp * basis.rest + cp * basis.side;
@@ -278,7 +355,7 @@ void AnjyoHair::stepStrand(size_t s, const AccelerationField& field, double dt, 
     if (field.rotating) {
       // The segment's turn over the last step, to first order, gives its midpoint's velocity.
       const glm::dvec3 turnRate =
-          ((theta0 - state[kThetaPrev]) * thetaDir + (phi0 - state[kPhiPrev]) * ct * phiDir) / dt;
+          ((theta0 - value(kThetaPrev)) * thetaDir + (phi0 - value(kPhiPrev)) * ct * phiDir) / dt;
       const glm::dvec3 mid = node + 0.5 * d * dir;
       departure = field.at(mid, nodeVelocity + 0.5 * d * turnRate) - restAcceleration_;
       nodeVelocity += d * turnRate;
@@ -304,8 +381,8 @@ void AnjyoHair::stepStrand(size_t s, const AccelerationField& field, double dt, 
     const double thetaAcc = c * glm::dot(push, thetaDir);
     const double phiAcc = c * ct * glm::dot(push, phiDir);
     // (4)' and (5)', with the damping as a loss of the last step's motion.
-    double theta = theta0 + keep * (theta0 - state[kThetaPrev]) + dt2 * thetaAcc;
-    double phi = phi0 + keep * (phi0 - state[kPhiPrev]) + dt2 * phiAcc;
+    double theta = theta0 + keep * (theta0 - value(kThetaPrev)) + dt2 * thetaAcc;
+    double phi = phi0 + keep * (phi0 - value(kPhiPrev)) + dt2 * phiAcc;
     if (fluctuate) {  // §3.2.3: a random turn, the most at the tip
       const double scale = fluctuation_ * double(j + 1) / double(k);
       theta += scale * (2.0 * counterUniform(seed_, s, kFluctuationKey ^ block, 2 * j) - 1.0);
@@ -315,50 +392,70 @@ void AnjyoHair::stepStrand(size_t s, const AccelerationField& field, double dt, 
     turn(nst, nct, theta - theta0);
     turn(nsp, ncp, phi - phi0);
     glm::dvec3 placed = nct * (ncp * basis.rest + nsp * basis.side) + nst * basis.pole;
-    bool adjusted = false;
-    // Out of every collision shape (no deeper than the node sat at rest), then the joint angle at the
-    // node before this segment at most JointAngleLimit (or the rest's turn, §3.2.3). Where the two
-    // disagree the limit wins: a hair does not kink to stay out.
-    for (int pass = 0; pass < 3; ++pass) {
-      bool moved = false;
-      for (size_t c2 = 0; c2 < shapes_.size(); ++c2) {
-        if (!(shapes_[c2].penalty > 0.0)) continue;  // a shape without penalty does not collide, as in grow
-        const glm::dvec3 next = node + d * placed, v = next - shapes_[c2].centre;
-        if (glm::dot(v, v) >= shapeReach2_[c2] || !shapeTests_[c2].mayBeInside(v)) continue;
-        const double allowedDepth = std::max(restDepth_[c2][p0 + j + 1], 0.0);
-        if (penetration(shapes_[c2], next) <= allowedDepth + 1e-9) continue;
-        placed = turnOut(shapes_[c2], node, placed, d, allowedDepth);
-        moved = true;
-      }
-      const double cosTurn = glm::dot(newBefore, placed);
-      if (cosTurn < segment.cosAllowed - 1e-12) {
-        glm::dvec3 side = placed - cosTurn * newBefore;
-        const double len = glm::length(side);
-        side = len > 1e-12 ? side / len : basis.pole;
-        placed = segment.cosAllowed * newBefore + segment.sinAllowed * side;
-        moved = true;
-      }
-      adjusted = adjusted || moved;
-      if (!moved) break;
-    }
-    if (adjusted) anglesNear(basis, placed, theta, phi, nst, nct, nsp, ncp);
-    state[kThetaPrev] = theta0;
-    state[kPhiPrev] = phi0;
-    state[kTheta] = theta;
-    state[kPhi] = phi;
-    state[kSinTheta] = nst;
-    state[kCosTheta] = nct;
-    state[kSinPhi] = nsp;
-    state[kCosPhi] = ncp;
+    settle(i, p0 + j + 1, node, newBefore, placed, theta, phi, nst, nct, nsp, ncp);
+    value(kThetaPrev) = theta0;
+    value(kPhiPrev) = phi0;
+    value(kTheta) = theta;
+    value(kPhi) = phi;
+    value(kSinTheta) = nst;
+    value(kCosTheta) = nct;
+    value(kSinPhi) = nsp;
+    value(kCosPhi) = ncp;
     node += d * (nct * (ncp * basis.rest + nsp * basis.side) + nst * basis.pole);
     newBefore = placed;
   }
 }
 
-glm::dvec3 AnjyoHair::directionOf(size_t i) const {
-  const SegmentFrame& b = segments_[i].frame;
-  const double* v = &state_[kStateValues * i];
-  return v[kCosTheta] * (v[kCosPhi] * b.rest + v[kSinPhi] * b.side) + v[kSinTheta] * b.pole;
+bool AnjyoHair::settle(size_t i, size_t nodeIndex, const glm::dvec3& node, const glm::dvec3& before,
+                       glm::dvec3& placed, double& theta, double& phi, double& st, double& ct, double& sp,
+                       double& cp) const {
+  const Segment& segment = segments_[i];
+  const double d = segment.length;
+  bool adjusted = false;
+  // Out of every collision shape (no deeper than the node sat at rest), then the joint angle at the
+  // node before this segment at most JointAngleLimit (or the rest's turn, §3.2.3). Where the two
+  // disagree the limit wins: a hair does not kink to stay out.
+  for (int pass = 0; pass < 3; ++pass) {
+    bool moved = false;
+    for (size_t c = 0; c < shapes_.size(); ++c) {
+      if (!(shapes_[c].penalty > 0.0)) continue;  // a shape without penalty does not collide, as in grow
+      const glm::dvec3 next = node + d * placed, v = next - shapes_[c].centre;
+      if (glm::dot(v, v) >= shapeReach2_[c] || !shapeTests_[c].mayBeInside(v)) continue;
+      const double allowedDepth = std::max(restDepth_[c][nodeIndex], 0.0);
+      if (penetration(shapes_[c], next) <= allowedDepth + 1e-9) continue;
+      placed = turnOut(shapes_[c], node, placed, d, allowedDepth);
+      moved = true;
+    }
+    const double cosTurn = glm::dot(before, placed);
+    if (cosTurn < segment.cosAllowed - 1e-12) {
+      glm::dvec3 side = placed - cosTurn * before;
+      const double len = glm::length(side);
+      side = len > 1e-12 ? side / len : segment.frame.pole;
+      placed = segment.cosAllowed * before + segment.sinAllowed * side;
+      moved = true;
+    }
+    adjusted = adjusted || moved;
+    if (!moved) break;
+  }
+  if (adjusted) anglesNear(segment.frame, placed, theta, phi, st, ct, sp, cp);
+  return adjusted;
+}
+
+glm::dvec3 AnjyoHair::directionOf(size_t s, uint32_t j) const {
+  const SegmentFrame& b = segments_[firstSegment_[s] + j].frame;
+  const double* v = &state_[stateAt(s, j)];
+  return v[kCosTheta * kLanes] * (v[kCosPhi * kLanes] * b.rest + v[kSinPhi * kLanes] * b.side) +
+         v[kSinTheta * kLanes] * b.pole;
+}
+
+std::array<double, AnjyoHair::kStateValues> AnjyoHair::segmentState(size_t s, uint32_t j) const {
+  std::array<double, kStateValues> out;
+  for (size_t v = 0; v < kStateValues; ++v) out[v] = state_[stateAt(s, j) + v * kLanes];
+  return out;
+}
+
+void AnjyoHair::setSegmentState(size_t s, uint32_t j, const std::array<double, kStateValues>& values) {
+  for (size_t v = 0; v < kStateValues; ++v) state_[stateAt(s, j) + v * kLanes] = values[v];
 }
 
 std::vector<glm::dvec3> AnjyoHair::nodes() const {
@@ -369,7 +466,7 @@ std::vector<glm::dvec3> AnjyoHair::nodes() const {
     out[p0] = node;
     for (uint32_t j = 0; j < k; ++j) {
       const size_t i = first + j;
-      node += segments_[i].length * directionOf(i);
+      node += segments_[i].length * directionOf(s, j);
       out[p0 + j + 1] = node;
     }
   });
@@ -382,8 +479,14 @@ Strands AnjyoHair::posed(const Pose& pose) const {
   return out;
 }
 
-void AnjyoHair::posedInto(const Pose& pose, Strands& out) const {
+void AnjyoHair::posedInto(const Pose& pose, Strands& out, Kernel kernel) const {
   out.assignRestKeepingBuffers(rest_);  // every attribute but the points and tangents is the rest's
+  if (kernel != Kernel::kStrands) {
+    const bool wide = kernel != Kernel::kLanes && hasWideLanes();
+    tbb::parallel_for(size_t(0), blockFirst_.size() - 1,
+                      [&](size_t b) { poseLanes(b * kLanes, pose, out, wide); });
+    return;
+  }
   const bool still = pose.isIdentity();
   tbb::parallel_for(size_t(0), rest_.strandCount(), [&](size_t s) {
     const uint32_t p0 = rest_.firstPoint[s], first = firstSegment_[s], k = firstSegment_[s + 1] - first;
@@ -393,9 +496,9 @@ void AnjyoHair::posedInto(const Pose& pose, Strands& out) const {
       const uint32_t p = p0 + j;
       if (j > 0) node += segments_[first + j - 1].length * dir;
       if (j < k) {  // the segment the point starts (the last point takes the last segment's)
-        const double* v = &state_[kStateValues * (first + j)];
-        dir = directionOf(first + j);
-        moved = v[kTheta] != 0.0 || v[kPhi] != 0.0;
+        const double* v = &state_[stateAt(s, j)];
+        dir = directionOf(s, j);
+        moved = v[kTheta * kLanes] != 0.0 || v[kPhi * kLanes] != 0.0;
       }
       // The input point plus the motion: at rest exactly the input.
       out.points[p] = glm::vec3(pose.apply(glm::dvec3(restPoints_[p]) + (node - restForward_[p])));
@@ -408,10 +511,16 @@ void AnjyoHair::posedInto(const Pose& pose, Strands& out) const {
 }
 
 void AnjyoHair::restore(const std::vector<double>& state, const std::string& source) {
+  if (state.size() < kStateHeader || state[0] != kStateTag || state[1] != double(kLanes) ||
+      state[2] != double(kStateValues))
+    throw InputError({source, 0},
+                     "its simulation state is not in the layout this hairgen keeps (an earlier "
+                     "version, or another model's); simulate from the first frame");
   if (state.size() != state_.size())
-    throw InputError({source, 0}, "its simulation state has " + std::to_string(state.size() / kStateValues) +
-                                      " segments, the guides " + std::to_string(segments_.size()) +
-                                      "; restart from a frame of the same guides");
+    throw InputError({source, 0}, "its simulation state is for other guides (" +
+                                      std::to_string(state.size()) + " values, these need " +
+                                      std::to_string(state_.size()) +
+                                      "); restart from a frame of the same guides");
   for (double v : state)
     if (!std::isfinite(v)) throw InputError({source, 0}, "its simulation state holds a non-finite value");
   state_ = state;

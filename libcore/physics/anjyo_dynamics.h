@@ -31,6 +31,7 @@
 //   rest, and sink as deep into a shape as it sat at rest, so the styled shape is always allowed.
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <vector>
 
@@ -56,34 +57,70 @@ class AnjyoHair {
   AnjyoHair(const Strands& rest, const Hairstyle& style, const Dynamics& dynamics, const Collision& collision,
             uint64_t seed);
 
+  // How a step is computed; each gives the same bits. kStrands: strand by strand. kLanes: kLanes strands
+  // at a time in vectors (2 doubles wide on any x86-64), kWideLanes: the same with AVX-512 (8 wide), where
+  // the processor has it (else kLanes); the lanes fall back to the strand's arithmetic where a segment
+  // meets a shape or its joint limit, and for the frames that draw fluctuations. kFastest: kWideLanes.
+  enum class Kernel { kFastest, kStrands, kLanes, kWideLanes };
+  static constexpr size_t kLanes = 8;  // strands a vector step takes at once
+
   // One substep of `dt` seconds for every strand (in parallel; the result does not depend on the
-  // thread count). `frame` and `firstSubstep` key the fluctuations, drawn at the first substep of every
-  // Fluctuation-th frame.
-  void step(const AccelerationField& field, double dt, int frame, bool firstSubstep);
+  // thread count or the kernel). `frame` and `firstSubstep` key the fluctuations, drawn at the first
+  // substep of every Fluctuation-th frame.
+  void step(const AccelerationField& field, double dt, int frame, bool firstSubstep,
+            Kernel kernel = Kernel::kFastest);
+
+  // step(), then posedInto(pose, out), in one pass over the hair where the kernel allows (the lanes):
+  // the same bits, the hair read once.
+  void stepAndPose(const AccelerationField& field, double dt, int frame, bool firstSubstep, const Pose& pose,
+                   Strands& out, Kernel kernel = Kernel::kFastest);
 
   // The current hair in world coordinates: the head frame moved by `pose`. Points at rest are the input
   // points exactly; tangents are the input's, turned with their segment.
   Strands posed(const Pose& pose) const;
-  void posedInto(const Pose& pose, Strands& out) const;  // the same into `out`, reusing its arrays
+  // The same into `out`, reusing its arrays (any kernel gives the same bits).
+  void posedInto(const Pose& pose, Strands& out, Kernel kernel = Kernel::kFastest) const;
 
-  // What a restart needs, kStateValues doubles per segment: θ, φ, the previous substep's θ, φ, and the
+  // What a restart needs, kStateValues values per segment: θ, φ, the previous substep's θ, φ, and the
   // sin and cos of θ and φ as the steps carried them (turned by each step's increment, not recomputed,
-  // so a resumed run computes exactly what the unbroken one did); and the inverse. The hair keeps its
-  // state in this layout, so `swapState` can lend it to a frame's cache without a copy: swap it out,
-  // write the cache, swap it back (stepping in between is an error).
-  static constexpr size_t kStateValues = 8;
+  // so a resumed run computes exactly what the unbroken one did). Laid out as the vector step reads it:
+  // a header of kStateHeader values (kStateTag, kLanes, kStateValues, then zeros), then per block of
+  // kLanes strands, per segment, per value, the block's lanes (a lane past its strand's end holds the
+  // rest state). The hair keeps its state in this layout, so `swapState` lends it to a frame's cache
+  // without a copy: swap it out, write the cache, swap it back (stepping in between is an error).
+  static constexpr size_t kStateValues = 8, kStateHeader = 8;
+  static constexpr double kStateTag = 0x414e4a32;  // "ANJ2": a state of this layout
   std::vector<double> state() const { return state_; }
   void stateInto(std::vector<double>& out) const { out = state_; }
   void swapState(std::vector<double>& other) { state_.swap(other); }
   void restore(const std::vector<double>& state, const std::string& source);
+  // One segment's values (θ, φ, the previous θ, φ, sin θ, cos θ, sin φ, cos φ), and setting them.
+  std::array<double, kStateValues> segmentState(size_t strand, uint32_t j) const;
+  void setSegmentState(size_t strand, uint32_t j, const std::array<double, kStateValues>& values);
 
   size_t segmentCount() const { return segments_.size(); }
   // Diagnostics for tests: every node's position (head frame), and each joint's turn in radians.
   std::vector<glm::dvec3> nodes() const;
 
  private:
+  bool fluctuates(int frame, bool firstSubstep) const;  // whether this substep draws the fluctuations
   void stepStrand(size_t strand, const AccelerationField& field, double dt, int frame, bool fluctuate);
-  glm::dvec3 directionOf(size_t segment) const;  // from the carried sin and cos
+  // The substep of the block of kLanes strands from s0 (anjyo_lanes.cpp): stepStrand's arithmetic lane by
+  // lane, bit for bit, in vectors; `wide` with AVX-512.
+  void stepLanes(size_t s0, const AccelerationField& field, double dt, bool wide, const Pose* pose = nullptr,
+                 Strands* out = nullptr);
+  void poseLanes(size_t s0, const Pose& pose, Strands& out, bool wide) const;  // posedInto's, the same way
+  // The new direction `placed` of segment i, from `node` (point nodeIndex − 1) after `before`: out of the
+  // collision shapes and within the joint limit; where it moved, the angles and their sin and cos are
+  // read off it. Returns whether it moved.
+  bool settle(size_t i, size_t nodeIndex, const glm::dvec3& node, const glm::dvec3& before,
+              glm::dvec3& placed, double& theta, double& phi, double& st, double& ct, double& sp,
+              double& cp) const;
+  glm::dvec3 directionOf(size_t strand, uint32_t j) const;  // segment j's, from the carried sin and cos
+  // Where segment j of `strand` keeps its first value in state_; value v is kLanes further on per v.
+  size_t stateAt(size_t strand, uint32_t j) const {
+    return kStateHeader + ((blockFirst_[strand / kLanes] + j) * kStateValues) * kLanes + strand % kLanes;
+  }
 
   // What a step reads of a segment, together: its frame (README, Dynamics), d_i, c_i u_i m_i (1/m),
   // ω² / c_i (the rest spring as an acceleration), and the turn allowed at the node before it (cos −2
@@ -94,6 +131,23 @@ class AnjyoHair {
   };
   // The state's values of a segment, in the restart layout.
   enum StateValue { kTheta, kPhi, kThetaPrev, kPhiPrev, kSinTheta, kCosTheta, kSinPhi, kCosPhi };
+
+  // Segment j of a block of kLanes consecutive strands, lane by lane (a lane past its strand's last
+  // segment holds zeros): what stepLanes reads of the segments, laid out for its vectors.
+  struct Lanes;  // anjyo_lanes.cpp
+  struct LaneSegment {
+    double rest[3][kLanes], pole[3][kLanes], side[3][kLanes];
+    double length[kLanes], coefficient[kLanes], springOverC[kLanes], cosAllowed[kLanes];
+  };
+  std::vector<LaneSegment> lanes_;
+  std::vector<size_t> blockFirst_;  // per block, its first LaneSegment, + 1
+  // Point j of a block's strands, lane by lane (a lane past its strand's last point repeats it): the
+  // input point, the rest node and the input tangent that posing starts from. Block b's points start
+  // at blockFirst_[b] + b (one more point than segments per block).
+  struct LanePoint {
+    double point[3][kLanes], forward[3][kLanes], tangent[3][kLanes];
+  };
+  std::vector<LanePoint> lanePoints_;
 
   Strands rest_;  // every attribute of the rest guides but their points and tangents
   std::vector<glm::vec3> restPoints_;
