@@ -7,6 +7,7 @@
 
 #include <tbb/parallel_for.h>
 
+#include "libcore/physics/anjyo_turn.h"
 #include "libcore/physics/strand_energy.h"
 #include "libcore/util/error.h"
 #include "libcore/util/random.h"
@@ -31,14 +32,12 @@ SegmentFrame frameFor(const glm::dvec3& rest) {
   return {rest, pole, glm::cross(pole, rest)};
 }
 
-// sin and cos of a + δ from those of a: for the small turns of a step by a series (exact to rounding
-// below 0.02 rad), else by the library; what every step does instead of two new sin/cos pairs.
+// sin and cos of a + δ from those of a: for the turns of a step by a series (anjyo_turn.h), beyond its
+// reach by the library; what every step does instead of two new sin/cos pairs.
 inline void turn(double& s, double& c, double delta) {
   double sd, cd;
-  if (std::abs(delta) < 0.02) {
-    const double d2 = delta * delta;
-    sd = delta * (1.0 - d2 / 6.0 * (1.0 - d2 / 20.0 * (1.0 - d2 / 42.0)));
-    cd = 1.0 - d2 / 2.0 * (1.0 - d2 / 12.0 * (1.0 - d2 / 30.0));
+  if (std::abs(delta) < kTurnSeriesReach) {
+    turnSeries(delta, sd, cd);
   } else {
     sd = std::sin(delta);
     cd = std::cos(delta);

@@ -8,6 +8,7 @@
 #include <optional>
 
 #include "libcore/physics/anjyo_dynamics.h"
+#include "libcore/physics/anjyo_turn.h"
 
 namespace hairgen {
 
@@ -110,13 +111,12 @@ HAIRGEN_LANE Vm deeperThanAtRest(const CollisionShape& shape, const V3& v, const
   return !(inside <= allowed + 1e-9);
 }
 
-// anjyo_dynamics.cpp's turn(): sin and cos of a + δ from those of a, the series below 0.02 rad; a lane
-// beyond it is marked in `big` for the library's sin and cos.
-HAIRGEN_LANE void turnSeries(Vd& s, Vd& c, Vd delta, Vm& big) {
-  const Vd d2 = delta * delta;
-  const Vd sd = delta * (1.0 - d2 / 6.0 * (1.0 - d2 / 20.0 * (1.0 - d2 / 42.0)));
-  const Vd cd = 1.0 - d2 / 2.0 * (1.0 - d2 / 12.0 * (1.0 - d2 / 30.0));
-  big = !(abs(delta) < 0.02);
+// anjyo_dynamics.cpp's turn(): sin and cos of a + δ from those of a, by the series within its reach;
+// a lane beyond it is marked in `big` for the library's sin and cos.
+HAIRGEN_LANE void turnLanes(Vd& s, Vd& c, Vd delta, Vm& big) {
+  Vd sd, cd;
+  turnSeries(delta, sd, cd);
+  big = !(abs(delta) < kTurnSeriesReach);
   const Vd s2 = s * cd + c * sd;
   c = c * cd - s * sd;
   s = s2;
@@ -315,8 +315,8 @@ void AnjyoHair::Lanes::step(AnjyoHair& hair, size_t s0, const AccelerationField&
     Vd phi = phi0 + keep * (phi0 - phiPrev) + dt2 * phiAcc;
     Vd nst = st, nct = ct, nsp = sp, ncp = cp;
     Vm bigTheta, bigPhi;
-    turnSeries(nst, nct, theta - theta0, bigTheta);
-    turnSeries(nsp, ncp, phi - phi0, bigPhi);
+    turnLanes(nst, nct, theta - theta0, bigTheta);
+    turnLanes(nsp, ncp, phi - phi0, bigPhi);
     for (size_t l = 0; l < n; ++l) {
       if (bigTheta[l] && j < count[l]) {
         nst[l] = st[l];
