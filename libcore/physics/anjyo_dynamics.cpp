@@ -7,7 +7,7 @@
 
 #include <tbb/parallel_for.h>
 
-#include "libcore/physics/anjyo_turn.h"
+#include "libcore/physics/anjyo_sincos.h"
 #include "libcore/physics/strand_energy.h"
 #include "libcore/util/error.h"
 #include "libcore/util/random.h"
@@ -32,26 +32,9 @@ SegmentFrame frameFor(const glm::dvec3& rest) {
   return {rest, pole, glm::cross(pole, rest)};
 }
 
-// sin and cos of a + δ from those of a: for the turns of a step by a series (anjyo_turn.h), beyond its
-// reach by the library; what every step does instead of two new sin/cos pairs.
-inline void turn(double& s, double& c, double delta) {
-  double sd, cd;
-  if (std::abs(delta) < kTurnSeriesReach) {
-    turnSeries(delta, sd, cd);
-  } else {
-    sd = std::sin(delta);
-    cd = std::cos(delta);
-  }
-  const double s2 = s * cd + c * sd;
-  c = c * cd - s * sd;
-  s = s2;
-}
-
-// The (θ, φ) of unit `dir` nearest to a segment's previous angles, and their sin and cos (read off
-// `dir`, no more trigonometry): past the pole the same direction is (±π − θ, φ + π), and φ is
-// unwrapped, so the recurrences see no jump.
-void anglesNear(const SegmentFrame& b, const glm::dvec3& dir, double& theta, double& phi, double& st,
-                double& ct, double& sp, double& cp) {
+// The (θ, φ) of unit `dir` nearest to a segment's previous angles: past the pole the same direction is
+// (±π − θ, φ + π), and φ is unwrapped, so the recurrences see no jump.
+void anglesNear(const SegmentFrame& b, const glm::dvec3& dir, double& theta, double& phi) {
   const double sinLat = std::clamp(glm::dot(dir, b.pole), -1.0, 1.0);
   const double x = glm::dot(dir, b.rest), y = glm::dot(dir, b.side), h = std::hypot(x, y);
   const double lat = std::asin(sinLat), lon = h > 1e-12 ? std::atan2(y, x) : phi;
@@ -59,13 +42,8 @@ void anglesNear(const SegmentFrame& b, const glm::dvec3& dir, double& theta, dou
   const double t1 = lat, p1 = unwrap(lon);
   const double t2 = (lat >= 0.0 ? M_PI : -M_PI) - lat, p2 = unwrap(lon + M_PI);
   const bool first = std::abs(t1 - theta) + std::abs(p1 - phi) <= std::abs(t2 - theta) + std::abs(p2 - phi);
-  const double sign = first ? 1.0 : -1.0;  // the far branch flips cos θ and the longitude's direction
   theta = first ? t1 : t2;
   phi = first ? p1 : p2;
-  st = sinLat;
-  ct = sign * h;
-  cp = h > 1e-12 ? sign * x / h : std::cos(phi);
-  sp = h > 1e-12 ? sign * y / h : std::sin(phi);
 }
 
 // The gradient of a shape's inside-outside function at p: the ellipsoid's (the paper's D_i), the
@@ -174,16 +152,11 @@ AnjyoHair::AnjyoHair(const Strands& rest, const Hairstyle& style, const Dynamics
       most = std::max(most, firstSegment_[s + 1] - firstSegment_[s]);
     blockFirst_[b + 1] = blockFirst_[b] + most;
   }
-  // At rest every value is 0 but the cosines, 1.
+  // At rest every angle is 0.
   state_.assign(kStateHeader + blockFirst_.back() * kStateValues * kLanes, 0.0);
   state_[0] = kStateTag;
   state_[1] = double(kLanes);
   state_[2] = double(kStateValues);
-  for (size_t i = 0; i < blockFirst_.back(); ++i)
-    for (size_t l = 0; l < kLanes; ++l) {
-      state_[kStateHeader + (i * kStateValues + kCosTheta) * kLanes + l] = 1.0;
-      state_[kStateHeader + (i * kStateValues + kCosPhi) * kLanes + l] = 1.0;
-    }
   restForward_.resize(rest.pointCount());
   restTangents_ = tangentsOf(rest);
   // posedInto writes the points and tangents; the rest's are kept apart, so that handing every other
@@ -344,8 +317,10 @@ void AnjyoHair::stepStrand(size_t s, const AccelerationField& field, double dt, 
     const SegmentFrame& basis = segment.frame;
     double* state = &state_[stateAt(s, j)];  // value v at state[v * kLanes]
     auto value = [&](StateValue v) -> double& { return state[v * kLanes]; };
-    const double st = value(kSinTheta), ct = value(kCosTheta), sp = value(kSinPhi), cp = value(kCosPhi);
     const double theta0 = value(kTheta), phi0 = value(kPhi);
+    double st, ct, sp, cp;
+    sinCos(theta0, st, ct);
+    sinCos(phi0, sp, cp);
     const glm::dvec3 across = cp * basis.rest + sp * basis.side;  // the longitude's horizontal direction
     const glm::dvec3 dir = ct * across + st * basis.pole;
     const glm::dvec3 thetaDir = -st * across + ct * basis.pole, phiDir = -sp * basis.rest + cp * basis.side;
@@ -387,27 +362,25 @@ void AnjyoHair::stepStrand(size_t s, const AccelerationField& field, double dt, 
       theta += scale * (2.0 * counterUniform(seed_, s, kFluctuationKey ^ block, 2 * j) - 1.0);
       phi += scale * (2.0 * counterUniform(seed_, s, kFluctuationKey ^ block, 2 * j + 1) - 1.0);
     }
-    double nst = st, nct = ct, nsp = sp, ncp = cp;
-    turn(nst, nct, theta - theta0);
-    turn(nsp, ncp, phi - phi0);
+    double nst, nct, nsp, ncp;
+    sinCos(theta, nst, nct);
+    sinCos(phi, nsp, ncp);
     glm::dvec3 placed = nct * (ncp * basis.rest + nsp * basis.side) + nst * basis.pole;
-    settle(i, p0 + j + 1, node, newBefore, placed, theta, phi, nst, nct, nsp, ncp);
+    if (settle(i, p0 + j + 1, node, newBefore, placed, theta, phi)) {
+      sinCos(theta, nst, nct);
+      sinCos(phi, nsp, ncp);
+    }
     value(kThetaPrev) = theta0;
     value(kPhiPrev) = phi0;
     value(kTheta) = theta;
     value(kPhi) = phi;
-    value(kSinTheta) = nst;
-    value(kCosTheta) = nct;
-    value(kSinPhi) = nsp;
-    value(kCosPhi) = ncp;
     node += d * (nct * (ncp * basis.rest + nsp * basis.side) + nst * basis.pole);
     newBefore = placed;
   }
 }
 
 bool AnjyoHair::settle(size_t i, size_t nodeIndex, const glm::dvec3& node, const glm::dvec3& before,
-                       glm::dvec3& placed, double& theta, double& phi, double& st, double& ct, double& sp,
-                       double& cp) const {
+                       glm::dvec3& placed, double& theta, double& phi) const {
   const Segment& segment = segments_[i];
   const double d = segment.length;
   bool adjusted = false;
@@ -436,15 +409,17 @@ bool AnjyoHair::settle(size_t i, size_t nodeIndex, const glm::dvec3& node, const
     adjusted = adjusted || moved;
     if (!moved) break;
   }
-  if (adjusted) anglesNear(segment.frame, placed, theta, phi, st, ct, sp, cp);
+  if (adjusted) anglesNear(segment.frame, placed, theta, phi);
   return adjusted;
 }
 
 glm::dvec3 AnjyoHair::directionOf(size_t s, uint32_t j) const {
   const SegmentFrame& b = segments_[firstSegment_[s] + j].frame;
   const double* v = &state_[stateAt(s, j)];
-  return v[kCosTheta * kLanes] * (v[kCosPhi * kLanes] * b.rest + v[kSinPhi * kLanes] * b.side) +
-         v[kSinTheta * kLanes] * b.pole;
+  double st, ct, sp, cp;
+  sinCos(v[kTheta * kLanes], st, ct);
+  sinCos(v[kPhi * kLanes], sp, cp);
+  return ct * (cp * b.rest + sp * b.side) + st * b.pole;
 }
 
 std::array<double, AnjyoHair::kStateValues> AnjyoHair::segmentState(size_t s, uint32_t j) const {

@@ -81,20 +81,20 @@ class AnjyoHair {
   // The same into `out`, reusing its arrays (any kernel gives the same bits).
   void posedInto(const Pose& pose, Strands& out, Kernel kernel = Kernel::kFastest) const;
 
-  // What a restart needs, kStateValues values per segment: θ, φ, the previous substep's θ, φ, and the
-  // sin and cos of θ and φ as the steps carried them (turned by each step's increment, not recomputed,
-  // so a resumed run computes exactly what the unbroken one did). Laid out as the vector step reads it:
-  // a header of kStateHeader values (kStateTag, kLanes, kStateValues, then zeros), then per block of
-  // kLanes strands, per segment, per value, the block's lanes (a lane past its strand's end holds the
-  // rest state). The hair keeps its state in this layout, so `swapState` lends it to a frame's cache
-  // without a copy: swap it out, write the cache, swap it back (stepping in between is an error).
-  static constexpr size_t kStateValues = 8, kStateHeader = 8;
-  static constexpr double kStateTag = 0x414e4a32;  // "ANJ2": a state of this layout
+  // What a restart needs, kStateValues values per segment: θ and φ, and the previous substep's (their sin
+  // and cos are computed from them by arithmetic alone, anjyo_sincos.h, so a resumed run computes
+  // exactly what the unbroken one did). Laid out as the vector step reads it: a header of kStateHeader
+  // values (kStateTag, kLanes, kStateValues, then zeros), then per block of kLanes strands, per
+  // segment, per value, the block's lanes (a lane past its strand's end holds the rest state, zeros).
+  // The hair keeps its state in this layout, so `swapState` lends it to a frame's cache without a copy:
+  // swap it out, write the cache, swap it back (stepping in between is an error).
+  static constexpr size_t kStateValues = 4, kStateHeader = 8;
+  static constexpr double kStateTag = 0x414e4a33;  // "ANJ3": a state of this layout
   std::vector<double> state() const { return state_; }
   void stateInto(std::vector<double>& out) const { out = state_; }
   void swapState(std::vector<double>& other) { state_.swap(other); }
   void restore(const std::vector<double>& state, const std::string& source);
-  // One segment's values (θ, φ, the previous θ, φ, sin θ, cos θ, sin φ, cos φ), and setting them.
+  // One segment's values (θ, φ, the previous θ, φ), and setting them.
   std::array<double, kStateValues> segmentState(size_t strand, uint32_t j) const;
   void setSegmentState(size_t strand, uint32_t j, const std::array<double, kStateValues>& values);
 
@@ -111,12 +111,11 @@ class AnjyoHair {
                  Strands* out = nullptr);
   void poseLanes(size_t s0, const Pose& pose, Strands& out, bool wide) const;  // posedInto's, the same way
   // The new direction `placed` of segment i, from `node` (point nodeIndex − 1) after `before`: out of the
-  // collision shapes and within the joint limit; where it moved, the angles and their sin and cos are
-  // read off it. Returns whether it moved.
+  // collision shapes and within the joint limit; where it moved, the angles are read off it. Returns
+  // whether it moved.
   bool settle(size_t i, size_t nodeIndex, const glm::dvec3& node, const glm::dvec3& before,
-              glm::dvec3& placed, double& theta, double& phi, double& st, double& ct, double& sp,
-              double& cp) const;
-  glm::dvec3 directionOf(size_t strand, uint32_t j) const;  // segment j's, from the carried sin and cos
+              glm::dvec3& placed, double& theta, double& phi) const;
+  glm::dvec3 directionOf(size_t strand, uint32_t j) const;  // segment j's, from its angles
   // Where segment j of `strand` keeps its first value in state_; value v is kLanes further on per v.
   size_t stateAt(size_t strand, uint32_t j) const {
     return kStateHeader + ((blockFirst_[strand / kLanes] + j) * kStateValues) * kLanes + strand % kLanes;
@@ -130,7 +129,7 @@ class AnjyoHair {
     double length, coefficient, springOverC, cosAllowed, sinAllowed;
   };
   // The state's values of a segment, in the restart layout.
-  enum StateValue { kTheta, kPhi, kThetaPrev, kPhiPrev, kSinTheta, kCosTheta, kSinPhi, kCosPhi };
+  enum StateValue { kTheta, kPhi, kThetaPrev, kPhiPrev };
 
   // Segment j of a block of kLanes consecutive strands, lane by lane (a lane past its strand's last
   // segment holds zeros): what stepLanes reads of the segments, laid out for its vectors.

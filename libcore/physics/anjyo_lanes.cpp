@@ -8,7 +8,7 @@
 #include <optional>
 
 #include "libcore/physics/anjyo_dynamics.h"
-#include "libcore/physics/anjyo_turn.h"
+#include "libcore/physics/anjyo_sincos.h"
 
 namespace hairgen {
 
@@ -109,23 +109,6 @@ HAIRGEN_LANE Vm deeperThanAtRest(const CollisionShape& shape, const V3& v, const
   for (size_t l = 0; l < AnjyoHair::kLanes; ++l)
     allowed[l] = node <= count[l] ? std::max(depth[p0[l] + node], 0.0) : 0.0;
   return !(inside <= allowed + 1e-9);
-}
-
-// anjyo_dynamics.cpp's turn(): sin and cos of a + δ from those of a, by the series within its reach;
-// a lane beyond it is marked in `big` for the library's sin and cos.
-HAIRGEN_LANE void turnLanes(Vd& s, Vd& c, Vd delta, Vm& big) {
-  Vd sd, cd;
-  turnSeries(delta, sd, cd);
-  big = !(abs(delta) < kTurnSeriesReach);
-  const Vd s2 = s * cd + c * sd;
-  c = c * cd - s * sd;
-  s = s2;
-}
-HAIRGEN_LANE void turnLane(double& s, double& c, double delta) {
-  const double sd = std::sin(delta), cd = std::cos(delta);
-  const double s2 = s * cd + c * sd;
-  c = c * cd - s * sd;
-  s = s2;
 }
 
 }  // namespace
@@ -236,8 +219,10 @@ void AnjyoHair::Lanes::pose(const AnjyoHair& hair, size_t s0, const Pose& pose, 
       Vm here;  // a lane past its strand's last segment keeps the last one's
       for (size_t l = 0; l < n; ++l) here[l] = j < count[l] ? -1 : 0;
       const V3 rest = load(segment.rest);
-      const V3 now = value(kCosTheta) * (value(kCosPhi) * rest + value(kSinPhi) * load(segment.side)) +
-                     value(kSinTheta) * load(segment.pole);
+      Vd st, ct, sp, cp;
+      sinCos(value(kTheta), st, ct);
+      sinCos(value(kPhi), sp, cp);
+      const V3 now = ct * (cp * rest + sp * load(segment.side)) + st * load(segment.pole);
       writer.segment(here, now, rest, value(kTheta), value(kPhi));
     }
     writer.point(j, node);
@@ -273,9 +258,11 @@ void AnjyoHair::Lanes::step(AnjyoHair& hair, size_t s0, const AccelerationField&
     // The block's state for segment j: each value a vector of the lanes (anjyo_dynamics.h, state()).
     double* state = &hair.state_[kStateHeader + (hair.blockFirst_[block] + j) * kStateValues * n];
     auto value = [&](StateValue v) { return loadLanes(state + v * n); };
-    const Vd st = value(kSinTheta), ct = value(kCosTheta), sp = value(kSinPhi), cp = value(kCosPhi);
     const Vd theta0 = value(kTheta), phi0 = value(kPhi), thetaPrev = value(kThetaPrev),
              phiPrev = value(kPhiPrev);
+    Vd st, ct, sp, cp;
+    sinCos(theta0, st, ct);
+    sinCos(phi0, sp, cp);
     Vm active;  // lanes whose strand has segment j; the others keep their rest state
     for (size_t l = 0; l < n; ++l) active[l] = j < count[l] ? -1 : 0;
     const V3 rest = load(segment.rest), pole = load(segment.pole), side = load(segment.side);
@@ -313,22 +300,9 @@ void AnjyoHair::Lanes::step(AnjyoHair& hair, size_t s0, const AccelerationField&
     const Vd phiAcc = c * ct * dot(push, phiDir);
     Vd theta = theta0 + keep * (theta0 - thetaPrev) + dt2 * thetaAcc;
     Vd phi = phi0 + keep * (phi0 - phiPrev) + dt2 * phiAcc;
-    Vd nst = st, nct = ct, nsp = sp, ncp = cp;
-    Vm bigTheta, bigPhi;
-    turnLanes(nst, nct, theta - theta0, bigTheta);
-    turnLanes(nsp, ncp, phi - phi0, bigPhi);
-    for (size_t l = 0; l < n; ++l) {
-      if (bigTheta[l] && j < count[l]) {
-        nst[l] = st[l];
-        nct[l] = ct[l];
-        turnLane(nst[l], nct[l], theta[l] - theta0[l]);
-      }
-      if (bigPhi[l] && j < count[l]) {
-        nsp[l] = sp[l];
-        ncp[l] = cp[l];
-        turnLane(nsp[l], ncp[l], phi[l] - phi0[l]);
-      }
-    }
+    Vd nst, nct, nsp, ncp;
+    sinCos(theta, nst, nct);
+    sinCos(phi, nsp, ncp);
     V3 placed = nct * (ncp * rest + nsp * side) + nst * pole;
     // Which lanes may meet a shape or their joint limit: those go through the strand's own code (which
     // finds, as here, that nothing moves where nothing reaches).
@@ -351,22 +325,25 @@ void AnjyoHair::Lanes::step(AnjyoHair& hair, size_t s0, const AccelerationField&
       }
       check = check || maybe;
     }
+    bool settled = false;
     for (size_t l = 0; l < n; ++l) {
       if (!check[l] || j >= count[l]) continue;
       glm::dvec3 placedLane = lane(placed, l);
       if (hair.settle(first[l] + j, p0[l] + j + 1, lane(node, l), lane(newBefore, l), placedLane, theta[l],
-                      phi[l], nst[l], nct[l], nsp[l], ncp[l]))
+                      phi[l])) {
         setLane(placed, l, placedLane);
+        settled = true;
+      }
+    }
+    if (settled) {  // the moved lanes' new angles (the others' give the same values again)
+      sinCos(theta, nst, nct);
+      sinCos(phi, nsp, ncp);
     }
     auto store = [&](StateValue v, Vd to) { storeLanes(state + v * n, select(active, to, value(v))); };
     store(kThetaPrev, theta0);
     store(kPhiPrev, phi0);
     store(kTheta, theta);
     store(kPhi, phi);
-    store(kSinTheta, nst);
-    store(kCosTheta, nct);
-    store(kSinPhi, nsp);
-    store(kCosPhi, ncp);
     const V3 now = nct * (ncp * rest + nsp * side) + nst * pole;
     if (writer) {
       writer->segment(active, now, rest, theta, phi);
