@@ -7,6 +7,7 @@
 #include <tbb/global_control.h>
 #include <cmath>
 #include <cstring>
+#include <functional>
 
 #include "libcore/physics/anjyo_dynamics.h"
 #include "libcore/physics/anjyo_sincos.h"
@@ -359,6 +360,16 @@ TEST(Simulate, ThreadsAndRestartsChangeNoBit) {
   ASSERT_EQ(second.size(), 8u);
   for (size_t i = 0; i < 8; ++i) EXPECT_TRUE(second[i] == one[8 + i]) << "frame " << 9 + i;
   EXPECT_THROW(run(1, {9, 16}, &one[6]), InputError);  // frame 7 is not the frame before 9
+  // A state it cannot read is refused, not stepped: another layout (an older hairgen's), a non-finite
+  // angle, an angle past any shot's.
+  for (auto spoil : std::vector<std::function<void(std::vector<double>&)>>{
+           [](std::vector<double>& v) { v[0] = 0x414e4a32; },
+           [](std::vector<double>& v) { v.back() = std::nan(""); },
+           [](std::vector<double>& v) { v.back() = 1e6; }}) {
+    Strands spoiled = one[7];
+    spoil(spoiled.simulationState);
+    EXPECT_THROW(run(1, {9, 16}, &spoiled), InputError);
+  }
 }
 
 }  // namespace

@@ -495,8 +495,12 @@ void AnjyoHair::restore(const std::vector<double>& state, const std::string& sou
                                       std::to_string(state.size()) + " values, these need " +
                                       std::to_string(state_.size()) +
                                       "); restart from a frame of the same guides");
-  for (double v : state)
-    if (!std::isfinite(v)) throw InputError({source, 0}, "its simulation state holds a non-finite value");
+  // Angles beyond kMaxAngle are not a shot's (16,000 turns) and past where sinCos is exact.
+  for (size_t i = kStateHeader; i < state.size(); ++i)
+    if (!(std::abs(state[i]) <= kMaxAngle))
+      throw InputError({source, 0}, "its simulation state holds an angle that is not finite or beyond " +
+                                        std::to_string(int(kMaxAngle)) +
+                                        " rad; simulate from the first frame");
   state_ = state;
 }
 

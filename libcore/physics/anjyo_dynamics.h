@@ -90,6 +90,7 @@ class AnjyoHair {
   // swap it out, write the cache, swap it back (stepping in between is an error).
   static constexpr size_t kStateValues = 4, kStateHeader = 8;
   static constexpr double kStateTag = 0x414e4a33;  // "ANJ3": a state of this layout
+  static constexpr double kMaxAngle = 1e5;         // radians: the most a restart state may hold
   std::vector<double> state() const { return state_; }
   void stateInto(std::vector<double>& out) const { out = state_; }
   void swapState(std::vector<double>& other) { state_.swap(other); }
