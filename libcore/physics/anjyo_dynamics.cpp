@@ -17,10 +17,11 @@ namespace {
 
 constexpr uint64_t kFluctuationKey = 0x666c756374ull;  // "fluct": apart from every other stream
 
-// Whether this processor runs the lanes 8 wide (anjyo_lanes.cpp's `wide`).
-bool hasWideLanes() {
-  static const bool has = __builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512dq");
-  return has;
+// The kernel asked for, or the strands where this processor has no AVX-512 for the lanes.
+AnjyoHair::Kernel available(AnjyoHair::Kernel asked) {
+  static const bool avx512 = __builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512dq");
+  return asked != AnjyoHair::Kernel::kStrands && avx512 ? AnjyoHair::Kernel::kLanes
+                                                        : AnjyoHair::Kernel::kStrands;
 }
 
 SegmentFrame frameFor(const glm::dvec3& rest) {
@@ -280,27 +281,26 @@ bool AnjyoHair::fluctuates(int frame, bool firstSubstep) const {
 
 void AnjyoHair::stepAndPose(const AccelerationField& field, double dt, int frame, bool firstSubstep,
                             const Pose& pose, Strands& out, Kernel kernel) {
+  kernel = available(kernel);
   if (fluctuates(frame, firstSubstep) || kernel == Kernel::kStrands) {
     step(field, dt, frame, firstSubstep, kernel);
     posedInto(pose, out, kernel);
     return;
   }
   out.assignRestKeepingBuffers(rest_);
-  const bool wide = kernel != Kernel::kLanes && hasWideLanes();
   tbb::parallel_for(size_t(0), blockFirst_.size() - 1,
-                    [&](size_t b) { stepLanes(b * kLanes, field, dt, wide, &pose, &out); });
+                    [&](size_t b) { stepLanes(b * kLanes, field, dt, &pose, &out); });
 }
 
 void AnjyoHair::step(const AccelerationField& field, double dt, int frame, bool firstSubstep, Kernel kernel) {
   const bool fluctuate = fluctuates(frame, firstSubstep);
+  kernel = available(kernel);
   if (fluctuate || kernel == Kernel::kStrands) {
     tbb::parallel_for(size_t(0), rest_.strandCount(),
                       [&](size_t s) { stepStrand(s, field, dt, frame, fluctuate); });
     return;
   }
-  const bool wide = kernel != Kernel::kLanes && hasWideLanes();
-  tbb::parallel_for(size_t(0), blockFirst_.size() - 1,
-                    [&](size_t b) { stepLanes(b * kLanes, field, dt, wide); });
+  tbb::parallel_for(size_t(0), blockFirst_.size() - 1, [&](size_t b) { stepLanes(b * kLanes, field, dt); });
 }
 
 void AnjyoHair::stepStrand(size_t s, const AccelerationField& field, double dt, int frame, bool fluctuate) {
@@ -455,10 +455,9 @@ Strands AnjyoHair::posed(const Pose& pose) const {
 
 void AnjyoHair::posedInto(const Pose& pose, Strands& out, Kernel kernel) const {
   out.assignRestKeepingBuffers(rest_);  // every attribute but the points and tangents is the rest's
+  kernel = available(kernel);
   if (kernel != Kernel::kStrands) {
-    const bool wide = kernel != Kernel::kLanes && hasWideLanes();
-    tbb::parallel_for(size_t(0), blockFirst_.size() - 1,
-                      [&](size_t b) { poseLanes(b * kLanes, pose, out, wide); });
+    tbb::parallel_for(size_t(0), blockFirst_.size() - 1, [&](size_t b) { poseLanes(b * kLanes, pose, out); });
     return;
   }
   const bool still = pose.isIdentity();

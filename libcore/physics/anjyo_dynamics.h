@@ -58,10 +58,10 @@ class AnjyoHair {
             uint64_t seed);
 
   // How a step is computed; each gives the same bits. kStrands: strand by strand. kLanes: kLanes strands
-  // at a time in vectors (2 doubles wide on any x86-64), kWideLanes: the same with AVX-512 (8 wide), where
-  // the processor has it (else kLanes); the lanes fall back to the strand's arithmetic where a segment
-  // meets a shape or its joint limit, and for the frames that draw fluctuations. kFastest: kWideLanes.
-  enum class Kernel { kFastest, kStrands, kLanes, kWideLanes };
+  // at a time in AVX-512 vectors, where the processor has it (else kStrands), falling back to the
+  // strand's arithmetic where a segment meets a shape or its joint limit, and for the frames that draw
+  // fluctuations. kFastest: kLanes.
+  enum class Kernel { kFastest, kStrands, kLanes };
   static constexpr size_t kLanes = 8;  // strands a vector step takes at once
 
   // One substep of `dt` seconds for every strand (in parallel; the result does not depend on the
@@ -107,10 +107,10 @@ class AnjyoHair {
   bool fluctuates(int frame, bool firstSubstep) const;  // whether this substep draws the fluctuations
   void stepStrand(size_t strand, const AccelerationField& field, double dt, int frame, bool fluctuate);
   // The substep of the block of kLanes strands from s0 (anjyo_lanes.cpp): stepStrand's arithmetic lane by
-  // lane, bit for bit, in vectors; `wide` with AVX-512.
-  void stepLanes(size_t s0, const AccelerationField& field, double dt, bool wide, const Pose* pose = nullptr,
+  // lane, bit for bit, in AVX-512 vectors (the processor must have it).
+  void stepLanes(size_t s0, const AccelerationField& field, double dt, const Pose* pose = nullptr,
                  Strands* out = nullptr);
-  void poseLanes(size_t s0, const Pose& pose, Strands& out, bool wide) const;  // posedInto's, the same way
+  void poseLanes(size_t s0, const Pose& pose, Strands& out) const;  // posedInto's, the same way
   // The new direction `placed` of segment i, from `node` (point nodeIndex − 1) after `before`: out of the
   // collision shapes and within the joint limit; where it moved, the angles are read off it. Returns
   // whether it moved.

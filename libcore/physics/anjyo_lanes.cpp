@@ -1,5 +1,5 @@
-// Anjyo et al. 1992 §3, the substep of anjyo_dynamics.cpp for kLanes strands at once: the same
-// operations in the same order on each lane, so every lane's bits are stepStrand's (IEEE arithmetic and
+// Anjyo et al. 1992 §3, the substep of anjyo_dynamics.cpp for kLanes strands at once (AVX2 or AVX-512): the
+// same operations in the same order on each lane, so every lane's bits are stepStrand's (IEEE arithmetic and
 // square roots are exact per lane; this file is built without contraction into fused multiply-adds).
 // What branches per segment (a segment that meets a collision shape or its joint limit, a turn too
 // large for the series) is done lane by lane with the strand's own code.
@@ -118,37 +118,27 @@ struct AnjyoHair::Lanes {
   HAIRGEN_LANE static void step(AnjyoHair& hair, size_t s0, const AccelerationField& field, double dt,
                                 const Pose* pose, Strands* out);
   HAIRGEN_LANE static void pose(const AnjyoHair& hair, size_t s0, const Pose& pose, Strands& out);
-  [[gnu::target("avx512f,avx512dq")]] static void wide(AnjyoHair& hair, size_t s0,
-                                                       const AccelerationField& field, double dt,
-                                                       const Pose* p, Strands* out) {
+  // The code built for AVX-512, the instruction set the lanes run on. (Built for AVX2, 8 lanes in pairs
+  // of 4, or for SSE2, it was measured slower than the strand-by-strand step: 82 and 87 ms of CPU a frame
+  // in SimulateAnjyo against 61.)
+  [[gnu::target("avx512f,avx512dq")]] static void stepAvx512(AnjyoHair& hair, size_t s0,
+                                                             const AccelerationField& field, double dt,
+                                                             const Pose* p, Strands* out) {
     step(hair, s0, field, dt, p, out);
   }
-  static void baseline(AnjyoHair& hair, size_t s0, const AccelerationField& field, double dt, const Pose* p,
-                       Strands* out) {
-    step(hair, s0, field, dt, p, out);
-  }
-  [[gnu::target("avx512f,avx512dq")]] static void widePose(const AnjyoHair& hair, size_t s0, const Pose& p,
-                                                           Strands& out) {
-    pose(hair, s0, p, out);
-  }
-  static void baselinePose(const AnjyoHair& hair, size_t s0, const Pose& p, Strands& out) {
+  [[gnu::target("avx512f,avx512dq")]] static void poseAvx512(const AnjyoHair& hair, size_t s0, const Pose& p,
+                                                             Strands& out) {
     pose(hair, s0, p, out);
   }
 };
 
-void AnjyoHair::stepLanes(size_t s0, const AccelerationField& field, double dt, bool wide, const Pose* pose,
+void AnjyoHair::stepLanes(size_t s0, const AccelerationField& field, double dt, const Pose* pose,
                           Strands* out) {
-  if (wide)
-    Lanes::wide(*this, s0, field, dt, pose, out);
-  else
-    Lanes::baseline(*this, s0, field, dt, pose, out);
+  Lanes::stepAvx512(*this, s0, field, dt, pose, out);
 }
 
-void AnjyoHair::poseLanes(size_t s0, const Pose& pose, Strands& out, bool wide) const {
-  if (wide)
-    Lanes::widePose(*this, s0, pose, out);
-  else
-    Lanes::baselinePose(*this, s0, pose, out);
+void AnjyoHair::poseLanes(size_t s0, const Pose& pose, Strands& out) const {
+  Lanes::poseAvx512(*this, s0, pose, out);
 }
 
 // posedInto's arithmetic, lane by lane: each point is the input point plus its node's motion, posed;
