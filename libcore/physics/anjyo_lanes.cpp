@@ -1,8 +1,8 @@
-// Anjyo et al. 1992 §3, the substep of anjyo_dynamics.cpp for kLanes strands at once (AVX2 or AVX-512): the
-// same operations in the same order on each lane, so every lane's bits are stepStrand's (IEEE arithmetic and
-// square roots are exact per lane; this file is built without contraction into fused multiply-adds).
-// What branches per segment (a segment that meets a collision shape or its joint limit, a turn too
-// large for the series) is done lane by lane with the strand's own code.
+// Anjyo et al. 1992 §3, the substep of anjyo_dynamics.cpp for kLanes strands at once in AVX-512 vectors:
+// the same operations in the same order on each lane, so every lane's bits are stepStrand's (IEEE
+// arithmetic and square roots are exact per lane; this file is built without contraction into fused
+// multiply-adds). What branches per segment (a segment that meets a collision shape or its joint limit)
+// is done lane by lane with the strand's own code.
 #include <algorithm>
 #include <cmath>
 #include <optional>
