@@ -62,7 +62,7 @@ StrandEnergy::StrandEnergy(const Hairstyle& style, const Collision& collision, c
     if (!(s.penalty > 0.0)) continue;
     double extra = s.envelopeGrowth * envelope;
     double reach = boundingRadius(s) + std::max(extra, 0.0);
-    Shape shape{s, extra, reach * reach, {}, HUGE_VAL};
+    Shape shape{s, extra, reach, reach * reach, {}, HUGE_VAL};
     if (s.kind == ShapeKind::kEllipsoid) {
       for (int k = 0; k < 3; ++k) shape.scaledAxes[k] = s.axes[k] / s.halfExtents[k];
       double minHalf = std::min(s.halfExtents.x, std::min(s.halfExtents.y, s.halfExtents.z));
@@ -116,6 +116,15 @@ std::vector<double> StrandEnergy::initialSteps() const {
   return steps;
 }
 
+bool StrandEnergy::mayTouch(const glm::dvec3& p, double radius) const {
+  for (const Shape& shape : shapes_) {
+    const glm::dvec3 v = p - shape.shape.centre;
+    const double within = shape.reach + radius;
+    if (glm::dot(v, v) < within * within) return true;
+  }
+  return false;
+}
+
 double StrandEnergy::penalty(const glm::dvec3& p) const {
   // penetration() per kind (equal to it within rounding), with the cheap rejections first.
   double sum = 0.0;
@@ -158,7 +167,9 @@ EnergyTerms StrandEnergy::terms(std::span<const double> q) const {
   forEachElement(root_, lengths_, q, [&](const HelixElement& element, double, size_t k) {
     height +=
         element.length() * (element.start().position.y - root_.position.y) + element.displacementIntegral().y;
-    if (shapes_.empty()) return;
+    // An element's samples lie within its length of its start (the arc is at least the chord): where no
+    // shape reaches that far, each would add exactly 0, so none is placed.
+    if (shapes_.empty() || !mayTouch(element.start().position, element.length())) return;
     const ElementSamples& samples = samples_[k];
     element.visitGrid(samples.first, collisionStep_, samples.gridCount,
                       [&](size_t, const glm::dvec3& p) { penalty += this->penalty(p); });

@@ -43,7 +43,8 @@ class StrandEnergy {
   struct Shape {
     CollisionShape shape;
     double extra;
-    double reach2;  // (bounding radius + extra)²: a point farther from the centre cannot touch
+    double reach;   // bounding radius + extra: a point farther from the centre cannot touch
+    double reach2;  // its square
     // Ellipsoids: the axes divided by their semi-axes, and the squared "ratio" |local/half|² beyond
     // which dent + extra ≤ 0 (dist ≥ ratio·min semi-axis bounds the dent by −min·(ratio − 1)).
     glm::dvec3 scaledAxes[3];
@@ -57,6 +58,8 @@ class StrandEnergy {
     std::vector<double> offGrid;
   };
   double penalty(const glm::dvec3& p) const;
+  // Whether any point within `radius` of p may touch a shape (else its penalty is exactly 0).
+  bool mayTouch(const glm::dvec3& p, double radius) const;
 
   std::vector<double> lengths_;
   RodFrame root_;
