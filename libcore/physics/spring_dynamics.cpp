@@ -478,8 +478,10 @@ Strands SpringHair::posed(const Pose& pose) const {
 
 void SpringHair::posedInto(const Pose& pose, Strands& out) const {
   out.assignRestKeepingBuffers(rest_);  // every attribute but the points and tangents is the rest's
+  const bool still = pose.isIdentity();
   tbb::parallel_for(size_t(0), rest_.strandCount(), [&](size_t s) {
     const uint32_t p0 = rest_.firstPoint[s], count = rest_.pointsOf(s);
+    glm::dvec3 restDir(0.0), dir(0.0);
     for (uint32_t j = 0; j < count; ++j) {
       const uint32_t p = p0 + j;
       // The input point plus the motion: at rest exactly the input.
@@ -487,10 +489,13 @@ void SpringHair::posedInto(const Pose& pose, Strands& out) const {
       glm::dvec3 t(restTangents_[p]);
       if (count >= 2) {
         // Turned with its segment (the one it starts, or the last): the minimal rotation.
-        const uint32_t e = p0 + std::clamp(j + 1, 1u, count - 1);
-        t = transport(glm::normalize(xRest_[e] - xRest_[e - 1]), glm::normalize(x_[e] - x_[e - 1]), t);
+        if (j + 1 < count) {
+          restDir = glm::normalize(xRest_[p + 1] - xRest_[p]);
+          dir = glm::normalize(x_[p + 1] - x_[p]);
+        }
+        t = transportFast(restDir, dir, t);
       }
-      out.tangents[p] = pose.isIdentity() ? glm::vec3(t) : glm::vec3(glm::normalize(pose.rotation * t));
+      out.tangents[p] = glm::vec3(still ? t : pose.rotation * t);  // a rotation keeps it unit
     }
   });
 }
