@@ -1,7 +1,9 @@
 #!/usr/bin/env bash
 # Benchmarks, one group or all: scripts/bench.sh [grow|cantilever|interpolate|shade|render|simulate|cache|all] [Google Benchmark flags]
 # scripts/bench.sh farm: a shot in one process and through a local Slurm (scripts/bench-farm.sh).
-# Builds Release first. Speed targets are checked here, never by timed unit tests.
+# Builds Release first. Speed targets are checked here, never by timed unit tests: each benchmark with a
+# target (issues 15, 16 and 20) prints `of_target`, its figure over the target (1 or more meets it).
+# Medians: add --benchmark_repetitions=5 --benchmark_report_aggregates_only=true.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 group="${1:-all}"

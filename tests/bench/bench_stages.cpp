@@ -29,6 +29,7 @@
 #include "libcore/io/hair_io.h"
 #include "libcore/io/obj_io.h"
 #include "libcore/render/gl_context.h"
+#include "libcore/util/stopwatch.h"
 #include "stages/cantilever.h"
 #include "stages/grow.h"
 #include "stages/interpolate.h"
@@ -38,6 +39,22 @@
 
 namespace hairgen {
 namespace {
+
+// The issues' targets, each printed beside its figure as `of_target`: the figure over its target, so 1
+// or more meets it (issue 20 for the stages and caches, 15 and 16 for the dynamics).
+constexpr double kGrowCoupe3GuidesPerSecond = 5000.0, kGrowDefaultGuidesPerSecond = 2000.0;
+constexpr double kInterpolateSeconds = 0.05, kShadeSeconds = 0.4, kReadCacheSeconds = 0.3;
+constexpr double kRender1080pSeconds = 4.0;  // 150,000 strands at 1920×1080 (the whole command's)
+constexpr double kAnjyoFramesPerSecond = 200.0, kSpringsFramesPerSecond = 24.0;
+
+// `done` things in `seconds` against a target of `perSecond` a second.
+void rateTarget(benchmark::State& state, double done, double seconds, double perSecond) {
+  state.counters["of_target"] = done / seconds / perSecond;
+}
+// The iterations' `seconds` against a target of `target` seconds each.
+void timeTarget(benchmark::State& state, double seconds, double target) {
+  state.counters["of_target"] = target / (seconds / double(state.iterations()));
+}
 
 // A bundled coupe's config and wick.
 struct Bundled {
@@ -80,8 +97,9 @@ void EnergyEvaluation(benchmark::State& state) {
 }
 BENCHMARK(EnergyEvaluation);
 
-void growBundled(benchmark::State& state, const Bundled& c) {
+void growBundled(benchmark::State& state, const Bundled& c, double target) {
   uint64_t evaluations = 0, guides = 0;
+  Stopwatch clock;
   for (auto _ : state) {
     GrowResult g = grow(c.wick, c.config.hairstyle, c.config.collision, {});
     evaluations += g.evaluations;
@@ -93,13 +111,14 @@ void growBundled(benchmark::State& state, const Bundled& c) {
       benchmark::Counter(double(evaluations) / tbb::info::default_concurrency(), benchmark::Counter::kIsRate);
   state.counters["follicles"] = double(c.wick.vertexCount());
   state.counters["elements"] = double(c.config.hairstyle.hairLengths.size());
+  rateTarget(state, double(guides), clock.lap(), target);
 }
 void GrowCoupe3(benchmark::State& state) {
-  growBundled(state, coupe3());
+  growBundled(state, coupe3(), kGrowCoupe3GuidesPerSecond);
 }
 BENCHMARK(GrowCoupe3)->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(3.0);
 void GrowDefault(benchmark::State& state) {
-  growBundled(state, defaultCoupe());
+  growBundled(state, defaultCoupe(), kGrowDefaultGuidesPerSecond);
 }
 BENCHMARK(GrowDefault)->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(3.0);
 
@@ -111,6 +130,7 @@ void InterpolateCoupe3(benchmark::State& state) {
   const double area = surfaceArea(c.wick) * 1e4;
   style.hairDensity = 150000.0 / area;
   uint64_t strands = 0, points = 0;
+  Stopwatch clock;
   for (auto _ : state) {
     Strands coupe = interpolate(c.wick, guides, style, c.config.collision, {});
     strands += coupe.strandCount();
@@ -121,6 +141,7 @@ void InterpolateCoupe3(benchmark::State& state) {
   state.counters["vertices/strand"] = double(points) / double(strands);
   state.counters["strands/s"] = benchmark::Counter(double(strands), benchmark::Counter::kIsRate);
   state.counters["vertices/s"] = benchmark::Counter(double(points), benchmark::Counter::kIsRate);
+  timeTarget(state, clock.lap(), kInterpolateSeconds);
 }
 BENCHMARK(InterpolateCoupe3)->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(3.0);
 
@@ -133,11 +154,14 @@ void ShadeCoupe3(benchmark::State& state) {
       interpolate(c.wick, grow(c.wick, style, c.config.collision, {}).guides, style, c.config.collision, {});
   ShadeTimings total;
   glm::ivec3 grid(0);
+  double shading = 0.0;
   for (auto _ : state) {
     state.PauseTiming();  // the copy `shade` takes: hairgen shade moves its coupe in
     Strands input = coupe;
     state.ResumeTiming();
+    Stopwatch clock;
     ShadeResult r = shade(std::move(input), c.config.visuality, c.config.render, {style.seed, ""});
+    shading += clock.lap();
     total.volume += r.timings.volume;
     total.normals += r.timings.normals;
     grid = r.volume.density.size;
@@ -152,6 +176,7 @@ void ShadeCoupe3(benchmark::State& state) {
   state.counters["voxel_mm"] = c.config.render.voxelSize * 1000.0;
   state.counters["volume_s"] = total.volume / n;
   state.counters["normals_s"] = total.normals / n;
+  timeTarget(state, shading, kShadeSeconds);
 }
 BENCHMARK(ShadeCoupe3)->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(3.0);
 
@@ -220,6 +245,7 @@ void SimulateAnjyo(benchmark::State& state) {
   options.frames = {1, 25};
   size_t frames = 0;
   const std::clock_t start = std::clock();
+  Stopwatch clock;
   for (auto _ : state)
     simulate(guides, config, options, [&](int, const Strands& g) {
       benchmark::DoNotOptimize(g.points.data());
@@ -229,6 +255,7 @@ void SimulateAnjyo(benchmark::State& state) {
   state.counters["segments"] = double(guides.pointCount() - guides.strandCount());
   // As for SimulateSprings: CPU seconds of every thread per frame, what a shared machine's load leaves out.
   state.counters["cpu_s_per_frame"] = double(std::clock() - start) / CLOCKS_PER_SEC / double(frames);
+  rateTarget(state, double(frames), clock.lap(), kAnjyoFramesPerSecond);
 }
 BENCHMARK(SimulateAnjyo)->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(3.0);
 
@@ -259,6 +286,7 @@ void SimulateSprings(benchmark::State& state) {
   options.frames = {1, 25};
   size_t frames = 0;
   const std::clock_t start = std::clock();
+  Stopwatch clock;
   for (auto _ : state)
     simulate(guides, config, options, [&](int, const Strands& g) {
       benchmark::DoNotOptimize(g.points.data());
@@ -269,6 +297,7 @@ void SimulateSprings(benchmark::State& state) {
   // CPU seconds of every thread per frame: on a shared machine the wall clock also counts the other
   // jobs' time, this does not (2 / cpu_s_per_frame is what 2 free cores would give at best).
   state.counters["cpu_s_per_frame"] = double(std::clock() - start) / CLOCKS_PER_SEC / double(frames);
+  rateTarget(state, double(frames), clock.lap(), kSpringsFramesPerSecond);
 }
 BENCHMARK(SimulateSprings)->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(3.0);
 
@@ -298,11 +327,13 @@ std::filesystem::path coupeCache() {
 
 void ReadCache(benchmark::State& state) {
   const std::filesystem::path file = coupeCache();
+  Stopwatch clock;
   for (auto _ : state) {
     Strands s = readHair(file);
     benchmark::DoNotOptimize(s.points.data());
   }
   state.SetBytesProcessed(int64_t(state.iterations()) * int64_t(std::filesystem::file_size(file)));
+  timeTarget(state, clock.lap(), kReadCacheSeconds);
 }
 BENCHMARK(ReadCache)->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(3.0);
 
@@ -323,6 +354,7 @@ void Render(benchmark::State& state) {
   settings.resolution = {int(state.range(1)), int(state.range(2))};
   settings.samples = int(state.range(3));
   RenderTimings sum;
+  Stopwatch clock;
   for (auto _ : state) {
     RenderOutput out = render(gl, hair, &head, coupe3().config.visuality, settings, {}, {});
     sum.upload += out.timings.upload;
@@ -339,6 +371,8 @@ void Render(benchmark::State& state) {
   state.counters["shading_s"] = sum.shading / n;
   state.counters["readback_s"] = sum.readback / n;
   state.SetLabel(gl.renderer() + " (" + gl.platform() + ")");
+  if (state.range(0) == 150000 && state.range(1) == 1920 && state.range(2) == 1080)
+    timeTarget(state, clock.lap(), kRender1080pSeconds);
 }
 BENCHMARK(Render)
     ->ArgNames({"strands", "width", "height", "samples"})
