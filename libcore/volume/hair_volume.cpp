@@ -1,12 +1,12 @@
 #include "libcore/volume/hair_volume.h"
 
 #include <algorithm>
-#include <atomic>
 #include <cmath>
 #include <cstdio>
 #include <limits>
 
 #include <tbb/blocked_range.h>
+#include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
 
 #include "libcore/model/mesh.h"
@@ -93,14 +93,19 @@ GridOf<T> gridAround(const std::vector<glm::vec3>& points, double voxel, int pad
 
 void splat(Grid& d, const std::vector<glm::vec3>& points) {
   // Weights are added as 32.32 fixed-point integers: integer sums do not depend on the order of the
-  // additions, so the threads may race and the grid is the same bits on every run and thread count.
+  // additions, so however the points fall to threads the grid is the same bits on every run and thread
+  // count.
   // Each point's eight weights are rounded to sum to exactly one (the rounding is given to its
   // largest weight), so a point inside the grid adds exactly 1 to it.
   constexpr double kOne = 4294967296.0;  // 2^32
-  std::vector<int64_t> sums(d.values.size(), 0);
+  // Each thread sums into a grid of its own (atomic adds to one shared grid cost more than the rest of
+  // the splat together); the threads' grids are added node by node after, which integer sums allow.
+  tbb::enumerable_thread_specific<std::vector<int64_t>> partial(
+      [&] { return std::vector<int64_t>(d.values.size(), 0); });
   const glm::ivec3 size = d.size;
   tbb::parallel_for(
       tbb::blocked_range<size_t>(0, points.size(), 4096), [&](const tbb::blocked_range<size_t>& r) {
+        std::vector<int64_t>& sums = partial.local();
         for (size_t p = r.begin(); p != r.end(); ++p) {
           glm::dvec3 g = (glm::dvec3(points[p]) - d.origin) / d.voxel;
           glm::ivec3 c = glm::ivec3(glm::floor(g));
@@ -116,16 +121,34 @@ void splat(Grid& d, const std::vector<glm::vec3>& points) {
             if (w[corner] > w[largest]) largest = corner;
           }
           w[largest] += int64_t(kOne) - total;
+          if (glm::all(glm::greaterThanEqual(c, glm::ivec3(0))) && glm::all(glm::lessThan(c + 1, size))) {
+            const size_t base = d.index(c.x, c.y, c.z), strideY = size_t(size.x), strideZ = strideY * size.y;
+            sums[base] += w[0];
+            sums[base + 1] += w[1];
+            sums[base + strideY] += w[2];
+            sums[base + strideY + 1] += w[3];
+            sums[base + strideZ] += w[4];
+            sums[base + strideZ + 1] += w[5];
+            sums[base + strideZ + strideY] += w[6];
+            sums[base + strideZ + strideY + 1] += w[7];
+            continue;
+          }
           for (int corner = 0; corner < 8; ++corner) {  // on the grid's edge, the outer corners fall away
             const glm::ivec3 n = c + glm::ivec3(corner & 1, (corner >> 1) & 1, corner >> 2);
             if (glm::any(glm::lessThan(n, glm::ivec3(0))) || glm::any(glm::greaterThanEqual(n, size)))
               continue;
-            std::atomic_ref<int64_t>(sums[d.index(n.x, n.y, n.z)])
-                .fetch_add(w[corner], std::memory_order_relaxed);
+            sums[d.index(n.x, n.y, n.z)] += w[corner];
           }
         }
       });
-  for (size_t i = 0; i < sums.size(); ++i) d.values[i] += static_cast<float>(double(sums[i]) / kOne);
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, d.values.size(), 16384),
+                    [&](const tbb::blocked_range<size_t>& r) {
+                      for (size_t i = r.begin(); i != r.end(); ++i) {
+                        int64_t sum = 0;
+                        for (const std::vector<int64_t>& sums : partial) sum += sums[i];
+                        d.values[i] += static_cast<float>(double(sum) / kOne);
+                      }
+                    });
 }
 
 template <class T>
