@@ -13,6 +13,7 @@
 
 #include "libcore/util/error.h"
 #include "libcore/util/random.h"
+#include "libcore/util/vectorise.h"
 #include "stages/estimate.h"
 
 namespace hairgen {
@@ -123,17 +124,7 @@ namespace {
 // vertex: w = root + (tip − root)·f, p = centre + Σ w_c (guide_c − centre), t = 0 + Σ w_c tangent_c,
 // |t| = sqrt((x² + y²) + z²), t/|t| — the same operations in the same order on every value, so the
 // compiler may run them across vertices in vector registers and the bits are those of one at a time. No
-// fused multiply-add: the AVX2 clone is built without FMA, and ISO C++ mode keeps contraction off.
-#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__)
-#define HAIRGEN_VECTOR_CLONES __attribute__((target_clones("avx2", "default")))
-#else
-#define HAIRGEN_VECTOR_CLONES
-#endif
-#if defined(__GNUC__) && !defined(__clang__)
-#define HAIRGEN_IVDEP _Pragma("GCC ivdep")  // the 26 arrays never overlap: no run-time alias checks
-#else
-#define HAIRGEN_IVDEP
-#endif
+// fused multiply-add (libcore/util/vectorise.h).
 HAIRGEN_VECTOR_CLONES
 void blendVertices(const double* __restrict soa, uint32_t count, const double* root, const double* step,
                    const double* centre, float* __restrict out, double* __restrict lengths) {

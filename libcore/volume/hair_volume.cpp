@@ -11,6 +11,7 @@
 
 #include "libcore/model/mesh.h"
 #include "libcore/util/error.h"
+#include "libcore/util/vectorise.h"
 
 namespace hairgen {
 
@@ -405,17 +406,97 @@ HairVolume buildVolume(const Strands& strands, double voxel, int padding, double
   return volume;
 }
 
+namespace {
+
+// One corner of the trilinear interpolant for a block of points (sampleGradient's loop body, dz, dy, dx
+// fixed): out += w · gradient at the corner, with trilinear's weight and clamped index.
+template <int dx, int dy, int dz>
+inline __attribute__((always_inline)) void addCorner(size_t count, const int sx, const int sy, const int sz,
+                                                     const glm::vec3* __restrict gradients,
+                                                     const int* __restrict cx, const int* __restrict cy,
+                                                     const int* __restrict cz, const double* __restrict fx,
+                                                     const double* __restrict fy, const double* __restrict fz,
+                                                     double* __restrict ox, double* __restrict oy,
+                                                     double* __restrict oz) {
+  HAIRGEN_IVDEP
+  for (size_t p = 0; p < count; ++p) {
+    const double w = (dx ? fx[p] : 1 - fx[p]) * (dy ? fy[p] : 1 - fy[p]) * (dz ? fz[p] : 1 - fz[p]);
+    const int i = std::min(cx[p] + dx, sx - 1), j = std::min(cy[p] + dy, sy - 1),
+              k = std::min(cz[p] + dz, sz - 1);
+    const int node = (k * sy + j) * sx + i;  // fewer than 2^31 nodes (gridAround)
+    ox[p] = ox[p] + w * double(gradients[node].x);
+    oy[p] = oy[p] + w * double(gradients[node].y);
+    oz[p] = oz[p] + w * double(gradients[node].z);
+  }
+}
+
+// Normals ∇S/|∇S| of up to 256 points: sampleGradient and the normalisation of volumeNormals, one stage
+// at a time over the block so each runs across points in vector registers (libcore/util/vectorise.h),
+// with the arithmetic of trilinear() per point. The cell is the truncation of the clamped grid
+// coordinate: it is never negative, where truncating is flooring.
+HAIRGEN_VECTOR_CLONES
+void normalsOfBlock(const Grid& grid, const glm::vec3* __restrict gradients,
+                    const glm::vec3* __restrict points, size_t count, glm::vec3* __restrict normals) {
+  constexpr size_t kB = 256;
+  int c[3 * kB];
+  double f[3 * kB], out[3 * kB];
+  const glm::dvec3 top = glm::dvec3(grid.size - 1) - 1e-9;
+  const float* const xyz = &points[0].x;
+  for (int axis = 0; axis < 3; ++axis) {
+    const double origin = grid.origin[axis], voxel = grid.voxel, hi = top[axis];
+    HAIRGEN_IVDEP
+    for (size_t p = 0; p < count; ++p) {
+      double g = (double(xyz[3 * p + axis]) - origin) / voxel;
+      g = g < 0.0 ? 0.0 : g;  // glm::clamp: min(max(g, 0), hi)
+      g = hi < g ? hi : g;
+      const int cell = static_cast<int>(g);
+      c[axis * kB + p] = cell;
+      f[axis * kB + p] = g - double(cell);
+      out[axis * kB + p] = 0.0;
+    }
+  }
+  const int sx = grid.size.x, sy = grid.size.y, sz = grid.size.z;
+  addCorner<0, 0, 0>(count, sx, sy, sz, gradients, c, c + kB, c + 2 * kB, f, f + kB, f + 2 * kB, out,
+                     out + kB, out + 2 * kB);
+  addCorner<1, 0, 0>(count, sx, sy, sz, gradients, c, c + kB, c + 2 * kB, f, f + kB, f + 2 * kB, out,
+                     out + kB, out + 2 * kB);
+  addCorner<0, 1, 0>(count, sx, sy, sz, gradients, c, c + kB, c + 2 * kB, f, f + kB, f + 2 * kB, out,
+                     out + kB, out + 2 * kB);
+  addCorner<1, 1, 0>(count, sx, sy, sz, gradients, c, c + kB, c + 2 * kB, f, f + kB, f + 2 * kB, out,
+                     out + kB, out + 2 * kB);
+  addCorner<0, 0, 1>(count, sx, sy, sz, gradients, c, c + kB, c + 2 * kB, f, f + kB, f + 2 * kB, out,
+                     out + kB, out + 2 * kB);
+  addCorner<1, 0, 1>(count, sx, sy, sz, gradients, c, c + kB, c + 2 * kB, f, f + kB, f + 2 * kB, out,
+                     out + kB, out + 2 * kB);
+  addCorner<0, 1, 1>(count, sx, sy, sz, gradients, c, c + kB, c + 2 * kB, f, f + kB, f + 2 * kB, out,
+                     out + kB, out + 2 * kB);
+  addCorner<1, 1, 1>(count, sx, sy, sz, gradients, c, c + kB, c + 2 * kB, f, f + kB, f + 2 * kB, out,
+                     out + kB, out + 2 * kB);
+  float* const n = &normals[0].x;
+  HAIRGEN_IVDEP
+  for (size_t p = 0; p < count; ++p) {
+    const double x = out[p], y = out[kB + p], z = out[2 * kB + p];
+    const double len = std::sqrt((x * x + y * y) + z * z);
+    const bool unit = len > 1e-12;
+    const float nx = static_cast<float>(x / len), ny = static_cast<float>(y / len),
+                nz = static_cast<float>(z / len);
+    n[3 * p] = unit ? nx : 0.0f;
+    n[3 * p + 1] = unit ? ny : 1.0f;
+    n[3 * p + 2] = unit ? nz : 0.0f;
+  }
+}
+
+}  // namespace
+
 std::vector<glm::vec3> volumeNormals(const Grid& distance, const Strands& strands) {
   const std::vector<glm::vec3> gradients = nodeGradients(distance);
   std::vector<glm::vec3> normals(strands.pointCount());
-  tbb::parallel_for(
-      tbb::blocked_range<size_t>(0, strands.pointCount(), 8192), [&](const tbb::blocked_range<size_t>& r) {
-        for (size_t p = r.begin(); p != r.end(); ++p) {
-          const glm::dvec3 g = sampleGradient(distance, gradients, glm::dvec3(strands.points[p]));
-          const double len = glm::length(g);
-          normals[p] = len > 1e-12 ? glm::vec3(g / len) : glm::vec3(0, 1, 0);
-        }
-      });
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, strands.pointCount(), 8192),
+                    [&](const tbb::blocked_range<size_t>& r) {
+                      for (size_t p = r.begin(); p < r.end(); p += 256)
+                        normalsOfBlock(distance, gradients.data(), &strands.points[p],
+                                       std::min<size_t>(256, r.end() - p), &normals[p]);
+                    });
   return normals;
 }
 
