@@ -18,21 +18,28 @@ namespace hairgen {
 
 namespace {
 
-// Σ over the 8 nodes around p of their trilinear weight times value(i, j, k) (p clamped to the grid).
-template <class T, class G, class Value>
-T trilinear(const G& grid, const glm::dvec3& p, Value value) {
+// Calls corner(w, i, j, k) for the 8 nodes around p (clamped to the grid) with their trilinear weights,
+// z outermost and x innermost.
+template <class G, class Corner>
+void forEachCorner(const G& grid, const glm::dvec3& p, Corner corner) {
   glm::dvec3 g =
       glm::clamp((p - grid.origin) / grid.voxel, glm::dvec3(0.0), glm::dvec3(grid.size - 1) - 1e-9);
   glm::ivec3 c = glm::ivec3(glm::floor(g));
   glm::dvec3 f = g - glm::dvec3(c);
-  T out(0.0);
   for (int dz = 0; dz < 2; ++dz)
     for (int dy = 0; dy < 2; ++dy)
       for (int dx = 0; dx < 2; ++dx) {
         double w = (dx ? f.x : 1 - f.x) * (dy ? f.y : 1 - f.y) * (dz ? f.z : 1 - f.z);
-        out += w * value(std::min(c.x + dx, grid.size.x - 1), std::min(c.y + dy, grid.size.y - 1),
-                         std::min(c.z + dz, grid.size.z - 1));
+        corner(w, std::min(c.x + dx, grid.size.x - 1), std::min(c.y + dy, grid.size.y - 1),
+               std::min(c.z + dz, grid.size.z - 1));
       }
+}
+
+// Σ over the 8 nodes around p of their trilinear weight times value(i, j, k) (p clamped to the grid).
+template <class T, class G, class Value>
+T trilinear(const G& grid, const glm::dvec3& p, Value value) {
+  T out(0.0);
+  forEachCorner(grid, p, [&](double w, int i, int j, int k) { out += w * value(i, j, k); });
   return out;
 }
 
@@ -67,6 +74,23 @@ std::vector<glm::vec3> nodeGradients(const Grid& grid) {
 glm::dvec3 sampleGradient(const Grid& grid, const std::vector<glm::vec3>& gradients, const glm::dvec3& p) {
   return trilinear<glm::dvec3>(
       grid, p, [&](int i, int j, int k) { return glm::dvec3(gradients[grid.index(i, j, k)]); });
+}
+
+// grid.sample(p) and sampleGradient(grid, gradients, p) in one pass over the cell: the same weights and
+// the same sums, so the same bits as the two calls, for half the finding of the cell and its weights.
+struct ValueAndGradient {
+  double value = 0.0;
+  glm::dvec3 gradient{0.0};
+};
+ValueAndGradient sampleWithGradient(const Grid& grid, const std::vector<glm::vec3>& gradients,
+                                    const glm::dvec3& p) {
+  ValueAndGradient out;
+  forEachCorner(grid, p, [&](double w, int i, int j, int k) {
+    const size_t node = grid.index(i, j, k);
+    out.value += w * double(grid.values[node]);
+    out.gradient += w * glm::dvec3(gradients[node]);
+  });
+  return out;
 }
 
 }  // namespace
@@ -400,15 +424,19 @@ Grid signedDistance(const Grid& density, double iso) {
   // trilinear φ, p ← p − φ ∇φ/|∇φ|², back onto the shell; kept while the distance falls.
   const double tolerance = 1e-4 * std::abs(iso) + 1e-12;
   const std::vector<glm::vec3> gradients = nodeGradients(density);
-  auto ontoShell = [&](glm::dvec3& p) {
-    double value = density.sample(p) - iso;
+  // ontoShell leaves in `gradient` ∇φ at the point it returns, which the slide's next round starts from.
+  auto ontoShell = [&](glm::dvec3& p, glm::dvec3& gradient) {
+    ValueAndGradient at = sampleWithGradient(density, gradients, p);
+    double value = at.value - iso;
     for (int step = 0; step < 16 && std::abs(value) > tolerance; ++step) {
-      const glm::dvec3 g = sampleGradient(density, gradients, p);
+      const glm::dvec3 g = at.gradient;
       const double g2 = glm::dot(g, g);
       if (!(g2 > 0.0)) return false;
       p -= (value / g2) * g;
-      value = density.sample(p) - iso;
+      at = sampleWithGradient(density, gradients, p);
+      value = at.value - iso;
     }
+    gradient = at.gradient;
     return std::abs(value) <= tolerance;
   };
   auto slide = [&] {
@@ -418,19 +446,20 @@ Grid signedDistance(const Grid& density, double iso) {
           const size_t id = density.index(i, j, k);
           if (dist2[id] == kNone) continue;
           const glm::dvec3 x = node(i, j, k);
+          glm::dvec3 g = sampleGradient(density, gradients, nearest[id]);
           for (int round = 0; round < 6; ++round) {
-            const glm::dvec3 p = nearest[id], g = sampleGradient(density, gradients, p);
+            const glm::dvec3 p = nearest[id];
             const double g2 = glm::dot(g, g);
             if (!(g2 > 0.0)) break;
             glm::dvec3 across = (x - p) - glm::dot(x - p, g) / g2 * g;
             const double a2 = glm::dot(across, across);
             if (a2 <= 1e-6 * dist2[id]) break;
             if (a2 > h * h) across *= h / std::sqrt(a2);
-            glm::dvec3 q = p + across;
-            if (!ontoShell(q)) break;
+            glm::dvec3 q = p + across, gq;
+            if (!ontoShell(q, gq)) break;
             const double d2 = glm::dot(q - x, q - x);
             if (!(d2 < dist2[id])) break;
-            nearest[id] = q, dist2[id] = d2;
+            nearest[id] = q, dist2[id] = d2, g = gq;
           }
         }
     });
