@@ -559,17 +559,18 @@ void normalsOfBlock(const Grid& grid, const glm::vec3* __restrict gradients,
   addCorner<1, 1, 1>(count, sx, sy, sz, gradients, c, c + kB, c + 2 * kB, f, f + kB, f + 2 * kB, out,
                      out + kB, out + 2 * kB);
   float* const n = &normals[0].x;
+  double* const lengths = f;  // the fractions are spent
   HAIRGEN_IVDEP
   for (size_t p = 0; p < count; ++p) {
     const double x = out[p], y = out[kB + p], z = out[2 * kB + p];
     const double len = std::sqrt((x * x + y * y) + z * z);
-    const bool unit = len > 1e-12;
-    const float nx = static_cast<float>(x / len), ny = static_cast<float>(y / len),
-                nz = static_cast<float>(z / len);
-    n[3 * p] = unit ? nx : 0.0f;
-    n[3 * p + 1] = unit ? ny : 1.0f;
-    n[3 * p + 2] = unit ? nz : 0.0f;
+    lengths[p] = len;
+    n[3 * p] = static_cast<float>(x / len);
+    n[3 * p + 1] = static_cast<float>(y / len);
+    n[3 * p + 2] = static_cast<float>(z / len);
   }
+  for (size_t p = 0; p < count; ++p)  // no gradient (a flat distance): +y, as every vertex must have one
+    if (!(lengths[p] > 1e-12)) normals[p] = glm::vec3(0, 1, 0);
 }
 
 }  // namespace
