@@ -120,20 +120,18 @@ glm::dvec3 tipWeights(const glm::dvec3& r, double v1, double v2, bool strayHairs
 
 namespace {
 
-// The blend of one strand, vertex by vertex in the order blendVertex's arithmetic was written once per
-// vertex: w = root + (tip − root)·f, p = centre + Σ w_c (guide_c − centre), t = 0 + Σ w_c tangent_c,
-// |t| = sqrt((x² + y²) + z²), t/|t| — the same operations in the same order on every value, so the
-// compiler may run them across vertices in vector registers and the bits are those of one at a time. No
-// fused multiply-add (libcore/util/vectorise.h).
+// The blend of one strand, written as for one vertex at a time: w = root + (tip − root)·f, p = centre + Σ w_c
+// (guide_c − centre), t = 0 + Σ w_c tangent_c, |t| = sqrt((x² + y²) + z²), t/|t| — the same operations in the
+// same order on every value, so the compiler may run them across vertices in vector registers and the bits
+// are those of one at a time. No fused multiply-add (libcore/util/vectorise.h).
 HAIRGEN_VECTOR_CLONES
 void blendVertices(const double* __restrict soa, uint32_t count, const double* root, const double* step,
-                   const double* centre, float* __restrict out, double* __restrict lengths) {
+                   const double* centre, float* __restrict points, float* __restrict tangents,
+                   double* __restrict lengths) {
   const size_t n = count;
   const double* a[18];  // per guide: offsets x, y, z, tangents x, y, z
   for (size_t k = 0; k < 18; ++k) a[k] = soa + k * n;
   const double* const fraction = soa + 18 * n;
-  float *ox = out, *oy = out + n, *oz = out + 2 * n, *otx = out + 3 * n, *oty = out + 4 * n,
-        *otz = out + 5 * n;
   const double r0 = root[0], r1 = root[1], r2 = root[2], s0 = step[0], s1 = step[1], s2 = step[2];
   const double c0 = centre[0], c1 = centre[1], c2 = centre[2];
   HAIRGEN_IVDEP
@@ -148,12 +146,12 @@ void blendVertices(const double* __restrict soa, uint32_t count, const double* r
     tx = tx + w2 * a[15][i], ty = ty + w2 * a[16][i], tz = tz + w2 * a[17][i];
     const double len = std::sqrt((tx * tx + ty * ty) + tz * tz);
     lengths[i] = len;
-    ox[i] = static_cast<float>(px);
-    oy[i] = static_cast<float>(py);
-    oz[i] = static_cast<float>(pz);
-    otx[i] = static_cast<float>(tx / len);
-    oty[i] = static_cast<float>(ty / len);
-    otz[i] = static_cast<float>(tz / len);
+    points[3 * i] = static_cast<float>(px);  // the coupe's layout, each vertex written once
+    points[3 * i + 1] = static_cast<float>(py);
+    points[3 * i + 2] = static_cast<float>(pz);
+    tangents[3 * i] = static_cast<float>(tx / len);
+    tangents[3 * i + 1] = static_cast<float>(ty / len);
+    tangents[3 * i + 2] = static_cast<float>(tz / len);
   }
 }
 
@@ -165,7 +163,6 @@ void TriangleBlend::prepare(const GuideSpan (&g)[3], uint32_t n, const glm::dvec
   centre_ = centre;
   soa_.resize(19 * size_t(n));
   lengths_.resize(n);
-  blended_.resize(6 * size_t(n));
   for (int c = 0; c < 3; ++c) {
     double* a = soa_.data() + 6 * size_t(c) * n;
     for (uint32_t i = 0; i < n; ++i) {
@@ -183,14 +180,8 @@ void TriangleBlend::prepare(const GuideSpan (&g)[3], uint32_t n, const glm::dvec
 void TriangleBlend::blend(const glm::dvec3& root, const glm::dvec3& tip, glm::vec3* points,
                           glm::vec3* tangents) {
   const glm::dvec3 step = tip - root;
-  float* out = blended_.data();
-  blendVertices(soa_.data(), n_, &root.x, &step.x, &centre_.x, out, lengths_.data());
+  blendVertices(soa_.data(), n_, &root.x, &step.x, &centre_.x, &points[0].x, &tangents[0].x, lengths_.data());
   const double* fraction = soa_.data() + 18 * size_t(n_);
-  const size_t n = n_;
-  for (size_t i = 0; i < n; ++i) {  // into the coupe's layout, each vertex written once
-    points[i] = glm::vec3(out[i], out[n + i], out[2 * n + i]);
-    tangents[i] = glm::vec3(out[3 * n + i], out[4 * n + i], out[5 * n + i]);
-  }
   for (uint32_t i = 0; i < n_; ++i) {
     if (lengths_[i] > 1e-12) continue;
     // Opposed tangents cancel only on a pathological blend: keep the heaviest guide's.

@@ -78,7 +78,6 @@ class TriangleBlend {
   glm::dvec3 centre_{0.0};
   std::vector<double> soa_;  // 19 arrays of n: per guide its offsets x, y, z and tangents x, y, z; i/(n−1)
   std::vector<double> lengths_;  // |t| of the strand's vertices, before renormalising
-  std::vector<float> blended_;   // the strand's points x, y, z and tangents x, y, z, one array each
 };
 
 // The head centre the stray hairs scale about: the centre of the first Ellipsoid of Collision Info,
