@@ -394,26 +394,31 @@ Grid signedDistance(const Grid& density, double iso) {
 
   // Fast sweeping of the nearest points (a closest-point transform): in each of the 8 orders of the
   // axes a node takes the nearest point of a neighbour behind it when that is nearer than its own.
+  // A node reads only the neighbours behind it in the order, each already swept in it, and writes only
+  // itself; so the x-lines (jj, kk) on one diagonal jj + kk = d depend on the diagonal before alone,
+  // and sweeping the diagonals in turn, their lines at once, gives the bits of the raster order.
   auto sweep = [&] {  // one round of the 8 orders: the slide below mends what it leaves
     for (int order = 0; order < 8; ++order) {
       const bool fx = order & 1, fy = order & 2, fz = order & 4;
-      for (int kk = 0; kk < n.z; ++kk)
-        for (int jj = 0; jj < n.y; ++jj)
-          for (int ii = 0; ii < n.x; ++ii) {
-            const int i = fx ? n.x - 1 - ii : ii, j = fy ? n.y - 1 - jj : jj, k = fz ? n.z - 1 - kk : kk;
-            const size_t id = density.index(i, j, k);
-            const glm::dvec3 x = node(i, j, k);
-            const bool has[3] = {fx ? i + 1 < n.x : i > 0, fy ? j + 1 < n.y : j > 0,
-                                 fz ? k + 1 < n.z : k > 0};
-            const size_t behind[3] = {fx ? id + 1 : id - 1, fy ? id + strideY : id - strideY,
-                                      fz ? id + strideZ : id - strideZ};
-            for (int axis = 0; axis < 3; ++axis) {
-              if (!has[axis] || dist2[behind[axis]] == kNone) continue;
-              const glm::dvec3 e = nearest[behind[axis]] - x;
-              const double d2 = glm::dot(e, e);
-              if (d2 < dist2[id]) nearest[id] = nearest[behind[axis]], dist2[id] = d2;
-            }
+      auto line = [&](int jj, int kk) {
+        for (int ii = 0; ii < n.x; ++ii) {
+          const int i = fx ? n.x - 1 - ii : ii, j = fy ? n.y - 1 - jj : jj, k = fz ? n.z - 1 - kk : kk;
+          const size_t id = density.index(i, j, k);
+          const glm::dvec3 x = node(i, j, k);
+          const bool has[3] = {fx ? i + 1 < n.x : i > 0, fy ? j + 1 < n.y : j > 0, fz ? k + 1 < n.z : k > 0};
+          const size_t behind[3] = {fx ? id + 1 : id - 1, fy ? id + strideY : id - strideY,
+                                    fz ? id + strideZ : id - strideZ};
+          for (int axis = 0; axis < 3; ++axis) {
+            if (!has[axis] || dist2[behind[axis]] == kNone) continue;
+            const glm::dvec3 e = nearest[behind[axis]] - x;
+            const double d2 = glm::dot(e, e);
+            if (d2 < dist2[id]) nearest[id] = nearest[behind[axis]], dist2[id] = d2;
           }
+        }
+      };
+      for (int d = 0; d <= (n.y - 1) + (n.z - 1); ++d)
+        tbb::parallel_for(std::max(0, d - (n.y - 1)), std::min(d, n.z - 1) + 1,
+                          [&](int kk) { line(d - kk, kk); });
     }
   };
 
