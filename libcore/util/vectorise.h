@@ -5,11 +5,14 @@
 #pragma once
 
 // On x86-64 with GCC, the function is built twice, for the baseline (SSE2) and for AVX2 (four doubles a
-// register, no FMA), and the loader picks the one the processor runs.
+// register, no FMA), and the loader picks the one the processor runs. A build may define it empty
+// (-DHAIRGEN_VECTOR_CLONES=) to keep the baseline alone, e.g. to check both give the same bytes.
+#ifndef HAIRGEN_VECTOR_CLONES
 #if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__)
 #define HAIRGEN_VECTOR_CLONES __attribute__((target_clones("avx2", "default")))
 #else
 #define HAIRGEN_VECTOR_CLONES
+#endif
 #endif
 
 // Before a loop whose arrays never overlap: the compiler then needs no run-time overlap checks, which
