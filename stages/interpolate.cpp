@@ -8,10 +8,12 @@
 #include <cstdio>
 #include <limits>
 
+#include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
 
 #include "libcore/util/error.h"
 #include "libcore/util/random.h"
+#include "libcore/util/vectorise.h"
 #include "stages/estimate.h"
 
 namespace hairgen {
@@ -116,25 +118,76 @@ glm::dvec3 tipWeights(const glm::dvec3& r, double v1, double v2, bool strayHairs
   return w;
 }
 
-void blendStrand(const GuideSpan (&g)[3], uint32_t n, const glm::dvec3& root, const glm::dvec3& tip,
-                 const glm::dvec3& centre, glm::vec3* points, glm::vec3* tangents) {
-  for (uint32_t i = 0; i < n; ++i) {
-    // b_i from b_root at the root to b_tip at the tip (the thesis' i/n never reaches the tip).
-    const double f = n > 1 ? double(i) / double(n - 1) : 0.0;
-    const glm::dvec3 w = root + (tip - root) * f;
-    glm::dvec3 p = centre, tangent(0.0);
-    for (int c = 0; c < 3; ++c) {
-      p += w[c] * (glm::dvec3(g[c].points[i]) - centre);
-      tangent += w[c] * glm::dvec3(g[c].tangents[i]);
+namespace {
+
+// The blend of one strand, written as for one vertex at a time: w = root + (tip − root)·f, p = centre + Σ w_c
+// (guide_c − centre), t = 0 + Σ w_c tangent_c, |t| = sqrt((x² + y²) + z²), t/|t| — the same operations in the
+// same order on every value, so the compiler may run them across vertices in vector registers and the bits
+// are those of one at a time. No fused multiply-add (libcore/util/vectorise.h).
+HAIRGEN_VECTOR_CLONES
+void blendVertices(const double* __restrict soa, uint32_t count, const double* root, const double* step,
+                   const double* centre, float* __restrict points, float* __restrict tangents,
+                   double* __restrict lengths) {
+  const size_t n = count;
+  const double* a[18];  // per guide: offsets x, y, z, tangents x, y, z
+  for (size_t k = 0; k < 18; ++k) a[k] = soa + k * n;
+  const double* const fraction = soa + 18 * n;
+  const double r0 = root[0], r1 = root[1], r2 = root[2], s0 = step[0], s1 = step[1], s2 = step[2];
+  const double c0 = centre[0], c1 = centre[1], c2 = centre[2];
+  HAIRGEN_IVDEP
+  for (size_t i = 0; i < n; ++i) {
+    const double f = fraction[i];
+    const double w0 = r0 + s0 * f, w1 = r1 + s1 * f, w2 = r2 + s2 * f;
+    double px = c0 + w0 * a[0][i], py = c1 + w0 * a[1][i], pz = c2 + w0 * a[2][i];
+    px = px + w1 * a[6][i], py = py + w1 * a[7][i], pz = pz + w1 * a[8][i];
+    px = px + w2 * a[12][i], py = py + w2 * a[13][i], pz = pz + w2 * a[14][i];
+    double tx = 0.0 + w0 * a[3][i], ty = 0.0 + w0 * a[4][i], tz = 0.0 + w0 * a[5][i];
+    tx = tx + w1 * a[9][i], ty = ty + w1 * a[10][i], tz = tz + w1 * a[11][i];
+    tx = tx + w2 * a[15][i], ty = ty + w2 * a[16][i], tz = tz + w2 * a[17][i];
+    const double len = std::sqrt((tx * tx + ty * ty) + tz * tz);
+    lengths[i] = len;
+    points[3 * i] = static_cast<float>(px);  // the coupe's layout, each vertex written once
+    points[3 * i + 1] = static_cast<float>(py);
+    points[3 * i + 2] = static_cast<float>(pz);
+    tangents[3 * i] = static_cast<float>(tx / len);
+    tangents[3 * i + 1] = static_cast<float>(ty / len);
+    tangents[3 * i + 2] = static_cast<float>(tz / len);
+  }
+}
+
+}  // namespace
+
+void TriangleBlend::prepare(const GuideSpan (&g)[3], uint32_t n, const glm::dvec3& centre) {
+  for (int c = 0; c < 3; ++c) guides_[c] = g[c];
+  n_ = n;
+  centre_ = centre;
+  soa_.resize(19 * size_t(n));
+  lengths_.resize(n);
+  for (int c = 0; c < 3; ++c) {
+    double* a = soa_.data() + 6 * size_t(c) * n;
+    for (uint32_t i = 0; i < n; ++i) {
+      for (int axis = 0; axis < 3; ++axis) {
+        a[axis * size_t(n) + i] = double(g[c].points[i][axis]) - centre[axis];
+        a[(3 + axis) * size_t(n) + i] = double(g[c].tangents[i][axis]);
+      }
     }
-    const double len = glm::length(tangent);
-    points[i] = glm::vec3(p);
-    if (len > 1e-12) {
-      tangents[i] = glm::vec3(tangent / len);
-    } else {  // opposed tangents cancel only on a pathological blend: keep the heaviest guide's
-      const int heaviest = w.x >= w.y && w.x >= w.z ? 0 : (w.y >= w.z ? 1 : 2);
-      tangents[i] = g[heaviest].tangents[i];
-    }
+  }
+  // b_i from b_root at the root to b_tip at the tip (the thesis' i/n never reaches the tip).
+  double* fraction = soa_.data() + 18 * size_t(n);
+  for (uint32_t i = 0; i < n; ++i) fraction[i] = n > 1 ? double(i) / double(n - 1) : 0.0;
+}
+
+void TriangleBlend::blend(const glm::dvec3& root, const glm::dvec3& tip, glm::vec3* points,
+                          glm::vec3* tangents) {
+  const glm::dvec3 step = tip - root;
+  blendVertices(soa_.data(), n_, &root.x, &step.x, &centre_.x, &points[0].x, &tangents[0].x, lengths_.data());
+  const double* fraction = soa_.data() + 18 * size_t(n_);
+  for (uint32_t i = 0; i < n_; ++i) {
+    if (lengths_[i] > 1e-12) continue;
+    // Opposed tangents cancel only on a pathological blend: keep the heaviest guide's.
+    const glm::dvec3 w = root + step * fraction[i];
+    const int heaviest = w.x >= w.y && w.x >= w.z ? 0 : (w.y >= w.z ? 1 : 2);
+    tangents[i] = guides_[heaviest].tangents[i];
   }
 }
 
@@ -202,25 +255,36 @@ Strands interpolate(const Mesh& wick, const Strands& guides, const Hairstyle& st
   coupe.firstPoint[strands] = static_cast<uint32_t>(points);
 
   const glm::dvec3 centre(options.pose * glm::dvec4(strayCentre(collision), 1.0));
+  // Each thread's scratch: the triangle's guides in double and the resampled guides, reused from
+  // triangle to triangle, so no strand and no triangle allocates once a thread's buffers have grown.
+  struct Scratch {
+    TriangleBlend blend;
+    std::vector<glm::vec3> resampledPoints[3], resampledTangents[3];
+    std::vector<double> at;
+  };
+  tbb::enumerable_thread_specific<Scratch> scratch;
   tbb::parallel_for(firstTriangle, endTriangle, [&](size_t t) {
+    Scratch& local = scratch.local();
     const glm::uvec3 tri = wick.triangles[t];
     const uint32_t n = vertices[t];
     // Guides with n vertices are read by index (grow samples every guide at the same fractions of its
     // length); a shorter one is resampled at the normalised arc lengths of the first longest guide.
-    std::vector<glm::vec3> resampledPoints[3], resampledTangents[3];
     GuideSpan g[3];
     int reference = guides.pointsOf(tri.x) == n ? 0 : (guides.pointsOf(tri.y) == n ? 1 : 2);
-    std::vector<double> at;
+    bool haveAt = false;
     for (int c = 0; c < 3; ++c) {
       const uint32_t first = guides.firstPoint[tri[c]], m = guides.pointsOf(tri[c]);
       if (m == n) {
         g[c] = {&guides.points[first], &guideTangents[first]};
         continue;
       }
-      if (at.empty()) at = normalisedArcLength(&guides.points[guides.firstPoint[tri[reference]]], n);
-      resample(&guides.points[first], &guideTangents[first], m, at, resampledPoints[c], resampledTangents[c]);
-      g[c] = {resampledPoints[c].data(), resampledTangents[c].data()};
+      if (!haveAt) local.at = normalisedArcLength(&guides.points[guides.firstPoint[tri[reference]]], n);
+      haveAt = true;
+      resample(&guides.points[first], &guideTangents[first], m, local.at, local.resampledPoints[c],
+               local.resampledTangents[c]);
+      g[c] = {local.resampledPoints[c].data(), local.resampledTangents[c].data()};
     }
+    local.blend.prepare(g, n, centre);
 
     for (uint32_t k = 0; k < count[t]; ++k) {
       const size_t s = firstStrand[t] - strandBase + k;
@@ -229,7 +293,7 @@ Strands interpolate(const Mesh& wick, const Strands& guides, const Hairstyle& st
       const glm::dvec3 tip = tipWeights(root, style.clump * counterUniform(seed, t, k, kTipV1),
                                         style.clump * counterUniform(seed, t, k, kTipV2), style.strayHairs);
       const size_t p0 = firstPoint[t] - pointBase + uint64_t(k) * n;
-      blendStrand(g, n, root, tip, centre, &coupe.points[p0], &coupe.tangents[p0]);
+      local.blend.blend(root, tip, &coupe.points[p0], &coupe.tangents[p0]);
       coupe.firstPoint[s] = static_cast<uint32_t>(p0);
       coupe.strandId[s] = static_cast<uint32_t>(uint64_t(k) * triangleCount + t);
       coupe.rootTriangle[s] = static_cast<uint32_t>(t);

@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include <glm/glm.hpp>
 
@@ -53,15 +54,31 @@ glm::dvec3 rootWeights(double u1, double u2);
 // otherwise the next corner after the nearest (A→B→C→A) takes v1 and the one after takes v2.
 glm::dvec3 tipWeights(const glm::dvec3& root, double v1, double v2, bool strayHairs);
 
-// One strand of n vertices from three guides of n vertices each: weights from `root` at vertex 0 to
-// `tip` at vertex n − 1, positions blended about `centre` (a weight sum K ≠ 1 scales the blend about
-// it, §4.1.4.4), tangents blended and renormalised.
+// The three guides of one triangle, read once for all its strands, and the blend of each strand from
+// them: n vertices, weights from `root` at vertex 0 to `tip` at vertex n − 1, positions blended about
+// `centre` (a weight sum K ≠ 1 scales the blend about it, §4.1.4.4), tangents blended and renormalised.
+// prepare() keeps each guide vertex's offset from the centre and its tangent in double, one array per
+// component, so blend() runs across vertices in vector registers with the arithmetic of one vertex at a
+// time (the same operations in the same order, so the same bits). Reuse one object per thread: its
+// arrays keep their capacity, and blending a strand allocates nothing.
 struct GuideSpan {
   const glm::vec3* points;
   const glm::vec3* tangents;
 };
-void blendStrand(const GuideSpan (&guides)[3], uint32_t n, const glm::dvec3& root, const glm::dvec3& tip,
-                 const glm::dvec3& centre, glm::vec3* points, glm::vec3* tangents);
+class TriangleBlend {
+ public:
+  // The spans must outlive the blends (a tangent that cancels takes the heaviest guide's).
+  void prepare(const GuideSpan (&guides)[3], uint32_t n, const glm::dvec3& centre);
+  // Writes points[0, n) and tangents[0, n).
+  void blend(const glm::dvec3& root, const glm::dvec3& tip, glm::vec3* points, glm::vec3* tangents);
+
+ private:
+  GuideSpan guides_[3]{};
+  uint32_t n_ = 0;
+  glm::dvec3 centre_{0.0};
+  std::vector<double> soa_;  // 19 arrays of n: per guide its offsets x, y, z and tangents x, y, z; i/(n−1)
+  std::vector<double> lengths_;  // |t| of the strand's vertices, before renormalising
+};
 
 // The head centre the stray hairs scale about: the centre of the first Ellipsoid of Collision Info,
 // or the origin (the thesis puts its origin at the head centre).

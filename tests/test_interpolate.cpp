@@ -64,13 +64,48 @@ TEST(Interpolate, OneCornerWeightsReproduceThatGuideExactly) {
     g[c] = {&guides.points[guides.firstPoint[tri[c]]], &guides.tangents[guides.firstPoint[tri[c]]]};
   const uint32_t n = guides.pointsOf(tri.x);
   std::vector<glm::vec3> p(n), t(n);
+  TriangleBlend blend;
+  blend.prepare(g, n, strayCentre(grown().config.collision));
   for (int c = 0; c < 3; ++c) {
     glm::dvec3 corner(0.0);
     corner[c] = 1.0;
-    blendStrand(g, n, corner, corner, strayCentre(grown().config.collision), p.data(), t.data());
+    blend.blend(corner, corner, p.data(), t.data());
     for (uint32_t i = 0; i < n; ++i) {
       ASSERT_EQ(p[i], g[c].points[i]) << "corner " << c << " vertex " << i;
       ASSERT_EQ(t[i], g[c].tangents[i]) << "corner " << c << " vertex " << i;
+    }
+  }
+}
+
+// The blend runs across vertices in vector registers; its bits must stay those of the formula taken one
+// vertex at a time in double (caches are compared byte for byte): w = root + (tip − root)·f, p = centre
+// + Σ w_c (g_c − centre), t = Σ w_c t_c / |t|. A fused multiply-add or a reordered sum fails this.
+TEST(Interpolate, BlendKeepsTheBitsOfOneVertexAtATime) {
+  const Strands& guides = grown().guides;
+  const glm::uvec3 tri = grown().wick.triangles[200];
+  GuideSpan g[3];
+  for (int c = 0; c < 3; ++c)
+    g[c] = {&guides.points[guides.firstPoint[tri[c]]], &guides.tangents[guides.firstPoint[tri[c]]]};
+  const uint32_t n = guides.pointsOf(tri.x);
+  const glm::dvec3 centre = strayCentre(grown().config.collision);
+  TriangleBlend blend;
+  blend.prepare(g, n, centre);
+  std::vector<glm::vec3> p(n), t(n);
+  for (uint64_t k = 0; k < 50; ++k) {
+    const glm::dvec3 root = rootWeights(counterUniform(3, 0, k, 0), counterUniform(3, 0, k, 1));
+    const glm::dvec3 tip =
+        tipWeights(root, 0.4 * counterUniform(3, 0, k, 2), 0.4 * counterUniform(3, 0, k, 3), k % 2 == 0);
+    blend.blend(root, tip, p.data(), t.data());
+    for (uint32_t i = 0; i < n; ++i) {
+      const glm::dvec3 w = root + (tip - root) * (double(i) / double(n - 1));
+      glm::dvec3 point = centre, tangent(0.0);
+      for (int c = 0; c < 3; ++c) {
+        point += w[c] * (glm::dvec3(g[c].points[i]) - centre);
+        tangent += w[c] * glm::dvec3(g[c].tangents[i]);
+      }
+      const glm::vec3 expectPoint(point), expectTangent(tangent / glm::length(tangent));
+      ASSERT_EQ(std::memcmp(&p[i], &expectPoint, sizeof p[i]), 0) << "strand " << k << " vertex " << i;
+      ASSERT_EQ(std::memcmp(&t[i], &expectTangent, sizeof t[i]), 0) << "strand " << k << " vertex " << i;
     }
   }
 }

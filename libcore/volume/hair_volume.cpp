@@ -1,36 +1,45 @@
 #include "libcore/volume/hair_volume.h"
 
 #include <algorithm>
-#include <atomic>
+#include <bit>
 #include <cmath>
 #include <cstdio>
 #include <limits>
 
 #include <tbb/blocked_range.h>
+#include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
 
 #include "libcore/model/mesh.h"
 #include "libcore/util/error.h"
+#include "libcore/util/vectorise.h"
 
 namespace hairgen {
 
 namespace {
 
-// Σ over the 8 nodes around p of their trilinear weight times value(i, j, k) (p clamped to the grid).
-template <class T, class G, class Value>
-T trilinear(const G& grid, const glm::dvec3& p, Value value) {
+// Calls corner(w, i, j, k) for the 8 nodes around p (clamped to the grid) with their trilinear weights,
+// z outermost and x innermost.
+template <class G, class Corner>
+void forEachCorner(const G& grid, const glm::dvec3& p, Corner corner) {
   glm::dvec3 g =
       glm::clamp((p - grid.origin) / grid.voxel, glm::dvec3(0.0), glm::dvec3(grid.size - 1) - 1e-9);
   glm::ivec3 c = glm::ivec3(glm::floor(g));
   glm::dvec3 f = g - glm::dvec3(c);
-  T out(0.0);
   for (int dz = 0; dz < 2; ++dz)
     for (int dy = 0; dy < 2; ++dy)
       for (int dx = 0; dx < 2; ++dx) {
         double w = (dx ? f.x : 1 - f.x) * (dy ? f.y : 1 - f.y) * (dz ? f.z : 1 - f.z);
-        out += w * value(std::min(c.x + dx, grid.size.x - 1), std::min(c.y + dy, grid.size.y - 1),
-                         std::min(c.z + dz, grid.size.z - 1));
+        corner(w, std::min(c.x + dx, grid.size.x - 1), std::min(c.y + dy, grid.size.y - 1),
+               std::min(c.z + dz, grid.size.z - 1));
       }
+}
+
+// Σ over the 8 nodes around p of their trilinear weight times value(i, j, k) (p clamped to the grid).
+template <class T, class G, class Value>
+T trilinear(const G& grid, const glm::dvec3& p, Value value) {
+  T out(0.0);
+  forEachCorner(grid, p, [&](double w, int i, int j, int k) { out += w * value(i, j, k); });
   return out;
 }
 
@@ -67,6 +76,23 @@ glm::dvec3 sampleGradient(const Grid& grid, const std::vector<glm::vec3>& gradie
       grid, p, [&](int i, int j, int k) { return glm::dvec3(gradients[grid.index(i, j, k)]); });
 }
 
+// grid.sample(p) and sampleGradient(grid, gradients, p) in one pass over the cell: the same weights and
+// the same sums, so the same bits as the two calls, for half the finding of the cell and its weights.
+struct ValueAndGradient {
+  double value = 0.0;
+  glm::dvec3 gradient{0.0};
+};
+ValueAndGradient sampleWithGradient(const Grid& grid, const std::vector<glm::vec3>& gradients,
+                                    const glm::dvec3& p) {
+  ValueAndGradient out;
+  forEachCorner(grid, p, [&](double w, int i, int j, int k) {
+    const size_t node = grid.index(i, j, k);
+    out.value += w * double(grid.values[node]);
+    out.gradient += w * glm::dvec3(gradients[node]);
+  });
+  return out;
+}
+
 }  // namespace
 
 template <class T>
@@ -91,41 +117,120 @@ GridOf<T> gridAround(const std::vector<glm::vec3>& points, double voxel, int pad
   return g;
 }
 
+namespace {
+
+constexpr double kSplatOne = 4294967296.0;  // 2^32: splat's weights are 32.32 fixed point
+constexpr size_t kSplatBlock = 256;
+
+// One corner's 32.32 weight for a block of points: int64(w·2^32 + 0.5), w the product of the tent
+// weights in x, y, z in that order. x = w·2^32 + 0.5 lies in [0.5, 2^33), where adding 2^52 rounds it
+// to the nearest integer exactly and leaves that integer in the low bits; one less where that rounded
+// up is the truncation int64(x) takes. All of it runs in vector registers, which a double-to-int64
+// conversion does not before AVX-512.
+template <int dx, int dy, int dz>
+inline __attribute__((always_inline)) void cornerWeights(size_t count, const double* __restrict fx,
+                                                         const double* __restrict fy,
+                                                         const double* __restrict fz, int64_t* __restrict w) {
+  HAIRGEN_IVDEP
+  for (size_t p = 0; p < count; ++p) {
+    const double x =
+        (dx ? fx[p] : 1 - fx[p]) * (dy ? fy[p] : 1 - fy[p]) * (dz ? fz[p] : 1 - fz[p]) * kSplatOne + 0.5;
+    const double y = x + 0x1p52;
+    w[p] = std::bit_cast<int64_t>(y) - std::bit_cast<int64_t>(0x1p52) - (y - 0x1p52 > x ? 1 : 0);
+  }
+}
+
+// The cells (floor of the grid coordinate) and the eight corner weights of a block of points.
+HAIRGEN_VECTOR_CLONES
+void splatBlock(const glm::dvec3& origin, double voxel, const glm::vec3* __restrict points, size_t count,
+                int* __restrict cell, int64_t* __restrict w) {
+  constexpr size_t kB = kSplatBlock;
+  double f[3 * kB];
+  const float* const xyz = &points[0].x;
+  for (int axis = 0; axis < 3; ++axis) {
+    const double o = axis == 0 ? origin.x : axis == 1 ? origin.y : origin.z;
+    HAIRGEN_IVDEP
+    for (size_t p = 0; p < count; ++p) {
+      const double g = (double(xyz[3 * p + axis]) - o) / voxel;
+      const int truncated = static_cast<int>(g);
+      const int c = double(truncated) > g ? truncated - 1 : truncated;  // floor(g), in vector registers
+      cell[axis * kB + p] = c;
+      f[axis * kB + p] = g - double(c);
+    }
+  }
+  const double *fx = f, *fy = f + kB, *fz = f + 2 * kB;
+  cornerWeights<0, 0, 0>(count, fx, fy, fz, w);
+  cornerWeights<1, 0, 0>(count, fx, fy, fz, w + kB);
+  cornerWeights<0, 1, 0>(count, fx, fy, fz, w + 2 * kB);
+  cornerWeights<1, 1, 0>(count, fx, fy, fz, w + 3 * kB);
+  cornerWeights<0, 0, 1>(count, fx, fy, fz, w + 4 * kB);
+  cornerWeights<1, 0, 1>(count, fx, fy, fz, w + 5 * kB);
+  cornerWeights<0, 1, 1>(count, fx, fy, fz, w + 6 * kB);
+  cornerWeights<1, 1, 1>(count, fx, fy, fz, w + 7 * kB);
+}
+
+}  // namespace
+
 void splat(Grid& d, const std::vector<glm::vec3>& points) {
   // Weights are added as 32.32 fixed-point integers: integer sums do not depend on the order of the
-  // additions, so the threads may race and the grid is the same bits on every run and thread count.
-  // Each point's eight weights are rounded to sum to exactly one (the rounding is given to its
+  // additions, so however the points fall to threads the grid is the same bits on every run and thread
+  // count. Each point's eight weights are rounded to sum to exactly one (the rounding is given to its
   // largest weight), so a point inside the grid adds exactly 1 to it.
-  constexpr double kOne = 4294967296.0;  // 2^32
-  std::vector<int64_t> sums(d.values.size(), 0);
+  // Each thread sums into a grid of its own (atomic adds to one shared grid cost more than the rest of
+  // the splat together); the threads' grids are added node by node after, which integer sums allow.
+  constexpr size_t kB = kSplatBlock;
+  tbb::enumerable_thread_specific<std::vector<int64_t>> partial(
+      [&] { return std::vector<int64_t>(d.values.size(), 0); });
   const glm::ivec3 size = d.size;
+  const size_t strideY = size_t(size.x), strideZ = strideY * size_t(size.y);
   tbb::parallel_for(
       tbb::blocked_range<size_t>(0, points.size(), 4096), [&](const tbb::blocked_range<size_t>& r) {
-        for (size_t p = r.begin(); p != r.end(); ++p) {
-          glm::dvec3 g = (glm::dvec3(points[p]) - d.origin) / d.voxel;
-          glm::ivec3 c = glm::ivec3(glm::floor(g));
-          glm::dvec3 f = g - glm::dvec3(c);
-          int64_t w[8];
-          int64_t total = 0;
-          int largest = 0;
-          for (int corner = 0; corner < 8; ++corner) {
-            const int dx = corner & 1, dy = (corner >> 1) & 1, dz = corner >> 2;
-            w[corner] =
-                int64_t((dx ? f.x : 1 - f.x) * (dy ? f.y : 1 - f.y) * (dz ? f.z : 1 - f.z) * kOne + 0.5);
-            total += w[corner];
-            if (w[corner] > w[largest]) largest = corner;
-          }
-          w[largest] += int64_t(kOne) - total;
-          for (int corner = 0; corner < 8; ++corner) {  // on the grid's edge, the outer corners fall away
-            const glm::ivec3 n = c + glm::ivec3(corner & 1, (corner >> 1) & 1, corner >> 2);
-            if (glm::any(glm::lessThan(n, glm::ivec3(0))) || glm::any(glm::greaterThanEqual(n, size)))
+        std::vector<int64_t>& sums = partial.local();
+        int cell[3 * kB];
+        int64_t weights[8 * kB];
+        for (size_t first = r.begin(); first < r.end(); first += kB) {
+          const size_t count = std::min(kB, r.end() - first);
+          splatBlock(d.origin, d.voxel, &points[first], count, cell, weights);
+          for (size_t p = 0; p < count; ++p) {
+            int64_t w[8];
+            int64_t total = 0;
+            int largest = 0;
+            for (int corner = 0; corner < 8; ++corner) {
+              w[corner] = weights[corner * kB + p];
+              total += w[corner];
+              if (w[corner] > w[largest]) largest = corner;
+            }
+            w[largest] += int64_t(kSplatOne) - total;
+            const glm::ivec3 c(cell[p], cell[kB + p], cell[2 * kB + p]);
+            if (glm::all(glm::greaterThanEqual(c, glm::ivec3(0))) && glm::all(glm::lessThan(c + 1, size))) {
+              const size_t base = d.index(c.x, c.y, c.z);
+              sums[base] += w[0];
+              sums[base + 1] += w[1];
+              sums[base + strideY] += w[2];
+              sums[base + strideY + 1] += w[3];
+              sums[base + strideZ] += w[4];
+              sums[base + strideZ + 1] += w[5];
+              sums[base + strideZ + strideY] += w[6];
+              sums[base + strideZ + strideY + 1] += w[7];
               continue;
-            std::atomic_ref<int64_t>(sums[d.index(n.x, n.y, n.z)])
-                .fetch_add(w[corner], std::memory_order_relaxed);
+            }
+            for (int corner = 0; corner < 8; ++corner) {  // on the grid's edge, the outer corners fall away
+              const glm::ivec3 n = c + glm::ivec3(corner & 1, (corner >> 1) & 1, corner >> 2);
+              if (glm::any(glm::lessThan(n, glm::ivec3(0))) || glm::any(glm::greaterThanEqual(n, size)))
+                continue;
+              sums[d.index(n.x, n.y, n.z)] += w[corner];
+            }
           }
         }
       });
-  for (size_t i = 0; i < sums.size(); ++i) d.values[i] += static_cast<float>(double(sums[i]) / kOne);
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, d.values.size(), 16384),
+                    [&](const tbb::blocked_range<size_t>& r) {
+                      for (size_t i = r.begin(); i != r.end(); ++i) {
+                        int64_t sum = 0;
+                        for (const std::vector<int64_t>& sums : partial) sum += sums[i];
+                        d.values[i] += static_cast<float>(double(sum) / kSplatOne);
+                      }
+                    });
 }
 
 template <class T>
@@ -289,26 +394,31 @@ Grid signedDistance(const Grid& density, double iso) {
 
   // Fast sweeping of the nearest points (a closest-point transform): in each of the 8 orders of the
   // axes a node takes the nearest point of a neighbour behind it when that is nearer than its own.
+  // A node reads only the neighbours behind it in the order, each already swept in it, and writes only
+  // itself; so the x-lines (jj, kk) on one diagonal jj + kk = d depend on the diagonal before alone,
+  // and sweeping the diagonals in turn, their lines at once, gives the bits of the raster order.
   auto sweep = [&] {  // one round of the 8 orders: the slide below mends what it leaves
     for (int order = 0; order < 8; ++order) {
       const bool fx = order & 1, fy = order & 2, fz = order & 4;
-      for (int kk = 0; kk < n.z; ++kk)
-        for (int jj = 0; jj < n.y; ++jj)
-          for (int ii = 0; ii < n.x; ++ii) {
-            const int i = fx ? n.x - 1 - ii : ii, j = fy ? n.y - 1 - jj : jj, k = fz ? n.z - 1 - kk : kk;
-            const size_t id = density.index(i, j, k);
-            const glm::dvec3 x = node(i, j, k);
-            const bool has[3] = {fx ? i + 1 < n.x : i > 0, fy ? j + 1 < n.y : j > 0,
-                                 fz ? k + 1 < n.z : k > 0};
-            const size_t behind[3] = {fx ? id + 1 : id - 1, fy ? id + strideY : id - strideY,
-                                      fz ? id + strideZ : id - strideZ};
-            for (int axis = 0; axis < 3; ++axis) {
-              if (!has[axis] || dist2[behind[axis]] == kNone) continue;
-              const glm::dvec3 e = nearest[behind[axis]] - x;
-              const double d2 = glm::dot(e, e);
-              if (d2 < dist2[id]) nearest[id] = nearest[behind[axis]], dist2[id] = d2;
-            }
+      auto line = [&](int jj, int kk) {
+        for (int ii = 0; ii < n.x; ++ii) {
+          const int i = fx ? n.x - 1 - ii : ii, j = fy ? n.y - 1 - jj : jj, k = fz ? n.z - 1 - kk : kk;
+          const size_t id = density.index(i, j, k);
+          const glm::dvec3 x = node(i, j, k);
+          const bool has[3] = {fx ? i + 1 < n.x : i > 0, fy ? j + 1 < n.y : j > 0, fz ? k + 1 < n.z : k > 0};
+          const size_t behind[3] = {fx ? id + 1 : id - 1, fy ? id + strideY : id - strideY,
+                                    fz ? id + strideZ : id - strideZ};
+          for (int axis = 0; axis < 3; ++axis) {
+            if (!has[axis] || dist2[behind[axis]] == kNone) continue;
+            const glm::dvec3 e = nearest[behind[axis]] - x;
+            const double d2 = glm::dot(e, e);
+            if (d2 < dist2[id]) nearest[id] = nearest[behind[axis]], dist2[id] = d2;
           }
+        }
+      };
+      for (int d = 0; d <= (n.y - 1) + (n.z - 1); ++d)
+        tbb::parallel_for(std::max(0, d - (n.y - 1)), std::min(d, n.z - 1) + 1,
+                          [&](int kk) { line(d - kk, kk); });
     }
   };
 
@@ -319,15 +429,19 @@ Grid signedDistance(const Grid& density, double iso) {
   // trilinear φ, p ← p − φ ∇φ/|∇φ|², back onto the shell; kept while the distance falls.
   const double tolerance = 1e-4 * std::abs(iso) + 1e-12;
   const std::vector<glm::vec3> gradients = nodeGradients(density);
-  auto ontoShell = [&](glm::dvec3& p) {
-    double value = density.sample(p) - iso;
+  // ontoShell leaves in `gradient` ∇φ at the point it returns, which the slide's next round starts from.
+  auto ontoShell = [&](glm::dvec3& p, glm::dvec3& gradient) {
+    ValueAndGradient at = sampleWithGradient(density, gradients, p);
+    double value = at.value - iso;
     for (int step = 0; step < 16 && std::abs(value) > tolerance; ++step) {
-      const glm::dvec3 g = sampleGradient(density, gradients, p);
+      const glm::dvec3 g = at.gradient;
       const double g2 = glm::dot(g, g);
       if (!(g2 > 0.0)) return false;
       p -= (value / g2) * g;
-      value = density.sample(p) - iso;
+      at = sampleWithGradient(density, gradients, p);
+      value = at.value - iso;
     }
+    gradient = at.gradient;
     return std::abs(value) <= tolerance;
   };
   auto slide = [&] {
@@ -337,19 +451,20 @@ Grid signedDistance(const Grid& density, double iso) {
           const size_t id = density.index(i, j, k);
           if (dist2[id] == kNone) continue;
           const glm::dvec3 x = node(i, j, k);
+          glm::dvec3 g = sampleGradient(density, gradients, nearest[id]);
           for (int round = 0; round < 6; ++round) {
-            const glm::dvec3 p = nearest[id], g = sampleGradient(density, gradients, p);
+            const glm::dvec3 p = nearest[id];
             const double g2 = glm::dot(g, g);
             if (!(g2 > 0.0)) break;
             glm::dvec3 across = (x - p) - glm::dot(x - p, g) / g2 * g;
             const double a2 = glm::dot(across, across);
             if (a2 <= 1e-6 * dist2[id]) break;
             if (a2 > h * h) across *= h / std::sqrt(a2);
-            glm::dvec3 q = p + across;
-            if (!ontoShell(q)) break;
+            glm::dvec3 q = p + across, gq;
+            if (!ontoShell(q, gq)) break;
             const double d2 = glm::dot(q - x, q - x);
             if (!(d2 < dist2[id])) break;
-            nearest[id] = q, dist2[id] = d2;
+            nearest[id] = q, dist2[id] = d2, g = gq;
           }
         }
     });
@@ -382,17 +497,98 @@ HairVolume buildVolume(const Strands& strands, double voxel, int padding, double
   return volume;
 }
 
+namespace {
+
+// One corner of the trilinear interpolant for a block of points (sampleGradient's loop body, dz, dy, dx
+// fixed): out += w · gradient at the corner, with trilinear's weight and clamped index.
+template <int dx, int dy, int dz>
+inline __attribute__((always_inline)) void addCorner(size_t count, const int sx, const int sy, const int sz,
+                                                     const glm::vec3* __restrict gradients,
+                                                     const int* __restrict cx, const int* __restrict cy,
+                                                     const int* __restrict cz, const double* __restrict fx,
+                                                     const double* __restrict fy, const double* __restrict fz,
+                                                     double* __restrict ox, double* __restrict oy,
+                                                     double* __restrict oz) {
+  HAIRGEN_IVDEP
+  for (size_t p = 0; p < count; ++p) {
+    const double w = (dx ? fx[p] : 1 - fx[p]) * (dy ? fy[p] : 1 - fy[p]) * (dz ? fz[p] : 1 - fz[p]);
+    const int i = std::min(cx[p] + dx, sx - 1), j = std::min(cy[p] + dy, sy - 1),
+              k = std::min(cz[p] + dz, sz - 1);
+    const int node = (k * sy + j) * sx + i;  // fewer than 2^31 nodes (gridAround)
+    ox[p] = ox[p] + w * double(gradients[node].x);
+    oy[p] = oy[p] + w * double(gradients[node].y);
+    oz[p] = oz[p] + w * double(gradients[node].z);
+  }
+}
+
+// Normals ∇S/|∇S| of up to 256 points: sampleGradient and the normalisation of volumeNormals, one stage
+// at a time over the block so each runs across points in vector registers (libcore/util/vectorise.h),
+// with the arithmetic of trilinear() per point. The cell is the truncation of the clamped grid
+// coordinate: it is never negative, where truncating is flooring.
+HAIRGEN_VECTOR_CLONES
+void normalsOfBlock(const Grid& grid, const glm::vec3* __restrict gradients,
+                    const glm::vec3* __restrict points, size_t count, glm::vec3* __restrict normals) {
+  constexpr size_t kB = 256;
+  int c[3 * kB];
+  double f[3 * kB], out[3 * kB];
+  const glm::dvec3 top = glm::dvec3(grid.size - 1) - 1e-9;
+  const float* const xyz = &points[0].x;
+  for (int axis = 0; axis < 3; ++axis) {
+    const double origin = grid.origin[axis], voxel = grid.voxel, hi = top[axis];
+    HAIRGEN_IVDEP
+    for (size_t p = 0; p < count; ++p) {
+      double g = (double(xyz[3 * p + axis]) - origin) / voxel;
+      g = g < 0.0 ? 0.0 : g;  // glm::clamp: min(max(g, 0), hi)
+      g = hi < g ? hi : g;
+      const int cell = static_cast<int>(g);
+      c[axis * kB + p] = cell;
+      f[axis * kB + p] = g - double(cell);
+      out[axis * kB + p] = 0.0;
+    }
+  }
+  const int sx = grid.size.x, sy = grid.size.y, sz = grid.size.z;
+  addCorner<0, 0, 0>(count, sx, sy, sz, gradients, c, c + kB, c + 2 * kB, f, f + kB, f + 2 * kB, out,
+                     out + kB, out + 2 * kB);
+  addCorner<1, 0, 0>(count, sx, sy, sz, gradients, c, c + kB, c + 2 * kB, f, f + kB, f + 2 * kB, out,
+                     out + kB, out + 2 * kB);
+  addCorner<0, 1, 0>(count, sx, sy, sz, gradients, c, c + kB, c + 2 * kB, f, f + kB, f + 2 * kB, out,
+                     out + kB, out + 2 * kB);
+  addCorner<1, 1, 0>(count, sx, sy, sz, gradients, c, c + kB, c + 2 * kB, f, f + kB, f + 2 * kB, out,
+                     out + kB, out + 2 * kB);
+  addCorner<0, 0, 1>(count, sx, sy, sz, gradients, c, c + kB, c + 2 * kB, f, f + kB, f + 2 * kB, out,
+                     out + kB, out + 2 * kB);
+  addCorner<1, 0, 1>(count, sx, sy, sz, gradients, c, c + kB, c + 2 * kB, f, f + kB, f + 2 * kB, out,
+                     out + kB, out + 2 * kB);
+  addCorner<0, 1, 1>(count, sx, sy, sz, gradients, c, c + kB, c + 2 * kB, f, f + kB, f + 2 * kB, out,
+                     out + kB, out + 2 * kB);
+  addCorner<1, 1, 1>(count, sx, sy, sz, gradients, c, c + kB, c + 2 * kB, f, f + kB, f + 2 * kB, out,
+                     out + kB, out + 2 * kB);
+  float* const n = &normals[0].x;
+  double* const lengths = f;  // the fractions are spent
+  HAIRGEN_IVDEP
+  for (size_t p = 0; p < count; ++p) {
+    const double x = out[p], y = out[kB + p], z = out[2 * kB + p];
+    const double len = std::sqrt((x * x + y * y) + z * z);
+    lengths[p] = len;
+    n[3 * p] = static_cast<float>(x / len);
+    n[3 * p + 1] = static_cast<float>(y / len);
+    n[3 * p + 2] = static_cast<float>(z / len);
+  }
+  for (size_t p = 0; p < count; ++p)  // no gradient (a flat distance): +y, as every vertex must have one
+    if (!(lengths[p] > 1e-12)) normals[p] = glm::vec3(0, 1, 0);
+}
+
+}  // namespace
+
 std::vector<glm::vec3> volumeNormals(const Grid& distance, const Strands& strands) {
   const std::vector<glm::vec3> gradients = nodeGradients(distance);
   std::vector<glm::vec3> normals(strands.pointCount());
-  tbb::parallel_for(
-      tbb::blocked_range<size_t>(0, strands.pointCount(), 8192), [&](const tbb::blocked_range<size_t>& r) {
-        for (size_t p = r.begin(); p != r.end(); ++p) {
-          const glm::dvec3 g = sampleGradient(distance, gradients, glm::dvec3(strands.points[p]));
-          const double len = glm::length(g);
-          normals[p] = len > 1e-12 ? glm::vec3(g / len) : glm::vec3(0, 1, 0);
-        }
-      });
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, strands.pointCount(), 8192),
+                    [&](const tbb::blocked_range<size_t>& r) {
+                      for (size_t p = r.begin(); p < r.end(); p += 256)
+                        normalsOfBlock(distance, gradients.data(), &strands.points[p],
+                                       std::min<size_t>(256, r.end() - p), &normals[p]);
+                    });
   return normals;
 }
 
