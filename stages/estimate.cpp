@@ -5,10 +5,12 @@
 
 #include <algorithm>
 #include <cmath>
+#include <thread>
 
 #include "libcore/util/error.h"
 #include "libcore/util/resources.h"
 #include "libcore/util/text.h"
+#include "libcore/volume/hair_volume.h"
 
 namespace hairgen {
 namespace {
@@ -133,7 +135,10 @@ WorkEstimate estimateShade(const RenderSettings& render, size_t strands, size_t 
   const double grid = nodes.x * nodes.y * nodes.z;
   // Per node: density, smoothed density and distance (floats), gradients and nearest shell points
   // (float triples), the sweep's state; per vertex its normal, and the coupe itself.
-  e.bytes = bytesOf(grid * 64.0 + double(points) * (12.0 + 40.0) + double(strands) * 64.0);
+  // The splat's per-thread grids (int64 per node), as many as kSplatCopiesBytes holds and the cores use.
+  const double copies = std::min(grid * 8.0 * double(std::max(1u, std::thread::hardware_concurrency())),
+                                 std::max(kSplatCopiesBytes, grid * 8.0));
+  e.bytes = bytesOf(grid * 64.0 + copies + double(points) * (12.0 + 40.0) + double(strands) * 64.0);
   e.seconds = grid * kSecondsPerNode + double(points) * kSecondsPerSplat;
   e.memoryKey = e.timeKey = "Render.VoxelSize (or check the cache is in metres)";
   e.detail = formatReal(nodes.x) + " x " + formatReal(nodes.y) + " x " + formatReal(nodes.z) + " grid nodes";

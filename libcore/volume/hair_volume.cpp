@@ -9,6 +9,7 @@
 #include <tbb/blocked_range.h>
 #include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
 
 #include "libcore/model/mesh.h"
 #include "libcore/util/error.h"
@@ -183,46 +184,50 @@ void splat(Grid& d, const std::vector<glm::vec3>& points) {
       [&] { return std::vector<int64_t>(d.values.size(), 0); });
   const glm::ivec3 size = d.size;
   const size_t strideY = size_t(size.x), strideZ = strideY * size_t(size.y);
-  tbb::parallel_for(
-      tbb::blocked_range<size_t>(0, points.size(), 4096), [&](const tbb::blocked_range<size_t>& r) {
-        std::vector<int64_t>& sums = partial.local();
-        int cell[3 * kB];
-        int64_t weights[8 * kB];
-        for (size_t first = r.begin(); first < r.end(); first += kB) {
-          const size_t count = std::min(kB, r.end() - first);
-          splatBlock(d.origin, d.voxel, &points[first], count, cell, weights);
-          for (size_t p = 0; p < count; ++p) {
-            int64_t w[8];
-            int64_t total = 0;
-            int largest = 0;
-            for (int corner = 0; corner < 8; ++corner) {
-              w[corner] = weights[corner * kB + p];
-              total += w[corner];
-              if (w[corner] > w[largest]) largest = corner;
-            }
-            w[largest] += int64_t(kSplatOne) - total;
-            const glm::ivec3 c(cell[p], cell[kB + p], cell[2 * kB + p]);
-            if (glm::all(glm::greaterThanEqual(c, glm::ivec3(0))) && glm::all(glm::lessThan(c + 1, size))) {
-              const size_t base = d.index(c.x, c.y, c.z);
-              sums[base] += w[0];
-              sums[base + 1] += w[1];
-              sums[base + strideY] += w[2];
-              sums[base + strideY + 1] += w[3];
-              sums[base + strideZ] += w[4];
-              sums[base + strideZ + 1] += w[5];
-              sums[base + strideZ + strideY] += w[6];
-              sums[base + strideZ + strideY + 1] += w[7];
-              continue;
-            }
-            for (int corner = 0; corner < 8; ++corner) {  // on the grid's edge, the outer corners fall away
-              const glm::ivec3 n = c + glm::ivec3(corner & 1, (corner >> 1) & 1, corner >> 2);
-              if (glm::any(glm::lessThan(n, glm::ivec3(0))) || glm::any(glm::greaterThanEqual(n, size)))
+  const size_t copies = std::clamp<size_t>(size_t(kSplatCopiesBytes / (8.0 * double(d.values.size()) + 1.0)),
+                                           1, size_t(tbb::this_task_arena::max_concurrency()));
+  tbb::task_arena(int(copies)).execute([&] {
+    tbb::parallel_for(
+        tbb::blocked_range<size_t>(0, points.size(), 4096), [&](const tbb::blocked_range<size_t>& r) {
+          std::vector<int64_t>& sums = partial.local();
+          int cell[3 * kB];
+          int64_t weights[8 * kB];
+          for (size_t first = r.begin(); first < r.end(); first += kB) {
+            const size_t count = std::min(kB, r.end() - first);
+            splatBlock(d.origin, d.voxel, &points[first], count, cell, weights);
+            for (size_t p = 0; p < count; ++p) {
+              int64_t w[8];
+              int64_t total = 0;
+              int largest = 0;
+              for (int corner = 0; corner < 8; ++corner) {
+                w[corner] = weights[corner * kB + p];
+                total += w[corner];
+                if (w[corner] > w[largest]) largest = corner;
+              }
+              w[largest] += int64_t(kSplatOne) - total;
+              const glm::ivec3 c(cell[p], cell[kB + p], cell[2 * kB + p]);
+              if (glm::all(glm::greaterThanEqual(c, glm::ivec3(0))) && glm::all(glm::lessThan(c + 1, size))) {
+                const size_t base = d.index(c.x, c.y, c.z);
+                sums[base] += w[0];
+                sums[base + 1] += w[1];
+                sums[base + strideY] += w[2];
+                sums[base + strideY + 1] += w[3];
+                sums[base + strideZ] += w[4];
+                sums[base + strideZ + 1] += w[5];
+                sums[base + strideZ + strideY] += w[6];
+                sums[base + strideZ + strideY + 1] += w[7];
                 continue;
-              sums[d.index(n.x, n.y, n.z)] += w[corner];
+              }
+              for (int corner = 0; corner < 8; ++corner) {  // on the grid's edge, the outer corners fall away
+                const glm::ivec3 n = c + glm::ivec3(corner & 1, (corner >> 1) & 1, corner >> 2);
+                if (glm::any(glm::lessThan(n, glm::ivec3(0))) || glm::any(glm::greaterThanEqual(n, size)))
+                  continue;
+                sums[d.index(n.x, n.y, n.z)] += w[corner];
+              }
             }
           }
-        }
-      });
+        });
+  });
   tbb::parallel_for(tbb::blocked_range<size_t>(0, d.values.size(), 16384),
                     [&](const tbb::blocked_range<size_t>& r) {
                       for (size_t i = r.begin(); i != r.end(); ++i) {

@@ -41,7 +41,10 @@ GridOf<T> gridAround(const std::vector<glm::vec3>& points, double voxel, int pad
 
 // Splats every point with the tent (trilinear) kernel of the paper's (1): each point adds weights
 // summing to exactly 1 to the 8 nodes around it, so the grid sums to the number of points inside it.
-// Parallel, and the same bits whatever the thread count.
+// Parallel, and the same bits whatever the thread count. Each thread sums into a grid of its own, as
+// many as fit in kSplatCopiesBytes (at least one): a many-core machine with a fine grid runs the
+// splat on fewer threads rather than holding a grid per core.
+constexpr double kSplatCopiesBytes = 256.0 * 1024 * 1024;
 void splat(Grid& density, const std::vector<glm::vec3>& points);
 
 // Adds values[i] times point i's tent weights to the 8 nodes around it (the outer corners of a point
