@@ -1,8 +1,9 @@
 #!/usr/bin/env bash
 # Remakes the README gallery: docs/coupe1-4.png, docs/coupe3-volumetric.png, docs/bob.png and
 # docs/default.png, each `hairgen run` of a bundled coupe at 320x320 with its own density, and the shots'
-# GIFs docs/gust.gif and docs/headturn.gif at 240x240 (the head turn at half density: 72 frames of the
-# full coupe take too long for a picture this small). Look at them before committing.
+# GIFs docs/gust.gif, docs/headturn.gif and docs/target.gif (with docs/target.png, the density target) at
+# 240x240 (the head turn and the target at half density: 72 frames of the full coupe take too long for a
+# picture this small). Look at them before committing.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/setup.sh
@@ -30,6 +31,7 @@ done
 shots=(
   "anjyo/gust gust"
   "shots/headturn headturn Hairstyle.HairDensity=50"
+  "pixar/target target Hairstyle.HairDensity=50"
 )
 for entry in "${shots[@]}"; do
   read -r name movie sets <<<"$entry"
@@ -40,3 +42,12 @@ for entry in "${shots[@]}"; do
   cp "$out/beauty.gif" "docs/$movie.gif"
   echo "gallery: docs/$movie.gif" >&2
 done
+# The density-targeting shot's target itself, for comparison: target.data interpolated and rendered.
+out=build/gallery/target-shape
+mkdir -p "$out"
+target_sets=(--quiet --set "Hairstyle.HairDensity=50" --set "Render.Resolution=240 240")
+./build/hairgen interpolate configs/pixar/target/setup.txt --guides configs/pixar/target/target.data \
+  -o "$out/coupe.hair" "${target_sets[@]}"
+./build/hairgen render configs/pixar/target/setup.txt --hair "$out/coupe.hair" -o "$out/beauty.exr" \
+  --preview docs/target.png "${target_sets[@]}"
+echo "gallery: docs/target.png" >&2

@@ -13,6 +13,9 @@
 namespace hairgen {
 namespace {
 
+// Density targeting: the grids of a spacing, shifted by half a cell along each combination of axes.
+constexpr int kDensityShifts = 8;
+
 // The most nodes a velocity grid may have: past it the spacing is coarsened (doubled) until it fits.
 constexpr double kMaxGridNodes = 2e7;
 
@@ -186,19 +189,31 @@ SpringHair::SpringHair(const Strands& rest, const Hairstyle& style, const Dynami
     const double scale =
         densityTarget->points.empty() ? 0.0 : double(rest.pointCount()) / double(densityTarget->pointCount());
     for (double h : dynamics.densitySpacings) {
-      Grid target = gridAround(both, h, 3);
-      splat(target, densityTarget->points);
-      for (float& value : target.values) value = float(double(value) * scale);
-      // The target's mean density where it has any: the force's unit at this spacing.
-      double sum = 0.0;
-      size_t occupied = 0;
-      for (float value : target.values)
-        if (value > 0.0f) {
-          sum += value;
-          ++occupied;
-        }
-      targetMean_.push_back(occupied ? sum / double(occupied) : 1.0);
-      targets_.push_back(std::move(target));
+      // Eight copies of the level's grid, shifted by half a cell along every combination of axes: the
+      // energy of one grid depends on where its cell walls fall (a surplus of hair may sit one cell
+      // away from the place it lacks, or in the same cell), the mean of the eight much less.
+      std::vector<Grid> grids;
+      double meanSum = 0.0;
+      for (int corner = 0; corner < kDensityShifts; ++corner) {
+        Grid target = gridAround(both, h, 3);
+        target.origin -= 0.5 * h * glm::dvec3(corner & 1, (corner >> 1) & 1, corner >> 2);
+        target.size += glm::ivec3(1);
+        target.values.assign(size_t(target.size.x) * target.size.y * target.size.z, 0.0f);
+        splat(target, densityTarget->points);
+        for (float& value : target.values) value = float(double(value) * scale);
+        // The target's mean density where it has any: the force's unit at this spacing.
+        double sum = 0.0;
+        size_t occupied = 0;
+        for (float value : target.values)
+          if (value > 0.0f) {
+            sum += value;
+            ++occupied;
+          }
+        meanSum += occupied ? sum / double(occupied) : 1.0;
+        grids.push_back(std::move(target));
+      }
+      targetMean_.push_back(meanSum / double(grids.size()));
+      targets_.push_back(std::move(grids));
     }
     for (size_t level = 0; level < targets_.size(); ++level) startEnergy_.push_back(densityEnergy(level));
   }
@@ -210,15 +225,20 @@ std::vector<glm::vec3> SpringHair::floatPoints() const {
   return out;
 }
 
-Grid SpringHair::densityDifference(size_t level) const {
-  Grid d = targets_[level];
-  for (float& value : d.values) value = -value;
-  splat(d, floatPoints());
-  return d;
+std::vector<Grid> SpringHair::densityDifference(size_t level) const {
+  std::vector<Grid> out = targets_[level];
+  const std::vector<glm::vec3> points = floatPoints();
+  for (Grid& d : out) {
+    for (float& value : d.values) value = -value;
+    splat(d, points);
+  }
+  return out;
 }
 
 double SpringHair::densityEnergy(size_t level) const {
-  return hairgen::densityEnergy(densityDifference(level));
+  double sum = 0.0;
+  for (const Grid& d : densityDifference(level)) sum += hairgen::densityEnergy(d);
+  return sum / double(targets_[level].size());
 }
 
 double SpringHair::kineticEnergy() const {
@@ -379,10 +399,13 @@ void SpringHair::stepStrand(size_t s, const AccelerationField& field, double dt)
     f -= restTension_[p] * unit[i];
     if (i < n) f += restTension_[p + 1] * unit[i + 1];
     f += mass_[p] * field.at(x_[p], v_[p]);
-    if (!difference_.values.empty() && densityStrength_ > 0.0) {
+    if (!difference_.empty() && densityStrength_ > 0.0) {
       // The memo's F in units of the target's mean density, at most 1 long: where the shapes are far
       // apart the push is DensityStrength toward the target, not a kick that flings the hair.
-      glm::dvec3 push = densityForce(difference_, x_[p]) / targetMean_[level_];
+      // The mean of the eight shifted grids' forces.
+      glm::dvec3 push(0.0);
+      for (const Grid& d : difference_) push += densityForce(d, x_[p]);
+      push /= double(difference_.size()) * targetMean_[level_];
       const double size = glm::length(push);
       if (size > 1.0) push /= size;
       f += mass_[p] * densityStrength_ * push;

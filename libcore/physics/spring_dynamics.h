@@ -37,12 +37,15 @@
 //   it. As a map on the velocities this is (1 − s)I + s·A with A = Wᵀ S D⁻¹ S W M self-adjoint in the
 //   mass inner product with eigenvalues in [0, 1] (README), so it never raises the kinetic energy.
 // - Density targeting (§5.2): the target's points (scaled to the hair's point count) and the hair's are
-//   splatted on one fixed grid per spacing; a particle's acceleration is DensityStrength times the memo's
-//   F (densityForce in libcore/volume/hair_volume.h) over the target's mean density where it has any,
-//   so the strength means the same on every grid: the acceleration of a point where the density is
-//   wrong by the target's mean from one node to the next. Spacings go from coarse to fine: at each frame
-//   the hair uses the finest spacing all of whose coarser ones have fallen to DensityRefine of their
-//   starting energy (a rule of the present state, so a restart needs nothing more).
+//   splatted on fixed grids per spacing: eight of them, the same grid shifted by half a cell along every
+//   combination of axes, and E is the mean of the eight grids' energies (one grid's E depends on where
+//   its cell walls fall; the mean much less). A particle's acceleration is DensityStrength times the
+//   mean of the eight grids' memo's F (densityForce in libcore/volume/hair_volume.h), so −∂E/∂P, over
+//   the target's mean density where it has any, so the strength means the same on every grid: the
+//   acceleration of a point where the density is wrong by the target's mean from one node to the next.
+//   Spacings go from coarse to fine: at each frame the hair uses the finest spacing all of whose
+//   coarser ones have fallen to DensityRefine of their starting energy (a rule of the present state,
+//   so a restart needs nothing more).
 //
 // Guarantees: a step depends only on the state (positions and velocities, in doubles) and the inputs;
 // strands step in parallel and every grid sums in a fixed order, so the result is the same bits for any
@@ -108,7 +111,8 @@ class SpringHair {
   void setPositions(const std::vector<glm::dvec3>& x) { x_ = x; }
   const std::vector<double>& masses() const { return mass_; }
   double kineticEnergy() const;  // joules, summed in point order
-  // §5.2: E = ½ Σ (D_s − D_t)² of the current positions on the grid of spacing `level` (0 = coarsest);
+  // §5.2: E = ½ Σ (D_s − D_t)² of the current positions on the grids of spacing `level` (0 = coarsest),
+  // the mean over its eight half-cell shifts;
   // the level the last frame used; the number of levels (0 without a target).
   double densityEnergy(size_t level) const;
   size_t densityLevel() const { return level_; }
@@ -120,7 +124,7 @@ class SpringHair {
   void stepStrand(size_t strand, const AccelerationField& field, double dt);
   void factor(double dt);
   void projectStretch(size_t strand, double dt, int iterations, std::vector<double>& lambda);
-  Grid densityDifference(size_t level) const;  // D_s − D_t at the current positions
+  std::vector<Grid> densityDifference(size_t level) const;  // D_s − D_t at the current positions
   std::vector<glm::vec3> floatPoints() const;
 
   Strands rest_;
@@ -147,14 +151,14 @@ class SpringHair {
   std::vector<std::vector<double>> restDepth_;
   std::vector<double> shapeReach2_;
   double damping_ = 0.0, smoothing_ = 0.0, smoothingSpacing_ = 0.01;
-  // Density targeting: per level the target's density on that level's grid; their energies at the
-  // start; the strength, the refine fraction and the level in use.
-  std::vector<Grid> targets_;
+  // Density targeting: per level the target's density on that level's eight shifted grids; their
+  // energies at the start; the strength, the refine fraction and the level in use.
+  std::vector<std::vector<Grid>> targets_;
   std::vector<double> startEnergy_;
   std::vector<double> targetMean_;  // per level, the target's mean density over the nodes it occupies
   double densityStrength_ = 0.0, densityRefine_ = 0.5;
   size_t level_ = 0;
-  Grid difference_;  // D_s − D_t of the current substep, at level_
+  std::vector<Grid> difference_;  // D_s − D_t of the current substep, at level_
   // Velocity smoothing's grid and point lists, kept between frames so their memory is reused.
   GridOf<glm::dvec4> velocityGrid_;
   std::vector<glm::dvec3> smoothWhere_;
