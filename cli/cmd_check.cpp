@@ -42,9 +42,8 @@ void registerCheck(CLI::App& app, int& exitCode) {
       }
       if (options->setup.empty()) throw InputError("check needs a SETUP (or --keys)");
       Stats stats("check");
-      std::vector<Override> overrides = parseOverrides(options->common);
-      Config config = loadConfig(options->setup, overrides, SetupUse::kCheck);
-      stats.setOverrides(overrides);
+      // As every stage's --stats: the overrides, the config's digest and its seed at the top.
+      Config config = loadStageConfig(options->setup, options->common, SetupUse::kCheck, stats);
       const Scene scene = readScene(options->common, config, true, true, stats);
       nlohmann::ordered_json report = describeSetup(
           options->setup, config, scene.wick ? &*scene.wick : nullptr, scene.head ? &*scene.head : nullptr);

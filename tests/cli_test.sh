@@ -43,6 +43,8 @@ usage)
 config_errors)
   expect_rc 0 "$hairgen" check "$src/configs/default/setup.txt" --set Hairstyle.HairDensity=160 --stats "$tmp/s.json"
   grep -q '"Hairstyle.HairDensity=160"' "$tmp/s.json" || fail "--stats does not report the override"
+  grep -q '"configDigest": "[0-9a-f]\{16\}"' "$tmp/s.json" && grep -q '"seed": 1' "$tmp/s.json" ||
+    fail "check --stats lacks the digest or the seed every stage's has"
   expect_rc 2 "$hairgen" check "$src/configs/default/setup.txt" --set Hairstyle.HairDensty=160
   grep -q "did you mean 'HairDensity'" "$tmp/err" || fail "no hint: $(cat "$tmp/err")"
   printf 'HairLengths 0.04\nYoung abc\n' > "$tmp/h.txt"
