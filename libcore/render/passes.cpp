@@ -78,24 +78,26 @@ StageSource stage(const char* own, const std::optional<CustomStage>& custom = st
 
 }  // namespace
 
-Programs::Programs(bool ribbons, const CustomShaders& custom, bool motion)
+Programs::Programs(bool ribbons, int block, const CustomShaders& custom, bool motion)
     : hairDepth(stage(glsl::kHairVertex, custom.hairVert, "HairVert"), stage(glsl::kDepthFragment),
                 "hair depth"),
       headDepth(stage(glsl::kHeadVertex, custom.headVert, "HeadVert"), stage(glsl::kDepthFragment),
                 "head depth"),
       opacity(stage(glsl::kHairVertex, custom.hairVert, "HairVert"), stage(glsl::kOpacityFragment),
               "deep opacity"),
-      hairShade(stage(glsl::kHairVertex, custom.hairVert, "HairVert", {.ribbon = ribbons}),
-                stage(glsl::kHairFragment, custom.hairFrag, "HairFrag",
-                      {.ribbon = ribbons, .shadowFunction = true, .screenDoor = true}),
-                "hair shading"),
+      hairShade(
+          stage(glsl::kHairVertex, custom.hairVert, "HairVert", {.ribbon = ribbons}),
+          stage(glsl::kHairFragment, custom.hairFrag, "HairFrag",
+                {.ribbon = ribbons, .shadowFunction = true, .screenDoor = true, .singleSample = block == 1}),
+          "hair shading"),
       headShade(stage(glsl::kHeadVertex, custom.headVert, "HeadVert"),
                 stage(glsl::kHeadFragment, custom.headFrag, "HeadFrag", {.shadowFunction = true}),
                 "head shading"),
       resolve(stage(glsl::kFullscreenVertex), stage(glsl::kResolveFragment), "resolve") {
   if (!motion) return;
   hairMotion.emplace(stage(glsl::kHairVertex, std::nullopt, "", {.ribbon = ribbons, .motion = true}),
-                     stage(glsl::kMotionFragment, std::nullopt, "", {.ribbon = ribbons, .screenDoor = true}),
+                     stage(glsl::kMotionFragment, std::nullopt, "",
+                           {.ribbon = ribbons, .screenDoor = true, .singleSample = block == 1}),
                      "hair motion");
   headMotion.emplace(stage(glsl::kHeadVertex, std::nullopt, "", {.motion = true}),
                      stage(glsl::kMotionFragment), "head motion");
@@ -117,7 +119,7 @@ Scene::Scene(const RenderInput& in)
       head(in.head && !in.head->triangles.empty()
                ? std::make_unique<HeadGeometry>(*in.head, motion ? in.previous->head : nullptr)
                : nullptr),
-      programs(ribbons, in.shaders, motion) {
+      programs(ribbons, block, in.shaders, motion) {
   if (motion) {
     // The projection's x and y do not depend on the near and far planes, so the previous camera is
     // the Render Info camera on this frame's sphere.
