@@ -127,6 +127,11 @@ Scene::Scene(const RenderInput& in)
     previousViewProj = before.proj * before.view;
     viewProj = camera.proj * camera.view;
   }
+  // Only without sub-pixels: there the shading stage is tested for depth before it runs (the screen
+  // door's discard would defer the test), and a different order could only change which of two
+  // fragments of exactly equal depth is kept. The light's passes are order-free: the nearest depth,
+  // and sums of equal opacities.
+  if (block == 1) hair.orderFrontToBack(*in.hair, camera.view);
   checkGl("setting up");
 }
 
