@@ -76,6 +76,15 @@ StageSource stage(const char* own, const std::optional<CustomStage>& custom = st
   return s;
 }
 
+// The strands' own tangents, or polylineTangents() in `computed` when they carry none: tangentsOf()
+// would copy them (115 MB at 150,000 strands of 64 points). `computed` lives to the end of the
+// expression that calls this.
+const std::vector<glm::vec3>& tangentsFor(const Strands& s, std::vector<glm::vec3>&& computed = {}) {
+  if (!s.tangents.empty()) return s.tangents;
+  computed = polylineTangents(s);
+  return computed;
+}
+
 }  // namespace
 
 Programs::Programs(bool ribbons, int block, const CustomShaders& custom, bool motion)
@@ -115,7 +124,7 @@ Scene::Scene(const RenderInput& in)
       light(lightView(in.settings, sphere, in.domResolution)),
       ribbons(drawsRibbons(in.settings, sphere, camera, block)),
       motion(in.previous.has_value()),
-      hair(*in.hair, tangentsOf(*in.hair), motion ? in.previous->hair : nullptr),
+      hair(*in.hair, tangentsFor(*in.hair), motion ? in.previous->hair : nullptr),
       head(in.head && !in.head->triangles.empty()
                ? std::make_unique<HeadGeometry>(*in.head, motion ? in.previous->head : nullptr)
                : nullptr),
