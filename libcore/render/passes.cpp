@@ -87,18 +87,29 @@ const std::vector<glm::vec3>& tangentsFor(const Strands& s, std::vector<glm::vec
 
 }  // namespace
 
-Programs::Programs(bool ribbons, int block, const CustomShaders& custom, bool motion)
+// hairgen's own hair shading stage compiled for one model, and for hair without colours
+// (glsl/hair_fragment.glsl): what it does not read, the vertex stage does not write.
+std::string hairShadingDefines(ShadingModel model, bool colored) {
+  return "#define HAIR_MODEL " + std::to_string(static_cast<int>(model)) + "\n" +
+         (colored ? "" : "#define HAIR_WHITE\n");
+}
+
+Programs::Programs(bool ribbons, int block, const CustomShaders& custom, bool motion, ShadingModel model,
+                   bool colored)
     : hairDepth(stage(glsl::kHairVertex, custom.hairVert, "HairVert"), stage(glsl::kDepthFragment),
                 "hair depth"),
       headDepth(stage(glsl::kHeadVertex, custom.headVert, "HeadVert"), stage(glsl::kDepthFragment),
                 "head depth"),
       opacity(stage(glsl::kHairVertex, custom.hairVert, "HairVert"), stage(glsl::kOpacityFragment),
               "deep opacity"),
-      hairShade(
-          stage(glsl::kHairVertex, custom.hairVert, "HairVert", {.ribbon = ribbons}),
-          stage(glsl::kHairFragment, custom.hairFrag, "HairFrag",
-                {.ribbon = ribbons, .shadowFunction = true, .screenDoor = true, .singleSample = block == 1}),
-          "hair shading"),
+      hairShade(stage(glsl::kHairVertex, custom.hairVert, "HairVert", {.ribbon = ribbons}),
+                stage(glsl::kHairFragment, custom.hairFrag, "HairFrag",
+                      {.ribbon = ribbons,
+                       .shadowFunction = true,
+                       .screenDoor = true,
+                       .singleSample = block == 1,
+                       .defines = custom.hairFrag ? "" : hairShadingDefines(model, colored)}),
+                "hair shading"),
       headShade(stage(glsl::kHeadVertex, custom.headVert, "HeadVert"),
                 stage(glsl::kHeadFragment, custom.headFrag, "HeadFrag", {.shadowFunction = true}),
                 "head shading"),
@@ -128,7 +139,7 @@ Scene::Scene(const RenderInput& in)
       head(in.head && !in.head->triangles.empty()
                ? std::make_unique<HeadGeometry>(*in.head, motion ? in.previous->head : nullptr)
                : nullptr),
-      programs(ribbons, block, in.shaders, motion) {
+      programs(ribbons, block, in.shaders, motion, in.settings.shadingModel, !in.hair->colors.empty()) {
   if (motion) {
     // The projection's x and y do not depend on the near and far planes, so the previous camera is
     // the Render Info camera on this frame's sphere.

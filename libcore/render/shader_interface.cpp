@@ -78,6 +78,7 @@ std::string assembleStage(const StagePrelude& prelude, const std::string& body) 
   if (prelude.ribbon) text += "#define RIBBON\n";
   if (prelude.motion) text += "#define MOTION\n";
   if (prelude.singleSample) text += "#define SINGLE_SAMPLE\n";
+  text += prelude.defines;
   text += glslConstants();
   if (prelude.shadowFunction) text += glsl::kShadow;
   if (prelude.screenDoor) text += std::string("#define SCREEN_DOOR\n") + glsl::kScreenDoor;

@@ -53,6 +53,7 @@ struct StagePrelude {
                                 // early depth test (a stage that may discard is shaded before its test)
   bool motion = false;          // `#define MOTION`: hairgen's own vertex stages in the motion pass also
                                 // write vMotion, the screen motion since the previous frame
+  std::string defines = {};     // more `#define` lines, for hairgen's own stages only (HAIR_MODEL, ...)
 };
 
 // The GLSL constants: `const int kShading<Name> = <value>;` for every ShadingModel (the name from
