@@ -204,8 +204,9 @@ Texture deepOpacityPass(const Scene& scene, const LightDepth& depth) {
   setView(p, scene.light);
   setHairWidth(p, scene.light, scene.settings);
   p.set("uLayers", glm::vec4(scene.settings.layerSizes));
-  glBindTextureUnit(kUnitHairStart, depth.hairStart.id);
+  glBindImageTexture(0, depth.hairStart.id, 0, GL_FALSE, 0, GL_READ_ONLY, GL_R32F);
   scene.hair.draw(false);
+  glBindImageTexture(0, 0, 0, GL_FALSE, 0, GL_READ_ONLY, GL_R32F);
   glDisable(GL_BLEND);
   checkGl("the deep opacity pass");
   return opacity;
