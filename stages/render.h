@@ -30,14 +30,14 @@
 //   HeadFrag  reads those; uniforms uLightPosition, uLightColor, uAmbient, uHeadColor; writes oColor
 //             (RGB, 1) and oData (Z, hair opacity 0, the shadow, 0).
 // In front of the file hairgen puts `#version 450 core`, `#define RIBBON` when the program draws
-// strands as ribbons, the constants kShading<Model> (kShadingKajiyaKay, kShadingThesis, kShadingAnjyo,
-// kShadingVolumetric: uModel's values), kUnit<Map> (texture units) and kShadowBiasHair,
-// kShadowOffsetHead, kShadowBiasHeadDepth (metres), and in a fragment stage the shadow function
-// `float lightArriving(vec3 world, float bias)` (1 in the open, down to 0.25; libcore/render/glsl/
-// shadow.glsl) and for HairFrag `void screenDoor(float alpha)` (supersampling's coverage; call it
-// first). Then `#line 1`, so the compiler's line numbers are the file's. The file has no #version line.
-// A file that fails to compile or link is an InputError (exit 2) whose one line names the file and the
-// compiler's line: "hairfrag.glsl:12: 'foo' : undeclared identifier (compiling HairFrag, named at
+// strands as ribbons, `#define SINGLE_SAMPLE` when there are no sub-pixels (Samples 1), the constants
+// kShading<Model> (kShadingKajiyaKay, kShadingThesis, kShadingAnjyo, kShadingVolumetric: uModel's values),
+// kUnit<Map> (texture units) and kShadowBiasHair, kShadowOffsetHead, kShadowBiasHeadDepth (metres), and in a
+// fragment stage the shadow function `float lightArriving(vec3 world, float bias)` (1 in the open, down to
+// 0.25; libcore/render/glsl/ shadow.glsl) and for HairFrag `void screenDoor(float alpha)` (supersampling's
+// coverage; call it first). Then `#line 1`, so the compiler's line numbers are the file's. The file has no
+// #version line. A file that fails to compile or link is an InputError (exit 2) whose one line names the file
+// and the compiler's line: "hairfrag.glsl:12: 'foo' : undeclared identifier (compiling HairFrag, named at
 // setup.txt:9)".
 #pragma once
 

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cstdio>
+#include <limits>
 #include <utility>
 
 #include <glm/gtc/type_ptr.hpp>
@@ -233,6 +234,27 @@ HairGeometry::HairGeometry(const Strands& s, const std::vector<glm::vec3>& tange
     glVertexArrayAttribFormat(vao, a, 3, GL_FLOAT, GL_FALSE, 0);
     glVertexArrayAttribBinding(vao, a, a);
   }
+}
+
+void HairGeometry::orderFrontToBack(const Strands& s, const glm::dmat4& view) {
+  const glm::vec4 row{float(view[0][2]), float(view[1][2]), float(view[2][2]), float(view[3][2])};
+  std::vector<std::pair<float, uint32_t>> keys(lineFirsts.size());
+  for (size_t i = 0; i < lineFirsts.size(); ++i) {
+    float nearest = std::numeric_limits<float>::infinity();
+    for (GLint p = lineFirsts[i]; p < lineFirsts[i] + lineCounts[i]; ++p)
+      nearest =
+          std::min(nearest, -(row.x * s.points[p].x + row.y * s.points[p].y + row.z * s.points[p].z + row.w));
+    keys[i] = {nearest, uint32_t(i)};
+  }
+  std::sort(keys.begin(), keys.end());
+  auto permute = [&](auto& v) {
+    auto old = v;
+    for (size_t i = 0; i < keys.size(); ++i) v[i] = old[keys[i].second];
+  };
+  permute(lineFirsts);
+  permute(lineCounts);
+  permute(ribbonFirsts);
+  permute(ribbonCounts);
 }
 
 HairGeometry::~HairGeometry() {

@@ -109,6 +109,9 @@ struct HairGeometry {
   HairGeometry& operator=(const HairGeometry&) = delete;
   // Binds the buffers and draws every strand as lines, or as ribbons.
   void draw(bool ribbon) const;
+  // Draws the strands nearest `view`'s eye first (by their nearest point), so a depth test made before
+  // shading skips more of what lies behind; the order changes no result but ties of equal depth.
+  void orderFrontToBack(const Strands& strands, const glm::dmat4& view);
 
   Buffer points, tangents, colors, normals, previous;
   bool hasColors, hasNormals, hasPrevious;

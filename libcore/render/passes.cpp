@@ -76,9 +76,26 @@ StageSource stage(const char* own, const std::optional<CustomStage>& custom = st
   return s;
 }
 
+// The strands' own tangents, or polylineTangents() in `computed` when they carry none: tangentsOf()
+// would copy them (115 MB at 150,000 strands of 64 points). `computed` lives to the end of the
+// expression that calls this.
+const std::vector<glm::vec3>& tangentsFor(const Strands& s, std::vector<glm::vec3>&& computed = {}) {
+  if (!s.tangents.empty()) return s.tangents;
+  computed = polylineTangents(s);
+  return computed;
+}
+
 }  // namespace
 
-Programs::Programs(bool ribbons, const CustomShaders& custom, bool motion)
+// hairgen's own hair shading stage compiled for one model, and for hair without colours
+// (glsl/hair_fragment.glsl): what it does not read, the vertex stage does not write.
+std::string hairShadingDefines(ShadingModel model, bool colored) {
+  return "#define HAIR_MODEL " + std::to_string(static_cast<int>(model)) + "\n" +
+         (colored ? "" : "#define HAIR_WHITE\n");
+}
+
+Programs::Programs(bool ribbons, int block, const CustomShaders& custom, bool motion, ShadingModel model,
+                   bool colored)
     : hairDepth(stage(glsl::kHairVertex, custom.hairVert, "HairVert"), stage(glsl::kDepthFragment),
                 "hair depth"),
       headDepth(stage(glsl::kHeadVertex, custom.headVert, "HeadVert"), stage(glsl::kDepthFragment),
@@ -87,7 +104,11 @@ Programs::Programs(bool ribbons, const CustomShaders& custom, bool motion)
               "deep opacity"),
       hairShade(stage(glsl::kHairVertex, custom.hairVert, "HairVert", {.ribbon = ribbons}),
                 stage(glsl::kHairFragment, custom.hairFrag, "HairFrag",
-                      {.ribbon = ribbons, .shadowFunction = true, .screenDoor = true}),
+                      {.ribbon = ribbons,
+                       .shadowFunction = true,
+                       .screenDoor = true,
+                       .singleSample = block == 1,
+                       .defines = custom.hairFrag ? "" : hairShadingDefines(model, colored)}),
                 "hair shading"),
       headShade(stage(glsl::kHeadVertex, custom.headVert, "HeadVert"),
                 stage(glsl::kHeadFragment, custom.headFrag, "HeadFrag", {.shadowFunction = true}),
@@ -95,7 +116,8 @@ Programs::Programs(bool ribbons, const CustomShaders& custom, bool motion)
       resolve(stage(glsl::kFullscreenVertex), stage(glsl::kResolveFragment), "resolve") {
   if (!motion) return;
   hairMotion.emplace(stage(glsl::kHairVertex, std::nullopt, "", {.ribbon = ribbons, .motion = true}),
-                     stage(glsl::kMotionFragment, std::nullopt, "", {.ribbon = ribbons, .screenDoor = true}),
+                     stage(glsl::kMotionFragment, std::nullopt, "",
+                           {.ribbon = ribbons, .screenDoor = true, .singleSample = block == 1}),
                      "hair motion");
   headMotion.emplace(stage(glsl::kHeadVertex, std::nullopt, "", {.motion = true}),
                      stage(glsl::kMotionFragment), "head motion");
@@ -113,11 +135,11 @@ Scene::Scene(const RenderInput& in)
       light(lightView(in.settings, sphere, in.domResolution)),
       ribbons(drawsRibbons(in.settings, sphere, camera, block)),
       motion(in.previous.has_value()),
-      hair(*in.hair, tangentsOf(*in.hair), motion ? in.previous->hair : nullptr),
+      hair(*in.hair, tangentsFor(*in.hair), motion ? in.previous->hair : nullptr),
       head(in.head && !in.head->triangles.empty()
                ? std::make_unique<HeadGeometry>(*in.head, motion ? in.previous->head : nullptr)
                : nullptr),
-      programs(ribbons, in.shaders, motion) {
+      programs(ribbons, block, in.shaders, motion, in.settings.shadingModel, !in.hair->colors.empty()) {
   if (motion) {
     // The projection's x and y do not depend on the near and far planes, so the previous camera is
     // the Render Info camera on this frame's sphere.
@@ -125,6 +147,11 @@ Scene::Scene(const RenderInput& in)
     previousViewProj = before.proj * before.view;
     viewProj = camera.proj * camera.view;
   }
+  // Only without sub-pixels: there the shading stage is tested for depth before it runs (the screen
+  // door's discard would defer the test), and a different order could only change which of two
+  // fragments of exactly equal depth is kept. The light's passes are order-free: the nearest depth,
+  // and sums of equal opacities.
+  if (block == 1) hair.orderFrontToBack(*in.hair, camera.view);
   checkGl("setting up");
 }
 
@@ -177,8 +204,9 @@ Texture deepOpacityPass(const Scene& scene, const LightDepth& depth) {
   setView(p, scene.light);
   setHairWidth(p, scene.light, scene.settings);
   p.set("uLayers", glm::vec4(scene.settings.layerSizes));
-  glBindTextureUnit(kUnitHairStart, depth.hairStart.id);
+  glBindImageTexture(0, depth.hairStart.id, 0, GL_FALSE, 0, GL_READ_ONLY, GL_R32F);
   scene.hair.draw(false);
+  glBindImageTexture(0, 0, 0, GL_FALSE, 0, GL_READ_ONLY, GL_R32F);
   glDisable(GL_BLEND);
   checkGl("the deep opacity pass");
   return opacity;

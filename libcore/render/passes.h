@@ -25,8 +25,11 @@ namespace hairgen {
 
 // The programs of one render: hairgen's stages (libcore/render/glsl/), or the Setup's custom ones in
 // their place (HairVert in every program that draws hair, HeadVert in every one that draws the head).
+// `block`: k, sub-pixels per pixel side; at 1 the screen door is compiled out of the fragment stages.
+// hairgen's own hair shading stage is compiled for `model`, and for white hair unless `colored`.
 struct Programs {
-  Programs(bool ribbons, const CustomShaders& custom, bool motion);
+  Programs(bool ribbons, int block, const CustomShaders& custom, bool motion, ShadingModel model,
+           bool colored);
   Program hairDepth, headDepth, opacity, hairShade, headShade, resolve;
   std::optional<Program> hairMotion, headMotion, motionResolve;  // with the previous frame
 };

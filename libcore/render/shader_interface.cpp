@@ -77,6 +77,8 @@ std::string assembleStage(const StagePrelude& prelude, const std::string& body) 
   std::string text = "#version 450 core\n";
   if (prelude.ribbon) text += "#define RIBBON\n";
   if (prelude.motion) text += "#define MOTION\n";
+  if (prelude.singleSample) text += "#define SINGLE_SAMPLE\n";
+  text += prelude.defines;
   text += glslConstants();
   if (prelude.shadowFunction) text += glsl::kShadow;
   if (prelude.screenDoor) text += std::string("#define SCREEN_DOOR\n") + glsl::kScreenDoor;

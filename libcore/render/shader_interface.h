@@ -48,8 +48,12 @@ struct StagePrelude {
   bool shadowFunction = false;  // lightArriving() (glsl/shadow.glsl): the shading fragment stages
   bool screenDoor = false;      // screenDoor() (glsl/screen_door.glsl) and `#define SCREEN_DOOR`: the
                                 // hair's shading and motion fragment stages
+  bool singleSample = false;    // `#define SINGLE_SAMPLE`: no sub-pixels (k = 1), so screenDoor() compiles
+                                // to nothing and a stage that does not discard of its own keeps llvmpipe's
+                                // early depth test (a stage that may discard is shaded before its test)
   bool motion = false;          // `#define MOTION`: hairgen's own vertex stages in the motion pass also
                                 // write vMotion, the screen motion since the previous frame
+  std::string defines = {};     // more `#define` lines, for hairgen's own stages only (HAIR_MODEL, ...)
 };
 
 // The GLSL constants: `const int kShading<Name> = <value>;` for every ShadingModel (the name from

@@ -16,6 +16,16 @@ uniform vec3 uDiffuseColor;
 uniform vec3 uSpecularColor;
 uniform float uGlossiness;
 uniform int uModel;           // ShadingModel: kShadingKajiyaKay, kShadingThesis, kShadingAnjyo, ...
+// hairgen's own stage is compiled for the render's model (HAIR_MODEL) and, when the hair has no colours,
+// with white in place of vColor (HAIR_WHITE), so the vertex stage's unused outputs are dropped at link.
+#ifndef HAIR_MODEL
+#define HAIR_MODEL uModel
+#endif
+#ifdef HAIR_WHITE
+#define HAIR_COLOR vec3(1.0)
+#else
+#define HAIR_COLOR vColor
+#endif
 uniform float uBlend;         // volumetric: its share against Kajiya-Kay
 layout(location = 0) out vec4 oColor;  // RGB, and the strand's opacity
 layout(location = 1) out vec4 oData;   // Z (metres), hair opacity (1), shadow, 0
@@ -27,24 +37,24 @@ void main() {
   float tl = dot(t, l), te = dot(t, e);
   float sinTL = sqrt(max(0.0, 1.0 - tl * tl)), sinTE = sqrt(max(0.0, 1.0 - te * te));
   float diffuse = sinTL, specular;
-  if (uModel == kShadingAnjyo) {
+  if (HAIR_MODEL == kShadingAnjyo) {
     float th = dot(t, normalize(l + e));
     specular = pow(max(1.0 - th * th, 0.0), 0.5 * uGlossiness);
     diffuse = 0.0;
   } else {
-    float cone = uModel == kShadingThesis ? abs(tl) * abs(te) + sinTL * sinTE : -tl * te + sinTL * sinTE;
+    float cone = HAIR_MODEL == kShadingThesis ? abs(tl) * abs(te) + sinTL * sinTE : -tl * te + sinTL * sinTE;
     specular = pow(max(cone, 0.0), uGlossiness);
   }
   float shadow = lightArriving(vWorld, kShadowBiasHair);
-  vec3 color = uAmbient * uAmbientColor * vColor +
-               shadow * uLightColor * (uDiffuseColor * vColor * diffuse + uSpecularColor * specular);
-  if (uModel == kShadingVolumetric) {
+  vec3 color = uAmbient * uAmbientColor * HAIR_COLOR +
+               shadow * uLightColor * (uDiffuseColor * HAIR_COLOR * diffuse + uSpecularColor * specular);
+  if (HAIR_MODEL == kShadingVolumetric) {
     // The strand as a point of the hair's surface, lit about the volume normal.
     vec3 n = dot(vNormal, vNormal) > 0.0 ? normalize(vNormal) : vec3(0.0);
     float surfaceDiffuse = max(dot(n, l), 0.0);
     float phong = pow(max(dot(reflect(-l, n), e), 0.0), uGlossiness);
-    vec3 volumetric = uAmbient * uAmbientColor * vColor +
-                      shadow * uLightColor * (uDiffuseColor * vColor * surfaceDiffuse + uSpecularColor * phong);
+    vec3 volumetric = uAmbient * uAmbientColor * HAIR_COLOR +
+                      shadow * uLightColor * (uDiffuseColor * HAIR_COLOR * surfaceDiffuse + uSpecularColor * phong);
     color = mix(color, volumetric, uBlend);
   }
   oColor = vec4(color, vAlpha);
