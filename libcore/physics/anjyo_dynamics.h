@@ -92,7 +92,6 @@ class AnjyoHair {
   static constexpr double kStateTag = 0x414e4a33;  // "ANJ3": a state of this layout
   static constexpr double kMaxAngle = 1e5;         // radians: the most a restart state may hold
   std::vector<double> state() const { return state_; }
-  void stateInto(std::vector<double>& out) const { out = state_; }
   void swapState(std::vector<double>& other) { state_.swap(other); }
   void restore(const std::vector<double>& state, const std::string& source);
   // One segment's values (θ, φ, the previous θ, φ), and setting them.
