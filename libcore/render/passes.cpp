@@ -49,6 +49,17 @@ void setShadowUniforms(const Program& p, const Scene& scene) {
   p.set("uAmbient", float(r.ambientIntensity));
 }
 
+// A program that draws the hair as strips at the camera's sub-pixels (the shading and motion passes),
+// in use with the camera, the strands' width and the screen door's dither.
+void useForHairStrips(const Program& p, const Scene& scene, const RenderSettings& r) {
+  p.use();
+  setView(p, scene.subpixel);
+  setHairWidth(p, scene.subpixel, r);
+  p.set("uMinWidth", float(scene.block));
+  p.set("uBlock", scene.block);
+  p.set("uOrder", ditherOrder(scene.block));
+}
+
 // Reads the first planes.size() float channels of a single-sample RGBA texture into planes (a null
 // plane is skipped), rows top to bottom.
 void readPlanes(const Texture& texture, std::vector<std::vector<float>*> planes) {
@@ -238,12 +249,7 @@ ShadedImage shadingPass(const Scene& scene, const LightDepth& depth, const Textu
     scene.head->draw();
   }
   const Program& p = scene.programs.hairShade;
-  p.use();
-  setView(p, scene.subpixel);
-  setHairWidth(p, scene.subpixel, r);
-  p.set("uMinWidth", float(scene.block));
-  p.set("uBlock", scene.block);
-  p.set("uOrder", ditherOrder(scene.block));
+  useForHairStrips(p, scene, r);
   setShadowUniforms(p, scene);
   p.set("uEye", glm::vec3(r.cameraPosition));
   p.set("uAmbientColor", glm::vec3(scene.visuality.ambientColor));
@@ -299,12 +305,7 @@ Texture motionPass(const Scene& scene) {
   }
   // As the shading pass draws the hair, so each sub-pixel's nearest kept fragment is the same strand's.
   const Program& p = *scene.programs.hairMotion;
-  p.use();
-  setView(p, scene.subpixel);
-  setHairWidth(p, scene.subpixel, r);
-  p.set("uMinWidth", float(scene.block));
-  p.set("uBlock", scene.block);
-  p.set("uOrder", ditherOrder(scene.block));
+  useForHairStrips(p, scene, r);
   p.set("uViewProj", glm::mat4(scene.viewProj));
   p.set("uPreviousViewProj", glm::mat4(scene.previousViewProj));
   p.set("uImageSize", imageSize);

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdio>
 #include <limits>
+#include <utility>
 
 #include <tbb/blocked_range.h>
 #include <tbb/enumerable_thread_specific.h>
@@ -552,22 +553,13 @@ void normalsOfBlock(const Grid& grid, const glm::vec3* __restrict gradients,
     }
   }
   const int sx = grid.size.x, sy = grid.size.y, sz = grid.size.z;
-  addCorner<0, 0, 0>(count, sx, sy, sz, gradients, c, c + kB, c + 2 * kB, f, f + kB, f + 2 * kB, out,
-                     out + kB, out + 2 * kB);
-  addCorner<1, 0, 0>(count, sx, sy, sz, gradients, c, c + kB, c + 2 * kB, f, f + kB, f + 2 * kB, out,
-                     out + kB, out + 2 * kB);
-  addCorner<0, 1, 0>(count, sx, sy, sz, gradients, c, c + kB, c + 2 * kB, f, f + kB, f + 2 * kB, out,
-                     out + kB, out + 2 * kB);
-  addCorner<1, 1, 0>(count, sx, sy, sz, gradients, c, c + kB, c + 2 * kB, f, f + kB, f + 2 * kB, out,
-                     out + kB, out + 2 * kB);
-  addCorner<0, 0, 1>(count, sx, sy, sz, gradients, c, c + kB, c + 2 * kB, f, f + kB, f + 2 * kB, out,
-                     out + kB, out + 2 * kB);
-  addCorner<1, 0, 1>(count, sx, sy, sz, gradients, c, c + kB, c + 2 * kB, f, f + kB, f + 2 * kB, out,
-                     out + kB, out + 2 * kB);
-  addCorner<0, 1, 1>(count, sx, sy, sz, gradients, c, c + kB, c + 2 * kB, f, f + kB, f + 2 * kB, out,
-                     out + kB, out + 2 * kB);
-  addCorner<1, 1, 1>(count, sx, sy, sz, gradients, c, c + kB, c + 2 * kB, f, f + kB, f + 2 * kB, out,
-                     out + kB, out + 2 * kB);
+  // The eight corners with x fastest, then y, then z: the order the one-point-at-a-time sum adds them.
+  [&]<int... k>(std::integer_sequence<int, k...>) {
+    ((addCorner<(k & 1), ((k >> 1) & 1), (k >> 2)>(count, sx, sy, sz, gradients, c, c + kB, c + 2 * kB, f,
+                                                   f + kB, f + 2 * kB, out, out + kB, out + 2 * kB)),
+     ...);
+  }
+  (std::make_integer_sequence<int, 8>{});
   float* const n = &normals[0].x;
   double* const lengths = f;  // the fractions are spent
   HAIRGEN_IVDEP
