@@ -80,6 +80,11 @@ HAIRGEN_LANE Vm select(Vm m, Vm a, Vm b) {
 HAIRGEN_LANE V3 select(Vm m, const V3& a, const V3& b) {
   return {m ? a.x : b.x, m ? a.y : b.y, m ? a.z : b.z};
 }
+// Lanes where v != 0 (NaN included), written with ordered comparisons: GCC splits an equality test of
+// double vectors into one scalar compare per lane in this file's large functions.
+HAIRGEN_LANE Vm nonZero(Vd v) {
+  return !((v <= 0.0) & (v >= 0.0));
+}
 HAIRGEN_LANE Vd abs(Vd v) {
   return v < 0.0 ? -v : v;
 }
@@ -164,7 +169,7 @@ struct AnjyoHair::Lanes::PoseOut {
   HAIRGEN_LANE void segment(Vm here, const V3& now, const V3& rest, Vd theta, Vd phi) {
     dir = select(here, now, dir);
     restDir = select(here, rest, restDir);
-    moved = select(here, theta != 0.0 || phi != 0.0, moved);
+    moved = select(here, nonZero(theta) | nonZero(phi), moved);
   }
   HAIRGEN_LANE void point(size_t j, const V3& node) {
     const LanePoint& at = hair.lanePoints_[hair.blockFirst_[s0 / kLanes] + s0 / kLanes + j];
@@ -199,6 +204,8 @@ void AnjyoHair::Lanes::pose(const AnjyoHair& hair, size_t s0, const Pose& pose, 
     p0[l] = s < strands ? hair.rest_.firstPoint[s] : 0;
     if (s < strands) setLane(node, l, hair.restForward_[p0[l]]);
   }
+  Vm counts;
+  for (size_t l = 0; l < n; ++l) counts[l] = count[l];
   PoseOut writer{hair, pose, out, s0, strands, p0, count};
   for (size_t j = 0; j <= most; ++j) {
     if (j > 0) node = node + load(segments[j - 1].length) * writer.dir;
@@ -206,8 +213,8 @@ void AnjyoHair::Lanes::pose(const AnjyoHair& hair, size_t s0, const Pose& pose, 
       const double* state = &hair.state_[kStateHeader + (hair.blockFirst_[block] + j) * kStateValues * n];
       auto value = [&](StateValue v) { return loadLanes(state + v * n); };
       const LaneSegment& segment = segments[j];
-      Vm here;  // a lane past its strand's last segment keeps the last one's
-      for (size_t l = 0; l < n; ++l) here[l] = j < count[l] ? -1 : 0;
+      const Vm here =
+          Vm{} + int64_t(j) < counts;  // a lane past its strand's last segment keeps the last one's
       const V3 rest = load(segment.rest);
       Vd st, ct, sp, cp;
       sinCos(value(kTheta), st, ct);
@@ -237,6 +244,8 @@ void AnjyoHair::Lanes::step(AnjyoHair& hair, size_t s0, const AccelerationField&
     p0[l] = s < strands ? hair.rest_.firstPoint[s] : 0;
     if (s < strands) setLane(node, l, hair.restForward_[p0[l]]);
   }
+  Vm counts;
+  for (size_t l = 0; l < n; ++l) counts[l] = count[l];
   V3 nodeVelocity{}, newBefore{};
   // The new state posed, point by point as its nodes are placed, where asked for (stepAndPose).
   std::optional<PoseOut> writer;
@@ -253,8 +262,8 @@ void AnjyoHair::Lanes::step(AnjyoHair& hair, size_t s0, const AccelerationField&
     Vd st, ct, sp, cp;
     sinCos(theta0, st, ct);
     sinCos(phi0, sp, cp);
-    Vm active;  // lanes whose strand has segment j; the others keep their rest state
-    for (size_t l = 0; l < n; ++l) active[l] = j < count[l] ? -1 : 0;
+    const Vm active =
+        Vm{} + int64_t(j) < counts;  // lanes whose strand has segment j; the others keep their rest state
     const V3 rest = load(segment.rest), pole = load(segment.pole), side = load(segment.side);
     const V3 across = cp * rest + sp * side;
     const V3 dir = ct * across + st * pole;
@@ -277,12 +286,12 @@ void AnjyoHair::Lanes::step(AnjyoHair& hair, size_t s0, const AccelerationField&
       const V3 v = node - splat(head->centre);
       const V3 s0v = splat(test.scaled[0]), s1v = splat(test.scaled[1]), s2v = splat(test.scaled[2]);
       const V3 r{dot(v, s0v), dot(v, s1v), dot(v, s2v)};
-      const Vm nonzero = departure.x != 0.0 || departure.y != 0.0 || departure.z != 0.0;
+      const Vm nonzero = nonZero(departure.x) | nonZero(departure.y) | nonZero(departure.z);
       const Vm near = dot(r, r) < test.near2;
       const V3 grad = r.x * s0v + r.y * s1v + r.z * s2v;
       const Vm into =
           dot(grad, departure) < hair.pseudoAlpha_ * sqrt(dot(grad, grad)) * sqrt(dot(departure, departure));
-      departure = select(nonzero && near && into, splat(hair.pseudoEpsilon_) * departure, departure);
+      departure = select(nonzero & near & into, splat(hair.pseudoEpsilon_) * departure, departure);
     }
     const Vd c = load(segment.coefficient);
     const V3 push = departure + load(segment.springOverC) * (rest - dir);
@@ -306,14 +315,14 @@ void AnjyoHair::Lanes::step(AnjyoHair& hair, size_t s0, const AccelerationField&
       if (test.ellipsoid) {
         const V3 r{dot(v, splat(test.scaled[0])), dot(v, splat(test.scaled[1])),
                    dot(v, splat(test.scaled[2]))};
-        maybe = maybe && dot(r, r) < 1.0;
+        maybe = maybe & (dot(r, r) < 1.0);
         bool any = false;
         for (size_t l = 0; l < n; ++l) any = any || (maybe[l] && j < count[l]);
         if (any)
-          maybe = maybe && deeperThanAtRest(hair.shapes_[c2], v, hair.restDepth_[c2].data(), p0, count,
-                                            uint32_t(j + 1));
+          maybe = maybe & deeperThanAtRest(hair.shapes_[c2], v, hair.restDepth_[c2].data(), p0, count,
+                                           uint32_t(j + 1));
       }
-      check = check || maybe;
+      check = check | maybe;
     }
     bool settled = false;
     for (size_t l = 0; l < n; ++l) {
