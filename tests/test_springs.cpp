@@ -6,6 +6,7 @@
 
 #include <tbb/global_control.h>
 #include <cmath>
+#include <cstring>
 #include <random>
 
 #include "libcore/config/setup.h"
@@ -143,6 +144,59 @@ TEST(Springs, ACurvedHairHoldsItsGroomedShapeUnderGravity) {
   field.base *= 2.0;
   for (int n = 0; n < 100; ++n) hair.step(field, 1e-2, true, false);
   EXPECT_GT(worst(), 1e-3);
+}
+
+// The stretch solve in vectors (8 strands at once, on AVX-512) gives the strand-by-strand step's bits:
+// strands of 1 to 12 points (a block of 8 with mixed counts, some solved in lanes, some alone, and 13
+// strands, not a whole number of blocks), one of 140 segments (past the lanes' limit), pushed hard into
+// an ellipsoid, a sphere and a box (so the collisions and the second solve run) while the head turns.
+TEST(Springs, EveryKernelGivesTheSameBits) {
+  const glm::dvec3 axes(0.10, 0.12, 0.11);
+  Collision shapes;
+  shapes.shapes.push_back({ShapeKind::kEllipsoid, 0.0, 1.0, glm::dvec3(0.0), axes, glm::dmat3(1.0), {}});
+  shapes.shapes.push_back(
+      {ShapeKind::kSphere, 0.0, 1.0, glm::dvec3(0.11, -0.08, 0.0), glm::dvec3(0.03), glm::dmat3(1.0), {}});
+  shapes.shapes.push_back(
+      {ShapeKind::kCuboid, 0.0, 1.0, glm::dvec3(0.02, -0.16, 0.06), glm::dvec3(0.04), glm::dmat3(1.0), {}});
+  Strands rest;
+  for (int s = 0; s < 14; ++s) {  // down the +x side from 60° above the equator
+    const double u = glm::radians(9.0 * (s - 6));
+    const int count = s == 13 ? 141 : s == 5 ? 1 : s < 8 ? 2 + (s * 5) % 11 : 9;
+    std::vector<glm::vec3> points;
+    for (int j = 0; j < count; ++j) {
+      const double v = glm::radians(60.0 - 7.0 * j * 11.0 / std::max(count, 11));
+      points.push_back(glm::vec3(
+          1.02 * axes * glm::dvec3(std::cos(v) * std::cos(u), std::sin(v), std::cos(v) * std::sin(u))));
+    }
+    rest.addStrand(points);
+  }
+  Hairstyle style;
+  style.gravity = 9.81;
+  Dynamics d = springs();
+  d.damping = 0.5;
+  AccelerationField field;
+  field.base = {-60.0, -9.81, 15.0};  // hard into the head
+  field.rotating = true;
+  field.omega = {0.3, 4.0, 0.5};
+  field.alpha = {2.0, 0.0, -1.0};
+  using Kernel = SpringHair::Kernel;
+  auto run = [&](Kernel kernel) {
+    SpringHair hair(rest, style, d, shapes, nullptr);
+    for (int n = 0; n < 40; ++n) hair.step(field, 1.0 / 96.0, n % 2 == 0, n % 2 == 1, kernel);
+    return std::pair(hair.positions(), hair.velocities());
+  };
+  const auto [x, v] = run(Kernel::kStrands);
+  double deepest = -1.0;
+  for (const glm::dvec3& p : x) deepest = std::max(deepest, penetration(shapes.shapes[0], p));
+  EXPECT_GT(deepest, -1e-3) << "the hair must reach the head";
+  for (Kernel kernel : {Kernel::kLanes, Kernel::kFastest}) {  // the strands' again without AVX-512
+    const auto [xk, vk] = run(kernel);
+    ASSERT_EQ(xk.size(), x.size());
+    for (size_t p = 0; p < x.size(); ++p) {
+      ASSERT_EQ(0, std::memcmp(&xk[p], &x[p], sizeof(glm::dvec3))) << "position of point " << p;
+      ASSERT_EQ(0, std::memcmp(&vk[p], &v[p], sizeof(glm::dvec3))) << "velocity of point " << p;
+    }
+  }
 }
 
 // A job on the bundled default coupe with a springs Dynamics Info in memory.

@@ -9,93 +9,14 @@
 
 #include "libcore/physics/anjyo_dynamics.h"
 #include "libcore/physics/anjyo_sincos.h"
+#include "libcore/physics/lanes.h"
 
 namespace hairgen {
 
 namespace {
 
-using Vd = double __attribute__((vector_size(AnjyoHair::kLanes * sizeof(double))));
-using Vm = decltype(Vd{} < Vd{});  // a comparison's lanes: all ones or zero
-
-struct V3 {
-  Vd x, y, z;
-};
-
-#define HAIRGEN_LANE [[gnu::always_inline]] inline
-
-HAIRGEN_LANE Vd splat(double v) {
-  return Vd{} + v;
-}
-HAIRGEN_LANE V3 splat(const glm::dvec3& v) {
-  return {splat(v.x), splat(v.y), splat(v.z)};
-}
-HAIRGEN_LANE V3 load(const double (&v)[3][AnjyoHair::kLanes]) {
-  V3 r;
-  __builtin_memcpy(&r.x, v[0], sizeof(Vd));
-  __builtin_memcpy(&r.y, v[1], sizeof(Vd));
-  __builtin_memcpy(&r.z, v[2], sizeof(Vd));
-  return r;
-}
-HAIRGEN_LANE Vd loadLanes(const double* v) {
-  Vd r;
-  __builtin_memcpy(&r, v, sizeof(Vd));
-  return r;
-}
-HAIRGEN_LANE void storeLanes(double* to, Vd v) {
-  __builtin_memcpy(to, &v, sizeof(Vd));
-}
-HAIRGEN_LANE Vd load(const double (&v)[AnjyoHair::kLanes]) {
-  return loadLanes(v);
-}
-// glm's operators, lane by lane: a scalar times a vector multiplies each component; dot is
-// (x + y) + z of the products; cross is glm's (a.y b.z − b.y a.z, a.z b.x − b.z a.x, a.x b.y − b.x a.y).
-HAIRGEN_LANE V3 operator+(const V3& a, const V3& b) {
-  return {a.x + b.x, a.y + b.y, a.z + b.z};
-}
-HAIRGEN_LANE V3 operator-(const V3& a, const V3& b) {
-  return {a.x - b.x, a.y - b.y, a.z - b.z};
-}
-HAIRGEN_LANE V3 operator*(Vd s, const V3& a) {
-  return {s * a.x, s * a.y, s * a.z};
-}
-HAIRGEN_LANE V3 operator/(const V3& a, Vd s) {
-  return {a.x / s, a.y / s, a.z / s};
-}
-HAIRGEN_LANE Vd dot(const V3& a, const V3& b) {
-  return a.x * b.x + a.y * b.y + a.z * b.z;
-}
-HAIRGEN_LANE V3 cross(const V3& a, const V3& b) {
-  return {a.y * b.z - b.y * a.z, a.z * b.x - b.z * a.x, a.x * b.y - b.x * a.y};
-}
-HAIRGEN_LANE Vd sqrt(Vd v) {
-  for (size_t l = 0; l < AnjyoHair::kLanes; ++l) v[l] = __builtin_sqrt(v[l]);
-  return v;
-}
-HAIRGEN_LANE Vd select(Vm m, Vd a, Vd b) {
-  return m ? a : b;
-}
-HAIRGEN_LANE Vm select(Vm m, Vm a, Vm b) {
-  return m ? a : b;
-}
-HAIRGEN_LANE V3 select(Vm m, const V3& a, const V3& b) {
-  return {m ? a.x : b.x, m ? a.y : b.y, m ? a.z : b.z};
-}
-// Lanes where v != 0 (NaN included), written with ordered comparisons: GCC splits an equality test of
-// double vectors into one scalar compare per lane in this file's large functions.
-HAIRGEN_LANE Vm nonZero(Vd v) {
-  return !((v <= 0.0) & (v >= 0.0));
-}
-HAIRGEN_LANE Vd abs(Vd v) {
-  return v < 0.0 ? -v : v;
-}
-HAIRGEN_LANE glm::dvec3 lane(const V3& v, size_t l) {
-  return {v.x[l], v.y[l], v.z[l]};
-}
-HAIRGEN_LANE void setLane(V3& v, size_t l, const glm::dvec3& to) {
-  v.x[l] = to.x;
-  v.y[l] = to.y;
-  v.z[l] = to.z;
-}
+using namespace lanes;
+static_assert(AnjyoHair::kLanes == kLaneWidth);
 
 // Where penetration() of an ellipsoid (strand_energy.cpp) at the centre's offset v exceeds the depth
 // its node sat at, as settle() tests it: the same operations, lane by lane. `depth` per point, the node

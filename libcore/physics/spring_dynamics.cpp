@@ -13,6 +13,12 @@
 namespace hairgen {
 namespace {
 
+SpringHair::Kernel available(SpringHair::Kernel asked) {
+  static const bool avx512 = __builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512dq");
+  return asked != SpringHair::Kernel::kStrands && avx512 ? SpringHair::Kernel::kLanes
+                                                         : SpringHair::Kernel::kStrands;
+}
+
 // Density targeting: the grids of a spacing, shifted by half a cell along each combination of axes.
 constexpr int kDensityShifts = 8;
 
@@ -306,7 +312,8 @@ void SpringHair::factor(double dt) {
   });
 }
 
-void SpringHair::step(const AccelerationField& field, double dt, bool firstSubstep, bool lastSubstep) {
+void SpringHair::step(const AccelerationField& field, double dt, bool firstSubstep, bool lastSubstep,
+                      Kernel kernel) {
   if (dt != dt_) factor(dt);
   if (!targets_.empty() && densityStrength_ > 0.0) {
     if (firstSubstep) {
@@ -317,7 +324,11 @@ void SpringHair::step(const AccelerationField& field, double dt, bool firstSubst
     }
     difference_ = densityDifference(level_);
   }
-  tbb::parallel_for(size_t(0), rest_.strandCount(), [&](size_t s) { stepStrand(s, field, dt); });
+  if (available(kernel) == Kernel::kLanes)
+    tbb::parallel_for(size_t(0), (rest_.strandCount() + kLanes - 1) / kLanes,
+                      [&](size_t b) { stepBlock(b * kLanes, field, dt); });
+  else
+    tbb::parallel_for(size_t(0), rest_.strandCount(), [&](size_t s) { stepStrand(s, field, dt); });
   if (lastSubstep && smoothing_ > 0.0) smoothVelocities(smoothing_);
 }
 
@@ -366,15 +377,11 @@ void SpringHair::projectStretch(size_t s, double dt, int iterations, std::vector
   }
 }
 
-void SpringHair::stepStrand(size_t s, const AccelerationField& field, double dt) {
-  const uint32_t p0 = rest_.firstPoint[s];
-  if (rest_.pointsOf(s) < 2) return;
-  const uint32_t n = rest_.pointsOf(s) - 1;
-  thread_local std::vector<glm::dvec3> turn, force, before;
-  thread_local std::vector<double> lambda;
+void SpringHair::predict(size_t s, const AccelerationField& field, double dt, glm::dvec3* before) {
+  const uint32_t p0 = rest_.firstPoint[s], n = rest_.pointsOf(s) - 1;
+  thread_local std::vector<glm::dvec3> turn, force;
   turn.resize(n + 2);
   force.resize(n + 1);
-  before.resize(n + 1);
   // Bending: g_j = k_j (b̄_j − b_j), and each point's force Σ_j (B_j)_i g_j.
   // Each segment's direction over its rest length (e_j / l_j), once.
   thread_local std::vector<glm::dvec3> unit;
@@ -427,9 +434,10 @@ void SpringHair::stepStrand(size_t s, const AccelerationField& field, double dt)
     before[i] = x_[p0 + i];
     x_[p0 + i] += dt * force[i];
   }
-  // Inextensible (to the stretch compliance), twist springs, collisions, and the stretch once more.
-  lambda.assign(n + 2, 0.0);
-  projectStretch(s, dt, 1, lambda);
+}
+
+bool SpringHair::constrain(size_t s, double dt) {
+  const uint32_t p0 = rest_.firstPoint[s], n = rest_.pointsOf(s) - 1;
   bool twisted = false;
   for (uint32_t i = 0; i + 3 <= n; ++i) {
     const uint32_t a = p0 + i, b = p0 + i + 3;
@@ -455,11 +463,57 @@ void SpringHair::stepStrand(size_t s, const AccelerationField& field, double dt)
       }
     }
   }
-  if (moved) {  // what the twist springs and the shapes did to the lengths
+  return moved;
+}
+
+void SpringHair::finish(size_t s, double dt, const glm::dvec3* before) {
+  const uint32_t p0 = rest_.firstPoint[s], n = rest_.pointsOf(s) - 1;
+  for (uint32_t i = 1; i <= n; ++i) v_[p0 + i] = (x_[p0 + i] - before[i]) / dt;
+}
+
+void SpringHair::stepStrand(size_t s, const AccelerationField& field, double dt) {
+  if (rest_.pointsOf(s) < 2) return;
+  thread_local std::vector<glm::dvec3> before;
+  thread_local std::vector<double> lambda;
+  const uint32_t n = rest_.pointsOf(s) - 1;
+  before.resize(n + 1);
+  predict(s, field, dt, before.data());
+  // Inextensible (to the stretch compliance), then the twist springs and collisions, and where they
+  // moved a point the stretch once more.
+  lambda.assign(n + 2, 0.0);
+  projectStretch(s, dt, 1, lambda);
+  if (constrain(s, dt)) {
     lambda.assign(n + 2, 0.0);
     projectStretch(s, dt, 1, lambda);
   }
-  for (uint32_t i = 1; i <= n; ++i) v_[p0 + i] = (x_[p0 + i] - before[i]) / dt;
+  finish(s, dt, before.data());
+}
+
+void SpringHair::stepBlock(size_t s0, const AccelerationField& field, double dt) {
+  // stepStrand for the block's strands of one segment count together (the first such strand's), their
+  // stretch solved in vectors; any other strand on its own.
+  const size_t end = std::min(s0 + kLanes, rest_.strandCount());
+  size_t lanes[kLanes], count = 0;
+  uint32_t n = 0;
+  for (size_t s = s0; s < end; ++s) {
+    if (rest_.pointsOf(s) < 2) continue;
+    if (count == 0) n = rest_.pointsOf(s) - 1;
+    if (rest_.pointsOf(s) - 1 == n && n <= kMaxLaneSegments)
+      lanes[count++] = s;
+    else
+      stepStrand(s, field, dt);
+  }
+  if (count == 0) return;
+  thread_local std::vector<glm::dvec3> before;
+  before.resize(kLanes * (n + 1));
+  for (size_t l = 0; l < count; ++l) predict(lanes[l], field, dt, &before[l * (n + 1)]);
+  bool again[kLanes] = {};
+  std::fill(again, again + count, true);
+  projectStretchLanes(lanes, count, n, dt, again);
+  bool any = false;
+  for (size_t l = 0; l < count; ++l) any = (again[l] = constrain(lanes[l], dt)) || any;
+  if (any) projectStretchLanes(lanes, count, n, dt, again);
+  for (size_t l = 0; l < count; ++l) finish(lanes[l], dt, &before[l * (n + 1)]);
 }
 
 void SpringHair::smoothVelocities(double fraction) {

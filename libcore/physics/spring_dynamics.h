@@ -86,7 +86,14 @@ class SpringHair {
 
   // One substep of `dt` seconds for every strand. At the first substep of a frame the density spacing
   // is chosen; after the last (`lastSubstep`) the velocities are smoothed by VelocitySmoothing.
-  void step(const AccelerationField& field, double dt, bool firstSubstep, bool lastSubstep);
+  // How a substep is computed; each gives the same bits. kStrands: strand by strand. kLanes: the stretch
+  // solve of kLanes strands at once in AVX-512 vectors, where the processor has it (else kStrands).
+  // kFastest: kLanes.
+  enum class Kernel { kFastest, kStrands, kLanes };
+  static constexpr size_t kLanes = 8;
+  static constexpr uint32_t kMaxLaneSegments = 128;  // longer strands step on their own
+  void step(const AccelerationField& field, double dt, bool firstSubstep, bool lastSubstep,
+            Kernel kernel = Kernel::kFastest);
 
   // §5.1 on the current velocities: every free particle moves `fraction` of the way to the smoothed
   // grid velocity at its place. Never raises the kinetic energy.
@@ -121,7 +128,20 @@ class SpringHair {
   double maxStretch() const;
 
  private:
+  // A substep of one strand: predict (the explicit forces and the implicit bending into x_, the old
+  // positions into `before`, n + 1 of them), projectStretch, constrain (twist springs and collisions;
+  // whether they moved a point), projectStretch again where they did, finish (the velocities).
   void stepStrand(size_t strand, const AccelerationField& field, double dt);
+  void predict(size_t strand, const AccelerationField& field, double dt, glm::dvec3* before);
+  bool constrain(size_t strand, double dt);
+  void finish(size_t strand, double dt, const glm::dvec3* before);
+  // stepStrand for the strands s0 .. s0 + kLanes − 1, the stretch solves in vectors (spring_lanes.cpp)
+  // for those of the first one's segment count (at most kMaxLaneSegments).
+  void stepBlock(size_t s0, const AccelerationField& field, double dt);
+  // projectStretch(s, dt, 1, zeros) for the `count` strands `strands` (all of n segments) at once, lane
+  // by lane the same bits; only those whose `take` is set.
+  void projectStretchLanes(const size_t* strands, size_t count, uint32_t n, double dt, const bool* take);
+  struct Lanes;
   void factor(double dt);
   void projectStretch(size_t strand, double dt, int iterations, std::vector<double>& lambda);
   std::vector<Grid> densityDifference(size_t level) const;  // D_s − D_t at the current positions
