@@ -338,12 +338,16 @@ void SpringHair::projectStretch(size_t s, double dt, int iterations, std::vector
   const uint32_t p0 = rest_.firstPoint[s], n = rest_.pointsOf(s) - 1;
   std::vector<glm::dvec3>& x = x_;
   thread_local std::vector<glm::dvec3> u;
-  thread_local std::vector<double> diag, upper, rhs;
+  thread_local std::vector<double> diag, upper, rhs, inverseDiag, alpha, base, inverseLength;
   u.resize(n + 2);
-  diag.resize(n + 2);
-  upper.resize(n + 2);
-  rhs.resize(n + 2);
+  for (auto* v : {&diag, &upper, &rhs, &inverseDiag, &alpha, &base, &inverseLength}) v->resize(n + 2);
   const double dt2 = dt * dt;
+  // What every pass has the same: α/Δt², the diagonal before elimination, 1/l.
+  for (uint32_t j = 1; j <= n; ++j) {
+    alpha[j] = compliance_[p0 + j] / dt2;
+    base[j] = inverseMass_[p0 + j - 1] + inverseMass_[p0 + j] + alpha[j];
+    inverseLength[j] = 1.0 / length_[p0 + j];
+  }
   // `iterations` passes, and more (up to kMaxPasses) while a segment is still off its length by more
   // than kStretchTolerance: a big push (a collision, a strong density force) needs a few Newton steps.
   constexpr int kMaxPasses = 32;
@@ -353,22 +357,23 @@ void SpringHair::projectStretch(size_t s, double dt, int iterations, std::vector
     for (uint32_t j = 1; j <= n; ++j) {
       const glm::dvec3 e = x[p0 + j] - x[p0 + j - 1];
       const double len = glm::length(e);
-      worst = std::max(worst, std::abs(len - length_[p0 + j]) / length_[p0 + j]);
-      u[j] = e / len;
-      const double alpha = compliance_[p0 + j] / dt2;
-      diag[j] = inverseMass_[p0 + j - 1] + inverseMass_[p0 + j] + alpha;
-      rhs[j] = -(len - length_[p0 + j]) - alpha * lambda[j];
+      worst = std::max(worst, std::abs(len - length_[p0 + j]) * inverseLength[j]);
+      u[j] = (1.0 / len) * e;
+      diag[j] = base[j];
+      rhs[j] = -(len - length_[p0 + j]) - alpha[j] * lambda[j];
     }
     if (it >= iterations && worst <= kStretchTolerance) break;
     for (uint32_t j = 1; j < n; ++j) upper[j] = -inverseMass_[p0 + j] * glm::dot(u[j], u[j + 1]);
-    // Thomas: forward elimination, back substitution.
+    // Thomas: forward elimination, back substitution; one division a row.
+    inverseDiag[1] = 1.0 / diag[1];
     for (uint32_t j = 2; j <= n; ++j) {
-      const double m = upper[j - 1] / diag[j - 1];
+      const double m = upper[j - 1] * inverseDiag[j - 1];
       diag[j] -= m * upper[j - 1];
       rhs[j] -= m * rhs[j - 1];
+      inverseDiag[j] = 1.0 / diag[j];
     }
-    rhs[n] /= diag[n];
-    for (uint32_t j = n - 1; j >= 1; --j) rhs[j] = (rhs[j] - upper[j] * rhs[j + 1]) / diag[j];
+    rhs[n] *= inverseDiag[n];
+    for (uint32_t j = n - 1; j >= 1; --j) rhs[j] = (rhs[j] - upper[j] * rhs[j + 1]) * inverseDiag[j];
     for (uint32_t j = 1; j <= n; ++j) {
       lambda[j] += rhs[j];
       const double next = j < n ? rhs[j + 1] : 0.0;

@@ -42,9 +42,10 @@ void SpringHair::Lanes::projectStretch(SpringHair& hair, const size_t* strands, 
   // The strands' points, masses, lengths and compliances, lane by lane; a lane without a strand (or not
   // taking part) repeats the first strand's and is never written back.
   V3 x[kMaxLaneSegments + 1], u[kMaxLaneSegments + 2];
-  Vd inverseMass[kMaxLaneSegments + 1], length[kMaxLaneSegments + 1], compliance[kMaxLaneSegments + 1],
-      lambda[kMaxLaneSegments + 1], diag[kMaxLaneSegments + 1], upper[kMaxLaneSegments + 1],
-      rhs[kMaxLaneSegments + 1];
+  Vd inverseMass[kMaxLaneSegments + 1], length[kMaxLaneSegments + 1], alpha[kMaxLaneSegments + 1],
+      base[kMaxLaneSegments + 1], inverseLength[kMaxLaneSegments + 1], lambda[kMaxLaneSegments + 1],
+      diag[kMaxLaneSegments + 1], upper[kMaxLaneSegments + 1], rhs[kMaxLaneSegments + 1],
+      inverseDiag[kMaxLaneSegments + 1];
   uint32_t p0[w];
   // 1 in lanes whose strand has finished (or never started): the strand's loop has left them. (A double:
   // GCC 12 fails on a mask kept in a variable and or-ed with a comparison.)
@@ -60,10 +61,15 @@ void SpringHair::Lanes::projectStretch(SpringHair& hair, const size_t* strands, 
       setLane(x[j], l, hair.x_[p]);
       inverseMass[j][l] = hair.inverseMass_[p];
       length[j][l] = hair.length_[p];
-      compliance[j][l] = hair.compliance_[p];
+      alpha[j][l] = hair.compliance_[p];
       lambda[j][l] = 0.0;
     }
   const double dt2 = dt * dt;
+  for (uint32_t j = 1; j <= n; ++j) {
+    alpha[j] = alpha[j] / dt2;
+    base[j] = inverseMass[j - 1] + inverseMass[j] + alpha[j];
+    inverseLength[j] = 1.0 / length[j];
+  }
   constexpr int kMaxPasses = 32, kIterations = 1;
   constexpr double kStretchTolerance = 1e-3;
   for (int it = 0; it < kMaxPasses; ++it) {
@@ -71,25 +77,26 @@ void SpringHair::Lanes::projectStretch(SpringHair& hair, const size_t* strands, 
     for (uint32_t j = 1; j <= n; ++j) {
       const V3 e = x[j] - x[j - 1];
       const Vd len = sqrt(dot(e, e));
-      const Vd off = abs(len - length[j]) / length[j];
+      const Vd off = abs(len - length[j]) * inverseLength[j];
       worst = select(worst < off, off, worst);  // std::max(worst, off)
-      u[j] = e / len;
-      const Vd alpha = compliance[j] / dt2;
-      diag[j] = inverseMass[j - 1] + inverseMass[j] + alpha;
-      rhs[j] = -(len - length[j]) - alpha * lambda[j];
+      u[j] = (1.0 / len) * e;
+      diag[j] = base[j];
+      rhs[j] = -(len - length[j]) - alpha[j] * lambda[j];
     }
     if (it >= kIterations) done = select(worst <= kStretchTolerance, splat(1.0), done);
     bool all = true;
     for (size_t l = 0; l < w; ++l) all = all && done[l] > 0.0;
     if (all) break;
     for (uint32_t j = 1; j < n; ++j) upper[j] = -inverseMass[j] * dot(u[j], u[j + 1]);
+    inverseDiag[1] = 1.0 / diag[1];
     for (uint32_t j = 2; j <= n; ++j) {
-      const Vd m = upper[j - 1] / diag[j - 1];
+      const Vd m = upper[j - 1] * inverseDiag[j - 1];
       diag[j] -= m * upper[j - 1];
       rhs[j] -= m * rhs[j - 1];
+      inverseDiag[j] = 1.0 / diag[j];
     }
-    rhs[n] /= diag[n];
-    for (uint32_t j = n - 1; j >= 1; --j) rhs[j] = (rhs[j] - upper[j] * rhs[j + 1]) / diag[j];
+    rhs[n] *= inverseDiag[n];
+    for (uint32_t j = n - 1; j >= 1; --j) rhs[j] = (rhs[j] - upper[j] * rhs[j + 1]) * inverseDiag[j];
     const Vm keep = done > 0.0;
     for (uint32_t j = 1; j <= n; ++j) {
       lambda[j] = select(keep, lambda[j], lambda[j] + rhs[j]);
