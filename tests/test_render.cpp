@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include "libcore/render/gl_context.h"
+#include "libcore/render/line_decimation.h"
 #include "libcore/render/shader_interface.h"
 #include "libcore/render/shading.h"
 #include "libcore/util/file_util.h"
@@ -12,6 +13,63 @@
 
 namespace hairgen {
 namespace {
+
+// The light's passes draw chords: every point dropped lies within the tolerance of the chord that
+// replaces it, ends are kept, a chord spans at most kMostSegmentsPerChord segments, and what bends more
+// than the tolerance keeps its points.
+TEST(LineDecimation, ChordsStayWithinToleranceOfEveryPointTheyDrop) {
+  Strands s;
+  std::vector<glm::vec3> straight, zigzag, arc, single = {glm::vec3(0.0f)};
+  for (int j = 0; j < 64; ++j) {
+    straight.push_back(glm::vec3(0.0f, -0.003f * j, 0.0f));
+    zigzag.push_back(glm::vec3(j % 2 ? 0.001f : 0.0f, -0.003f * j, 0.01f));
+    const double a = 0.05 * j;  // a 2 cm radius arc: 3 mm segments bend 0.06 mm off their chords of two
+    arc.push_back(glm::vec3(float(0.02 * std::cos(a)), float(0.02 * std::sin(a)), 0.02f));
+  }
+  for (const auto* points : {&straight, &single, &zigzag, &arc}) s.addStrand(*points);
+  const double tolerance = 1e-4;
+  auto stripsOf = [](const std::vector<uint32_t>& indices) {
+    std::vector<std::vector<uint32_t>> strips(1);
+    for (uint32_t i : indices) {
+      if (i == kRestartIndex)
+        strips.emplace_back();
+      else
+        strips.back().push_back(i);
+    }
+    EXPECT_TRUE(strips.back().empty()) << "every strip ends with a restart";
+    strips.pop_back();
+    return strips;
+  };
+  const std::vector<std::vector<uint32_t>> strips = stripsOf(decimatedLineStrips(s, tolerance));
+  ASSERT_EQ(strips.size(), 3u);  // the one-point strand draws nothing
+  // The straight strand: one chord every kMostSegmentsPerChord segments.
+  EXPECT_EQ(strips[0].size(), 63 / kMostSegmentsPerChord + 2);
+  EXPECT_EQ(strips[1].size(), 64u) << "a zigzag of 1 mm against 0.1 mm keeps every point";
+  EXPECT_GT(strips[2].size(), 64u / kMostSegmentsPerChord);
+  EXPECT_LT(strips[2].size(), 64u);
+  const size_t strandOf[3] = {0, 2, 3};
+  for (size_t k = 0; k < strips.size(); ++k) {
+    const std::vector<uint32_t>& strip = strips[k];
+    const size_t strand = strandOf[k];
+    EXPECT_EQ(strip.front(), s.firstPoint[strand]);
+    EXPECT_EQ(strip.back(), s.firstPoint[strand] + s.pointsOf(strand) - 1);
+    for (size_t c = 0; c + 1 < strip.size(); ++c) {
+      ASSERT_LT(strip[c], strip[c + 1]);
+      EXPECT_LE(strip[c + 1] - strip[c], kMostSegmentsPerChord);
+      const glm::dvec3 a(s.points[strip[c]]), b(s.points[strip[c + 1]]);
+      for (uint32_t p = strip[c] + 1; p < strip[c + 1]; ++p) {
+        const glm::dvec3 q(s.points[p]);
+        const double t = glm::clamp(glm::dot(q - a, b - a) / glm::dot(b - a, b - a), 0.0, 1.0);
+        EXPECT_LE(glm::length(q - (a + t * (b - a))), tolerance) << "point " << p;
+      }
+    }
+  }
+  // Tolerance 0 keeps every point of the bent strands.
+  const std::vector<std::vector<uint32_t>> exact = stripsOf(decimatedLineStrips(s, 0.0));
+  ASSERT_EQ(exact.size(), 3u);
+  EXPECT_EQ(exact[1].size(), 64u);
+  EXPECT_EQ(exact[2].size(), 64u);
+}
 
 GlContext& gl() {
   static GlContext context;  // every test here needs it; failing to open one fails them (exit 3 in the CLI)

@@ -216,6 +216,7 @@ HairGeometry::HairGeometry(const Strands& s, const std::vector<glm::vec3>& tange
                   std::to_string(s.points.size()));
   for (size_t i = 0; i < s.strandCount(); ++i) {
     if (s.pointsOf(i) < 2) continue;
+    lineStrands.push_back(static_cast<uint32_t>(i));
     lineFirsts.push_back(static_cast<GLint>(s.firstPoint[i]));
     lineCounts.push_back(static_cast<GLsizei>(s.pointsOf(i)));
     ribbonFirsts.push_back(static_cast<GLint>(2 * s.firstPoint[i]));
@@ -251,6 +252,7 @@ void HairGeometry::orderFrontToBack(const Strands& s, const glm::dmat4& view) {
     auto old = v;
     for (size_t i = 0; i < keys.size(); ++i) v[i] = old[keys[i].second];
   };
+  permute(lineStrands);
   permute(lineFirsts);
   permute(lineCounts);
   permute(ribbonFirsts);
@@ -261,7 +263,26 @@ HairGeometry::~HairGeometry() {
   glDeleteVertexArrays(1, &vao);
 }
 
-void HairGeometry::draw(bool ribbon) const {
+LineStrips::LineStrips(const std::vector<uint32_t>& indices) : count(static_cast<GLsizei>(indices.size())) {
+  glCreateBuffers(1, &id);
+  glNamedBufferStorage(id, static_cast<GLsizeiptr>(std::max<size_t>(indices.size() * sizeof(uint32_t), 4)),
+                       indices.empty() ? nullptr : indices.data(), 0);
+}
+
+LineStrips::~LineStrips() {
+  glDeleteBuffers(1, &id);
+}
+
+void HairGeometry::drawLines(const LineStrips* strips) const {
+  if (!strips) return draw(false);
+  draw(false, false);
+  glVertexArrayElementBuffer(vao, strips->id);
+  glEnable(GL_PRIMITIVE_RESTART_FIXED_INDEX);
+  glDrawElements(GL_LINE_STRIP, strips->count, GL_UNSIGNED_INT, nullptr);
+  glDisable(GL_PRIMITIVE_RESTART_FIXED_INDEX);
+}
+
+void HairGeometry::draw(bool ribbon, bool drawing) const {
   glBindVertexArray(vao);
   glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, points.id);
   glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, tangents.id);
@@ -270,7 +291,7 @@ void HairGeometry::draw(bool ribbon) const {
   glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 4, previous.id);
   if (!hasColors) glVertexAttrib3f(2, 1.0f, 1.0f, 1.0f);
   if (!hasNormals) glVertexAttrib3f(3, 0.0f, 0.0f, 0.0f);
-  if (lineFirsts.empty()) return;
+  if (lineFirsts.empty() || !drawing) return;
   if (ribbon)
     glMultiDrawArrays(GL_TRIANGLE_STRIP, ribbonFirsts.data(), ribbonCounts.data(),
                       static_cast<GLsizei>(ribbonFirsts.size()));

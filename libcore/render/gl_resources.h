@@ -95,6 +95,18 @@ struct Buffer {
   GLuint id = 0;
 };
 
+// Line strips through some of a coupe's points (line_decimation.h: point indices, kRestartIndex
+// between strips) in an index buffer, for HairGeometry::drawLines.
+struct LineStrips {
+  explicit LineStrips(const std::vector<uint32_t>& indices);
+  ~LineStrips();
+  LineStrips(const LineStrips&) = delete;
+  LineStrips& operator=(const LineStrips&) = delete;
+
+  GLuint id = 0;
+  GLsizei count = 0;
+};
+
 // Hair on the GPU: points, tangents, colors and normals (where the strands have them) both as vertex
 // attributes 0-3 and as storage buffers 0-3 (glsl/hair_vertex.glsl reads one or the other); per strand
 // a line strip (one vertex per point) or a triangle strip (two). Strands of fewer than 2 points are
@@ -107,8 +119,10 @@ struct HairGeometry {
   ~HairGeometry();
   HairGeometry(const HairGeometry&) = delete;
   HairGeometry& operator=(const HairGeometry&) = delete;
-  // Binds the buffers and draws every strand as lines, or as ribbons.
-  void draw(bool ribbon) const;
+  // Binds the buffers and draws every strand as lines, or as ribbons (with `drawing` false, only binds).
+  void draw(bool ribbon, bool drawing = true) const;
+  // Draws the strands as `strips` gives them (null: every point, draw(false)).
+  void drawLines(const struct LineStrips* strips) const;
   // Draws the strands nearest `view`'s eye first (by their nearest point), so a depth test made before
   // shading skips more of what lies behind; the order changes no result but ties of equal depth.
   void orderFrontToBack(const Strands& strands, const glm::dmat4& view);
@@ -117,6 +131,7 @@ struct HairGeometry {
   bool hasColors, hasNormals, hasPrevious;
   std::vector<GLint> lineFirsts, ribbonFirsts;
   std::vector<GLsizei> lineCounts, ribbonCounts;
+  std::vector<uint32_t> lineStrands;  // the strand of each line strip, in drawing order
   GLuint vao = 0;
 };
 

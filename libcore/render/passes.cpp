@@ -4,11 +4,16 @@
 #include <cmath>
 
 #include "glsl/embedded_glsl.h"
+#include "libcore/render/line_decimation.h"
 #include "libcore/render/shader_interface.h"
 
 namespace hairgen {
 
 namespace {
+
+// How far from the hair the chords drawn for it may stray: a quarter of a pixel of the image being drawn
+// (a sub-pixel when Samples asks for them, a texel of the light's maps).
+constexpr double kChordPixels = 0.25;
 
 // k for Samples = k² (k ≤ 8), lowered until the sub-pixel image fits the device's largest texture.
 int subpixelBlock(const RenderSettings& r) {
@@ -163,6 +168,23 @@ Scene::Scene(const RenderInput& in)
   // fragments of exactly equal depth is kept. The light's passes are order-free: the nearest depth,
   // and sums of equal opacities.
   if (block == 1) hair.orderFrontToBack(*in.hair, camera.view);
+  // Chords (line_decimation.h) within kChordPixels of a pixel of the image or a texel of the light's
+  // maps, measured where the hair is nearest (where they are smallest): the light's passes and the
+  // shading pass, whose cost is llvmpipe's vertex stage on one thread, draw a fraction of the vertices
+  // and the same picture to that.
+  if (!in.shaders.hairVert) {
+    auto nearest = [&](const View& v) {  // from the eye to the nearest of the scene
+      return glm::length(sphere.centre - glm::dvec3(glm::inverse(v.view)[3])) - sphere.radius;
+    };
+    const double lightNearest = nearest(light);
+    if (lightNearest > 0.0)
+      lightLines = std::make_unique<LineStrips>(
+          decimatedLineStrips(*in.hair, kChordPixels * lightNearest / light.focalPx));
+    const double cameraNearest = nearest(subpixel);
+    if (!ribbons && cameraNearest > 0.0)
+      cameraLines = std::make_unique<LineStrips>(
+          decimatedLineStrips(*in.hair, kChordPixels * cameraNearest / subpixel.focalPx, hair.lineStrands));
+  }
   checkGl("setting up");
 }
 
@@ -194,7 +216,7 @@ LightDepth lightDepthPass(const Scene& scene) {
     p.use();
     setView(p, scene.light);
     setHairWidth(p, scene.light, scene.settings);
-    scene.hair.draw(false);
+    scene.hair.drawLines(scene.lightLines.get());
   }
   checkGl("the light's depth pass");
   return depth;
@@ -216,7 +238,7 @@ Texture deepOpacityPass(const Scene& scene, const LightDepth& depth) {
   setHairWidth(p, scene.light, scene.settings);
   p.set("uLayers", glm::vec4(scene.settings.layerSizes));
   glBindImageTexture(0, depth.hairStart.id, 0, GL_FALSE, 0, GL_READ_ONLY, GL_R32F);
-  scene.hair.draw(false);
+  scene.hair.drawLines(scene.lightLines.get());
   glBindImageTexture(0, 0, 0, GL_FALSE, 0, GL_READ_ONLY, GL_R32F);
   glDisable(GL_BLEND);
   checkGl("the deep opacity pass");
@@ -260,7 +282,10 @@ ShadedImage shadingPass(const Scene& scene, const LightDepth& depth, const Textu
   p.set("uBlend", float(r.volumetricBlend));
   p.set("uHasColor", scene.hair.hasColors ? 1 : 0);
   p.set("uHasNormal", scene.hair.hasNormals ? 1 : 0);
-  scene.hair.draw(scene.ribbons);
+  if (scene.ribbons)
+    scene.hair.draw(true);
+  else
+    scene.hair.drawLines(scene.cameraLines.get());
   checkGl("the shading pass");
   return image;
 }
@@ -309,7 +334,10 @@ Texture motionPass(const Scene& scene) {
   p.set("uViewProj", glm::mat4(scene.viewProj));
   p.set("uPreviousViewProj", glm::mat4(scene.previousViewProj));
   p.set("uImageSize", imageSize);
-  scene.hair.draw(scene.ribbons);
+  if (scene.ribbons)
+    scene.hair.draw(true);
+  else
+    scene.hair.drawLines(scene.cameraLines.get());
   checkGl("the motion pass");
   return motion;
 }

@@ -49,6 +49,9 @@ struct Scene {
   bool motion;            // the previous frame was given: motion vectors too
   glm::dmat4 viewProj{1.0}, previousViewProj{1.0};  // world to clip: this frame's camera, the previous one's
   HairGeometry hair;
+  // The hair as chords for the light's passes and for the shading pass when it draws lines (null: every
+  // point; a custom HairVert always gets every point, since what it does to them is its own).
+  std::unique_ptr<LineStrips> lightLines, cameraLines;
   std::unique_ptr<HeadGeometry> head;  // null when there is no head to draw
   Programs programs;
 };

@@ -1,0 +1,70 @@
+// Greedy chord decimation of line strips, as line_decimation.h describes.
+#include "libcore/render/line_decimation.h"
+
+#include <tbb/parallel_for.h>
+
+#include <glm/glm.hpp>
+
+namespace hairgen {
+namespace {
+
+// The squared distance from p to the segment a–b.
+double distance2(const glm::dvec3& p, const glm::dvec3& a, const glm::dvec3& b) {
+  const glm::dvec3 ab = b - a, ap = p - a;
+  const double length2 = glm::dot(ab, ab);
+  const double t = length2 > 0.0 ? glm::clamp(glm::dot(ap, ab) / length2, 0.0, 1.0) : 0.0;
+  const glm::dvec3 off = ap - t * ab;
+  return glm::dot(off, off);
+}
+
+// Marks in `keep` (one flag per point of strand s) the points its strip keeps; returns how many.
+uint32_t keepPoints(const Strands& strands, size_t s, double tolerance2, uint8_t* keep) {
+  const uint32_t p0 = strands.firstPoint[s], n = strands.pointsOf(s);
+  auto point = [&](uint32_t j) { return glm::dvec3(strands.points[p0 + j]); };
+  uint32_t kept = 1, a = 0;
+  keep[0] = 1;
+  while (a + 1 < n) {
+    uint32_t b = a + 1;  // the farthest point whose chord from a holds every point between
+    for (uint32_t c = a + 2; c < n && c - a <= kMostSegmentsPerChord; ++c) {
+      bool holds = true;
+      for (uint32_t k = a + 1; k < c && holds; ++k)
+        holds = distance2(point(k), point(a), point(c)) <= tolerance2;
+      if (!holds) break;
+      b = c;
+    }
+    keep[b] = 1;
+    ++kept;
+    a = b;
+  }
+  return kept;
+}
+
+}  // namespace
+
+std::vector<uint32_t> decimatedLineStrips(const Strands& strands, double tolerance,
+                                          const std::vector<uint32_t>& order) {
+  std::vector<uint32_t> all;
+  if (order.empty())
+    for (uint32_t s = 0; s < strands.strandCount(); ++s)
+      if (strands.pointsOf(s) >= 2) all.push_back(s);
+  const std::vector<uint32_t>& drawn = order.empty() ? all : order;
+  std::vector<uint8_t> keep(strands.pointCount(), 0);
+  std::vector<uint64_t> first(drawn.size() + 1, 0);  // per strip, where it starts in the indices
+  const double tolerance2 = tolerance * tolerance;
+  tbb::parallel_for(size_t(0), drawn.size(), [&](size_t k) {
+    const uint32_t s = drawn[k];
+    first[k + 1] = keepPoints(strands, s, tolerance2, &keep[strands.firstPoint[s]]) + 1;  // + the restart
+  });
+  for (size_t k = 0; k < drawn.size(); ++k) first[k + 1] += first[k];
+  std::vector<uint32_t> indices(first.back());
+  tbb::parallel_for(size_t(0), drawn.size(), [&](size_t k) {
+    const uint32_t s = drawn[k];
+    uint64_t at = first[k];
+    for (uint32_t p = strands.firstPoint[s]; p < strands.firstPoint[s] + strands.pointsOf(s); ++p)
+      if (keep[p]) indices[at++] = p;
+    indices[at] = kRestartIndex;
+  });
+  return indices;
+}
+
+}  // namespace hairgen
