@@ -20,6 +20,7 @@
 #include <dlfcn.h>
 #include <half.h>
 #include <png.h>
+#include <tbb/global_control.h>
 
 #include "libcore/util/error.h"
 #include "libcore/util/file_util.h"
@@ -148,7 +149,11 @@ void writeExr(const fs::path& file, const Image& image, const ExrMetadata& metad
   }
   writeThroughTemporary(file, [&](const fs::path& temporary) {
     try {
-      Imf::OutputFile out(temporary.c_str(), header);
+      // Compressed on every core hairgen may use (--threads): each chunk is compressed alone, so the
+      // bytes are the same for any count.
+      Imf::OutputFile out(
+          temporary.c_str(), header,
+          int(tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism)));
       out.setFrameBuffer(frame);
       out.writePixels(image.height);
     } catch (const std::exception& e) {
