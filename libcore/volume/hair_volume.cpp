@@ -527,6 +527,24 @@ inline __attribute__((always_inline)) void addCorner(size_t count, const int sx,
   }
 }
 
+constexpr size_t kNormalsBlock = 256;  // points a block
+
+// The eight corners with x fastest, then y, then z: the order the one-point-at-a-time sum adds them. A
+// function forced inline, not a lambda: a lambda is a function of its own, built for the baseline, and
+// would run the corners without the caller's AVX2.
+template <int... k>
+inline __attribute__((always_inline)) void addCorners(std::integer_sequence<int, k...>, size_t count,
+                                                      const glm::ivec3& size,
+                                                      const glm::vec3* __restrict gradients,
+                                                      const int* __restrict c, const double* __restrict f,
+                                                      double* __restrict out) {
+  constexpr size_t kB = kNormalsBlock;
+  ((addCorner<(k & 1), ((k >> 1) & 1), (k >> 2)>(count, size.x, size.y, size.z, gradients, c, c + kB,
+                                                 c + 2 * kB, f, f + kB, f + 2 * kB, out, out + kB,
+                                                 out + 2 * kB)),
+   ...);
+}
+
 // Normals ∇S/|∇S| of up to 256 points: sampleGradient and the normalisation of volumeNormals, one stage
 // at a time over the block so each runs across points in vector registers (libcore/util/vectorise.h),
 // with the arithmetic of trilinear() per point. The cell is the truncation of the clamped grid
@@ -534,7 +552,7 @@ inline __attribute__((always_inline)) void addCorner(size_t count, const int sx,
 HAIRGEN_VECTOR_CLONES
 void normalsOfBlock(const Grid& grid, const glm::vec3* __restrict gradients,
                     const glm::vec3* __restrict points, size_t count, glm::vec3* __restrict normals) {
-  constexpr size_t kB = 256;
+  constexpr size_t kB = kNormalsBlock;
   int c[3 * kB];
   double f[3 * kB], out[3 * kB];
   const glm::dvec3 top = glm::dvec3(grid.size - 1) - 1e-9;
@@ -552,14 +570,7 @@ void normalsOfBlock(const Grid& grid, const glm::vec3* __restrict gradients,
       out[axis * kB + p] = 0.0;
     }
   }
-  const int sx = grid.size.x, sy = grid.size.y, sz = grid.size.z;
-  // The eight corners with x fastest, then y, then z: the order the one-point-at-a-time sum adds them.
-  [&]<int... k>(std::integer_sequence<int, k...>) {
-    ((addCorner<(k & 1), ((k >> 1) & 1), (k >> 2)>(count, sx, sy, sz, gradients, c, c + kB, c + 2 * kB, f,
-                                                   f + kB, f + 2 * kB, out, out + kB, out + 2 * kB)),
-     ...);
-  }
-  (std::make_integer_sequence<int, 8>{});
+  addCorners(std::make_integer_sequence<int, 8>{}, count, grid.size, gradients, c, f, out);
   float* const n = &normals[0].x;
   double* const lengths = f;  // the fractions are spent
   HAIRGEN_IVDEP
@@ -582,9 +593,9 @@ std::vector<glm::vec3> volumeNormals(const Grid& distance, const Strands& strand
   std::vector<glm::vec3> normals(strands.pointCount());
   tbb::parallel_for(tbb::blocked_range<size_t>(0, strands.pointCount(), 8192),
                     [&](const tbb::blocked_range<size_t>& r) {
-                      for (size_t p = r.begin(); p < r.end(); p += 256)
+                      for (size_t p = r.begin(); p < r.end(); p += kNormalsBlock)
                         normalsOfBlock(distance, gradients.data(), &strands.points[p],
-                                       std::min<size_t>(256, r.end() - p), &normals[p]);
+                                       std::min(kNormalsBlock, r.end() - p), &normals[p]);
                     });
   return normals;
 }
