@@ -2,8 +2,12 @@
 
 #include <cmath>
 
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
 #include "libcore/model/strand_frames.h"
 #include "libcore/util/error.h"
+#include "libcore/util/huge_pages.h"
 #include "libcore/util/random.h"
 #include "libcore/util/stopwatch.h"
 #include "stages/estimate.h"
@@ -40,13 +44,18 @@ ShadeResult shade(Strands coupe, const Visuality& visuality, const RenderSetting
   out = std::move(coupe);
   out.normals = volumeNormals(result.volume.distance, out);
   if (wantsAmbient(visuality)) {
-    out.colors.assign(out.pointCount(), glm::vec3(1.0f));
-    for (size_t s = 0; s < out.strandCount(); ++s) {
-      const uint32_t id = out.strandId.empty() ? static_cast<uint32_t>(s) : out.strandId[s];
-      const float a =
-          static_cast<float>(strandAmbient(seed, id, visuality.ambientMean, visuality.ambientDeviation));
-      for (uint32_t p = out.firstPoint[s]; p < out.firstPoint[s + 1]; ++p) out.colors[p] = glm::vec3(a);
-    }
+    // Every point belongs to one strand (firstPoint runs from 0 to the point count), so the strands,
+    // each on its own, write every colour.
+    resizeOnHugePages(out.colors, out.pointCount());
+    tbb::parallel_for(
+        tbb::blocked_range<size_t>(0, out.strandCount(), 1024), [&](const tbb::blocked_range<size_t>& r) {
+          for (size_t s = r.begin(); s < r.end(); ++s) {
+            const uint32_t id = out.strandId.empty() ? static_cast<uint32_t>(s) : out.strandId[s];
+            const float a = static_cast<float>(
+                strandAmbient(seed, id, visuality.ambientMean, visuality.ambientDeviation));
+            for (uint32_t p = out.firstPoint[s]; p < out.firstPoint[s + 1]; ++p) out.colors[p] = glm::vec3(a);
+          }
+        });
   }
   out.provenance = madeByHairgen("shade", seed, options.configDigest);
   result.timings.normals = clock.lap();
