@@ -12,7 +12,6 @@
 #include <tbb/parallel_for.h>
 
 #include "libcore/util/error.h"
-#include "libcore/util/huge_pages.h"
 #include "libcore/util/random.h"
 #include "libcore/util/vectorise.h"
 #include "stages/estimate.h"
@@ -251,10 +250,9 @@ void interpolateInto(const Mesh& wick, const Strands& guides, const Hairstyle& s
   const uint64_t strandBase = firstStrand[firstTriangle], pointBase = firstPoint[firstTriangle];
   const size_t strands = firstStrand[endTriangle] - strandBase, points = firstPoint[endTriangle] - pointBase;
   // Every array is resized, not made anew: a coupe of the same size (the next frame's) keeps its
-  // storage, and every element below is written whatever it held. Points and tangents, ~115 MB each at
-  // 150,000 × 64, go on huge pages when they are new.
-  resizeOnHugePages(coupe.points, points);
-  resizeOnHugePages(coupe.tangents, points);
+  // storage, and every element below is written whatever it held.
+  coupe.points.resize(points);
+  coupe.tangents.resize(points);
   coupe.firstPoint.resize(strands + 1);
   coupe.strandId.resize(strands);
   coupe.rootTriangle.resize(strands);

@@ -7,7 +7,6 @@
 
 #include "libcore/model/strand_frames.h"
 #include "libcore/util/error.h"
-#include "libcore/util/huge_pages.h"
 #include "libcore/util/random.h"
 #include "libcore/util/stopwatch.h"
 #include "stages/estimate.h"
@@ -46,7 +45,7 @@ ShadeResult shade(Strands coupe, const Visuality& visuality, const RenderSetting
   if (wantsAmbient(visuality)) {
     // Every point belongs to one strand (firstPoint runs from 0 to the point count), so the strands,
     // each on its own, write every colour.
-    resizeOnHugePages(out.colors, out.pointCount());
+    out.colors.resize(out.pointCount());
     tbb::parallel_for(
         tbb::blocked_range<size_t>(0, out.strandCount(), 1024), [&](const tbb::blocked_range<size_t>& r) {
           for (size_t s = r.begin(); s < r.end(); ++s) {

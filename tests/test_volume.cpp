@@ -10,7 +10,6 @@
 #include "libcore/config/setup.h"
 #include "libcore/io/obj_io.h"
 #include "libcore/model/strand_frames.h"
-#include "libcore/util/huge_pages.h"
 #include "libcore/volume/hair_volume.h"
 #include "stages/grow.h"
 #include "stages/interpolate.h"
@@ -134,23 +133,6 @@ TEST(Volume, ReposingRestNormalsOnARotatedCoupeRotatesThem) {
   for (size_t i = 0; i < reposed.size(); ++i)
     worst = std::max(worst, glm::length(glm::dvec3(reposed[i]) - r * glm::dvec3(rest.normals[i])));
   EXPECT_LT(worst, 1e-5);
-}
-
-// The normals and the coupe's points grow through resizeOnHugePages: past a huge page, new storage
-// faulted in ahead, it must still be what resize gives.
-TEST(HugePages, AGrownVectorKeepsItsElementsAndValueInitialisesTheRest) {
-  std::vector<glm::vec3> v(1000);
-  for (size_t i = 0; i < v.size(); ++i) v[i] = glm::vec3(float(i), 1.0f, 2.0f);
-  const size_t n = 3'000'000;  // 36 MB
-  resizeOnHugePages(v, n);
-  ASSERT_EQ(v.size(), n);
-  for (size_t i = 0; i < 1000; ++i) ASSERT_EQ(v[i], glm::vec3(float(i), 1.0f, 2.0f)) << i;
-  for (size_t i = 1000; i < n; ++i) ASSERT_EQ(v[i], glm::vec3(0.0f)) << i;
-  const glm::vec3* storage = v.data();
-  resizeOnHugePages(v, 10);
-  resizeOnHugePages(v, n);
-  EXPECT_EQ(v.data(), storage) << "a vector with the room reallocated";
-  EXPECT_EQ(v[n - 1], glm::vec3(0.0f));
 }
 
 }  // namespace

@@ -14,7 +14,6 @@
 
 #include "libcore/model/mesh.h"
 #include "libcore/util/error.h"
-#include "libcore/util/huge_pages.h"
 #include "libcore/util/vectorise.h"
 
 namespace hairgen {
@@ -591,8 +590,7 @@ void normalsOfBlock(const Grid& grid, const glm::vec3* __restrict gradients,
 
 std::vector<glm::vec3> volumeNormals(const Grid& distance, const Strands& strands) {
   const std::vector<glm::vec3> gradients = nodeGradients(distance);
-  std::vector<glm::vec3> normals;
-  resizeOnHugePages(normals, strands.pointCount());
+  std::vector<glm::vec3> normals(strands.pointCount());
   tbb::parallel_for(tbb::blocked_range<size_t>(0, strands.pointCount(), 8192),
                     [&](const tbb::blocked_range<size_t>& r) {
                       for (size_t p = r.begin(); p < r.end(); p += kNormalsBlock)
