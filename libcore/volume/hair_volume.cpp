@@ -365,6 +365,30 @@ namespace {
 
 constexpr double kNone = std::numeric_limits<double>::infinity();  // a node with no shell point yet
 
+// One x-line of fast sweeping in one of the 8 orders of the axes (bit 0, 1, 2 of `order` reverse x, y,
+// z): each node takes the nearest point of a neighbour behind it when that is nearer than its own. `jj`
+// and `kk` count lines in the order's direction. Built for AVX2 as well, as slideSlab is.
+HAIRGEN_VECTOR_CLONES __attribute__((flatten)) void sweepLine(const glm::ivec3& n, const glm::dvec3& origin,
+                                                              double h, int order, int jj, int kk,
+                                                              glm::dvec3* nearest, double* dist2) {
+  const bool fx = order & 1, fy = order & 2, fz = order & 4;
+  const size_t strideY = size_t(n.x), strideZ = size_t(n.x) * n.y;
+  for (int ii = 0; ii < n.x; ++ii) {
+    const int i = fx ? n.x - 1 - ii : ii, j = fy ? n.y - 1 - jj : jj, k = fz ? n.z - 1 - kk : kk;
+    const size_t id = (size_t(k) * n.y + j) * n.x + i;
+    const glm::dvec3 x = origin + h * glm::dvec3(i, j, k);
+    const bool has[3] = {fx ? i + 1 < n.x : i > 0, fy ? j + 1 < n.y : j > 0, fz ? k + 1 < n.z : k > 0};
+    const size_t behind[3] = {fx ? id + 1 : id - 1, fy ? id + strideY : id - strideY,
+                              fz ? id + strideZ : id - strideZ};
+    for (int axis = 0; axis < 3; ++axis) {
+      if (!has[axis] || dist2[behind[axis]] == kNone) continue;
+      const glm::dvec3 e = nearest[behind[axis]] - x;
+      const double d2 = glm::dot(e, e);
+      if (d2 < dist2[id]) nearest[id] = nearest[behind[axis]], dist2[id] = d2;
+    }
+  }
+}
+
 // Newton's steps on the trilinear φ = density − iso, p ← p − φ ∇φ/|∇φ|², from p back onto the shell;
 // false when they do not reach it within `tolerance`. Leaves in `gradient` ∇φ at the point it returns,
 // which the slide's next round starts from.
@@ -423,7 +447,6 @@ Grid signedDistance(const Grid& density, double iso) {
   const glm::ivec3 n = density.size;
   const double h = density.voxel;
   const size_t count = density.values.size();
-  const size_t strideY = size_t(n.x), strideZ = size_t(n.x) * n.y;
   auto node = [&](int i, int j, int k) { return density.origin + h * glm::dvec3(i, j, k); };
   std::vector<char> inside(count);
   for (size_t i = 0; i < count; ++i) inside[i] = density.values[i] > iso;
@@ -460,28 +483,11 @@ Grid signedDistance(const Grid& density, double iso) {
   // itself; so the x-lines (jj, kk) on one diagonal jj + kk = d depend on the diagonal before alone,
   // and sweeping the diagonals in turn, their lines at once, gives the bits of the raster order.
   auto sweep = [&] {  // one round of the 8 orders: the slide below mends what it leaves
-    for (int order = 0; order < 8; ++order) {
-      const bool fx = order & 1, fy = order & 2, fz = order & 4;
-      auto line = [&](int jj, int kk) {
-        for (int ii = 0; ii < n.x; ++ii) {
-          const int i = fx ? n.x - 1 - ii : ii, j = fy ? n.y - 1 - jj : jj, k = fz ? n.z - 1 - kk : kk;
-          const size_t id = density.index(i, j, k);
-          const glm::dvec3 x = node(i, j, k);
-          const bool has[3] = {fx ? i + 1 < n.x : i > 0, fy ? j + 1 < n.y : j > 0, fz ? k + 1 < n.z : k > 0};
-          const size_t behind[3] = {fx ? id + 1 : id - 1, fy ? id + strideY : id - strideY,
-                                    fz ? id + strideZ : id - strideZ};
-          for (int axis = 0; axis < 3; ++axis) {
-            if (!has[axis] || dist2[behind[axis]] == kNone) continue;
-            const glm::dvec3 e = nearest[behind[axis]] - x;
-            const double d2 = glm::dot(e, e);
-            if (d2 < dist2[id]) nearest[id] = nearest[behind[axis]], dist2[id] = d2;
-          }
-        }
-      };
+    for (int order = 0; order < 8; ++order)
       for (int d = 0; d <= (n.y - 1) + (n.z - 1); ++d)
-        tbb::parallel_for(std::max(0, d - (n.y - 1)), std::min(d, n.z - 1) + 1,
-                          [&](int kk) { line(d - kk, kk); });
-    }
+        tbb::parallel_for(std::max(0, d - (n.y - 1)), std::min(d, n.z - 1) + 1, [&](int kk) {
+          sweepLine(density.size, density.origin, h, order, d - kk, kk, nearest.data(), dist2.data());
+        });
   };
 
   // A nearest point carried from a neighbour is a shell point near the node's own nearest point, not
