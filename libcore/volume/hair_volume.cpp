@@ -614,15 +614,20 @@ void normalsOfBlock(const Grid& grid, const glm::vec3* __restrict gradients,
 }  // namespace
 
 std::vector<glm::vec3> volumeNormals(const Grid& distance, const Strands& strands) {
+  std::vector<glm::vec3> normals;
+  volumeNormals(distance, strands, normals);
+  return normals;
+}
+
+void volumeNormals(const Grid& distance, const Strands& strands, std::vector<glm::vec3>& normals) {
   const std::vector<glm::vec3> gradients = nodeGradients(distance);
-  std::vector<glm::vec3> normals(strands.pointCount());
+  normals.resize(strands.pointCount());
   tbb::parallel_for(tbb::blocked_range<size_t>(0, strands.pointCount(), 8192),
                     [&](const tbb::blocked_range<size_t>& r) {
                       for (size_t p = r.begin(); p < r.end(); p += kNormalsBlock)
                         normalsOfBlock(distance, gradients.data(), &strands.points[p],
                                        std::min(kNormalsBlock, r.end() - p), &normals[p]);
                     });
-  return normals;
 }
 
 }  // namespace hairgen

@@ -93,5 +93,7 @@ HairVolume buildVolume(const Strands& strands, double voxel, int padding, double
 
 // Shading normals ∇S/|∇S| at every strand vertex.
 std::vector<glm::vec3> volumeNormals(const Grid& distance, const Strands& strands);
+// The same written over `normals`, resized to the vertex count (its storage kept when it has room).
+void volumeNormals(const Grid& distance, const Strands& strands, std::vector<glm::vec3>& normals);
 
 }  // namespace hairgen
