@@ -31,7 +31,7 @@ double strandAmbient(uint64_t seed, uint32_t strandId, double mean, double devia
 ShadeResult shade(Strands coupe, const Visuality& visuality, const RenderSettings& render,
                   const ShadeOptions& options) {
   if (coupe.points.empty()) throw InputError("the coupe has no points to build a volume from");
-  const Bounds box = bounds(coupe.points);
+  const Bounds box = boundsInParallel(coupe.points);
   requireFits(estimateShade(render, coupe.strandCount(), coupe.pointCount(),
                             glm::dvec3(box.max) - glm::dvec3(box.min)),
               options.force);

@@ -10,6 +10,7 @@
 #include <tbb/blocked_range.h>
 #include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
+#include <tbb/parallel_reduce.h>
 #include <tbb/task_arena.h>
 
 #include "libcore/model/mesh.h"
@@ -96,10 +97,30 @@ ValueAndGradient sampleWithGradient(const Grid& grid, const glm::vec3* gradients
 
 }  // namespace
 
+Bounds boundsInParallel(const std::vector<glm::vec3>& points) {
+  if (points.empty()) return {};
+  const Bounds none{glm::vec3(std::numeric_limits<float>::max()),
+                    glm::vec3(std::numeric_limits<float>::lowest())};
+  // parallel_reduce joins the boxes of neighbouring ranges left to right, and glm::min and max keep
+  // the left of two equal values (+0 and −0): the serial loop's choices.
+  return tbb::parallel_reduce(
+      tbb::blocked_range<size_t>(0, points.size(), 65536), none,
+      [&](const tbb::blocked_range<size_t>& r, Bounds b) {
+        for (size_t i = r.begin(); i < r.end(); ++i) {
+          b.min = glm::min(b.min, points[i]);
+          b.max = glm::max(b.max, points[i]);
+        }
+        return b;
+      },
+      [](const Bounds& a, const Bounds& b) {
+        return Bounds{glm::min(a.min, b.min), glm::max(a.max, b.max)};
+      });
+}
+
 template <class T>
 GridOf<T> gridAround(const std::vector<glm::vec3>& points, double voxel, int padding) {
   if (points.empty()) throw InputError("the coupe has no points to build a volume from");
-  const Bounds box = bounds(points);
+  const Bounds box = boundsInParallel(points);
   const glm::dvec3 lo(box.min), hi(box.max);
   GridOf<T> g;
   g.voxel = voxel;

@@ -10,6 +10,7 @@
 
 #include <glm/glm.hpp>
 
+#include "libcore/model/mesh.h"
 #include "libcore/model/strands.h"
 
 namespace hairgen {
@@ -33,6 +34,10 @@ struct GridOf {
   Sample sample(const glm::dvec3& p) const;
 };
 using Grid = GridOf<float>;
+
+// bounds(points) from every core, for the millions of points of a coupe: a minimum or maximum does
+// not round, and the threads' boxes join in the points' order, so it is the same box to the bit.
+Bounds boundsInParallel(const std::vector<glm::vec3>& points);
 
 // A grid around `points` with `padding` empty nodes on every side, all values zero. Throws InputError
 // beyond 4e8 nodes.
