@@ -73,13 +73,15 @@ void registerInterpolate(CLI::App& app, int& exitCode) {
           throw InputError(*pattern + ": with --frames, write #### where the frame number goes");
       const HeadMotion head = headMotionOf(config);
       Progress progress("interpolate", "frames", size_t(frames.count()), !options->common.quiet);
+      // Every frame has the same strands: each is written over the last one's arrays.
+      Strands coupe;
       for (int f = frames.first; f <= frames.last; ++f) {
         const std::filesystem::path in = framePath(options->guides, f);
         const Strands guides = readStrandsAs(in, options->units);
         stats.add("read", clock.lap());
         InterpolateOptions frameOptions{config.digest(), in.string(), nullptr, options->common.force,
                                         head.pose(f).matrix()};
-        const Strands coupe = interpolate(wick, guides, config.hairstyle, config.collision, frameOptions);
+        interpolateInto(wick, guides, config.hairstyle, config.collision, frameOptions, coupe);
         stats.add("interpolate", clock.lap());
         writeStrands(framePath(options->output, f), coupe);
         stats.add("write", clock.lap());

@@ -201,6 +201,13 @@ glm::dvec3 strayCentre(const Collision& collision) {
 
 Strands interpolate(const Mesh& wick, const Strands& guides, const Hairstyle& style,
                     const Collision& collision, const InterpolateOptions& options) {
+  Strands coupe;
+  interpolateInto(wick, guides, style, collision, options, coupe);
+  return coupe;
+}
+
+void interpolateInto(const Mesh& wick, const Strands& guides, const Hairstyle& style,
+                     const Collision& collision, const InterpolateOptions& options, Strands& coupe) {
   if (wick.triangles.empty())
     throw InputError(
         "the wick has no faces, only points (roots): interpolation spreads strands over a "
@@ -242,7 +249,8 @@ Strands interpolate(const Mesh& wick, const Strands& guides, const Hairstyle& st
     throw InputError("the shard's triangles lie outside the wick's triangles");
   const uint64_t strandBase = firstStrand[firstTriangle], pointBase = firstPoint[firstTriangle];
   const size_t strands = firstStrand[endTriangle] - strandBase, points = firstPoint[endTriangle] - pointBase;
-  Strands coupe;
+  // Every array is resized, not made anew: a coupe of the same size (the next frame's) keeps its
+  // storage, and every element below is written whatever it held.
   coupe.points.resize(points);
   coupe.tangents.resize(points);
   coupe.firstPoint.resize(strands + 1);
@@ -251,8 +259,13 @@ Strands interpolate(const Mesh& wick, const Strands& guides, const Hairstyle& st
   coupe.rootBary.resize(strands);
   coupe.guideIds.resize(strands);
   coupe.guideWeights.resize(strands);
-  if (!wick.uvs.empty()) coupe.rootUv.resize(strands);
+  coupe.rootUv.resize(wick.uvs.empty() ? 0 : strands);
   coupe.firstPoint[strands] = static_cast<uint32_t>(points);
+  coupe.normals.clear();  // what shade or a converted cache added; a fresh coupe has none
+  coupe.colors.clear();
+  coupe.thickness.clear();
+  coupe.transparency.clear();
+  coupe.simulationState.clear();
 
   const glm::dvec3 centre(options.pose * glm::dvec4(strayCentre(collision), 1.0));
   // Each thread's scratch: the triangle's guides in double and the resampled guides, reused from
@@ -316,7 +329,6 @@ Strands interpolate(const Mesh& wick, const Strands& guides, const Hairstyle& st
   coupe.provenance.shard = options.shard;
   coupe.provenance.frame = guides.provenance.frame;  // a frame's coupe is that frame's
   coupe.provenance.time = guides.provenance.time;
-  return coupe;
 }
 
 }  // namespace hairgen

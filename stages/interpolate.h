@@ -39,6 +39,14 @@ struct InterpolateOptions {
 Strands interpolate(const Mesh& wick, const Strands& guides, const Hairstyle& style,
                     const Collision& collision, const InterpolateOptions& options);
 
+// The same coupe written into `coupe`, which is overwritten whatever it held (its arrays that
+// interpolate does not fill are emptied) and compares equal to what interpolate() returns. Its arrays
+// keep their storage: the frames of a sequence interpolated into one Strands touch no new memory after
+// the first (a fresh 150,000 × 64 coupe is ~230 MB of pages the kernel must fault in and clear, and that
+// the vectors then fill with zeros before the blend writes them). Left unspecified when it throws.
+void interpolateInto(const Mesh& wick, const Strands& guides, const Hairstyle& style,
+                     const Collision& collision, const InterpolateOptions& options, Strands& coupe);
+
 // The pieces, for tests.
 
 // Strands in a triangle of `areaCm2`: area × density, the fraction rounded up when u < fraction. For a

@@ -200,6 +200,29 @@ TEST(Interpolate, OutputIsIdenticalForAnyThreadCount) {
   EXPECT_FALSE(one == coupeAt(60, 8)) << "the seed changes nothing";
 }
 
+// A sequence interpolates every frame into one Strands: whatever it held, what comes out is the fresh
+// coupe, and a coupe of the same size is written in place.
+TEST(Interpolate, IntoAUsedCoupeGivesTheFreshCoupeInItsStorage) {
+  Strands used = coupeAt(80);
+  used.normals.assign(used.pointCount(), glm::vec3(0, 1, 0));
+  used.colors.assign(used.pointCount(), glm::vec3(0.5f));
+  used.thickness.assign(used.pointCount(), 1e-4f);
+  used.transparency.assign(used.pointCount(), 0.5f);
+  used.simulationState.assign(10, 1.0);
+  used.defaultThickness = 1e-3f;
+  used.provenance.stage = "shade";
+  Hairstyle h = grown().config.hairstyle;
+  h.hairDensity = 40;
+  h.seed = 7;
+  interpolateInto(grown().wick, grown().guides, h, grown().config.collision, {}, used);
+  EXPECT_TRUE(used == coupeAt(40));
+  const glm::vec3* storage = used.points.data();
+  h.seed = 8;
+  interpolateInto(grown().wick, grown().guides, h, grown().config.collision, {}, used);
+  EXPECT_TRUE(used == coupeAt(40, 8));
+  EXPECT_EQ(used.points.data(), storage) << "the same strands reallocated their points";
+}
+
 TEST(Interpolate, GuidesOfDifferentVertexCountsBlendByArcLength) {
   // Three straight guides 10 cm up from the corners, with 21, 11 and 6 vertices.
   Mesh wick;

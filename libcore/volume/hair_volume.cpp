@@ -10,6 +10,7 @@
 #include <tbb/blocked_range.h>
 #include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
+#include <tbb/parallel_reduce.h>
 #include <tbb/task_arena.h>
 
 #include "libcore/model/mesh.h"
@@ -73,7 +74,7 @@ std::vector<glm::vec3> nodeGradients(const Grid& grid) {
   return out;
 }
 
-glm::dvec3 sampleGradient(const Grid& grid, const std::vector<glm::vec3>& gradients, const glm::dvec3& p) {
+glm::dvec3 sampleGradient(const Grid& grid, const glm::vec3* gradients, const glm::dvec3& p) {
   return trilinear<glm::dvec3>(
       grid, p, [&](int i, int j, int k) { return glm::dvec3(gradients[grid.index(i, j, k)]); });
 }
@@ -84,8 +85,7 @@ struct ValueAndGradient {
   double value = 0.0;
   glm::dvec3 gradient{0.0};
 };
-ValueAndGradient sampleWithGradient(const Grid& grid, const std::vector<glm::vec3>& gradients,
-                                    const glm::dvec3& p) {
+ValueAndGradient sampleWithGradient(const Grid& grid, const glm::vec3* gradients, const glm::dvec3& p) {
   ValueAndGradient out;
   forEachCorner(grid, p, [&](double w, int i, int j, int k) {
     const size_t node = grid.index(i, j, k);
@@ -97,10 +97,30 @@ ValueAndGradient sampleWithGradient(const Grid& grid, const std::vector<glm::vec
 
 }  // namespace
 
+Bounds boundsInParallel(const std::vector<glm::vec3>& points) {
+  if (points.empty()) return {};
+  const Bounds none{glm::vec3(std::numeric_limits<float>::max()),
+                    glm::vec3(std::numeric_limits<float>::lowest())};
+  // parallel_reduce joins the boxes of neighbouring ranges left to right, and glm::min and max keep
+  // the left of two equal values (+0 and −0): the serial loop's choices.
+  return tbb::parallel_reduce(
+      tbb::blocked_range<size_t>(0, points.size(), 65536), none,
+      [&](const tbb::blocked_range<size_t>& r, Bounds b) {
+        for (size_t i = r.begin(); i < r.end(); ++i) {
+          b.min = glm::min(b.min, points[i]);
+          b.max = glm::max(b.max, points[i]);
+        }
+        return b;
+      },
+      [](const Bounds& a, const Bounds& b) {
+        return Bounds{glm::min(a.min, b.min), glm::max(a.max, b.max)};
+      });
+}
+
 template <class T>
 GridOf<T> gridAround(const std::vector<glm::vec3>& points, double voxel, int padding) {
   if (points.empty()) throw InputError("the coupe has no points to build a volume from");
-  const Bounds box = bounds(points);
+  const Bounds box = boundsInParallel(points);
   const glm::dvec3 lo(box.min), hi(box.max);
   GridOf<T> g;
   g.voxel = voxel;
@@ -372,11 +392,92 @@ template GridOf<glm::dvec4> smoothed<glm::dvec4>(const GridOf<glm::dvec4>&);
 template void splatValues<glm::dvec4>(GridOf<glm::dvec4>&, const std::vector<glm::dvec3>&,
                                       const std::vector<glm::dvec4>&);
 
+namespace {
+
+constexpr double kNone = std::numeric_limits<double>::infinity();  // a node with no shell point yet
+
+// One x-line of fast sweeping in one of the 8 orders of the axes (bit 0, 1, 2 of `order` reverse x, y,
+// z): each node takes the nearest point of a neighbour behind it when that is nearer than its own. `jj`
+// and `kk` count lines in the order's direction. Built for AVX2 as well, as slideSlab is.
+HAIRGEN_VECTOR_CLONES __attribute__((flatten)) void sweepLine(const glm::ivec3& n, const glm::dvec3& origin,
+                                                              double h, int order, int jj, int kk,
+                                                              glm::dvec3* nearest, double* dist2) {
+  const bool fx = order & 1, fy = order & 2, fz = order & 4;
+  const size_t strideY = size_t(n.x), strideZ = size_t(n.x) * n.y;
+  for (int ii = 0; ii < n.x; ++ii) {
+    const int i = fx ? n.x - 1 - ii : ii, j = fy ? n.y - 1 - jj : jj, k = fz ? n.z - 1 - kk : kk;
+    const size_t id = (size_t(k) * n.y + j) * n.x + i;
+    const glm::dvec3 x = origin + h * glm::dvec3(i, j, k);
+    const bool has[3] = {fx ? i + 1 < n.x : i > 0, fy ? j + 1 < n.y : j > 0, fz ? k + 1 < n.z : k > 0};
+    const size_t behind[3] = {fx ? id + 1 : id - 1, fy ? id + strideY : id - strideY,
+                              fz ? id + strideZ : id - strideZ};
+    for (int axis = 0; axis < 3; ++axis) {
+      if (!has[axis] || dist2[behind[axis]] == kNone) continue;
+      const glm::dvec3 e = nearest[behind[axis]] - x;
+      const double d2 = glm::dot(e, e);
+      if (d2 < dist2[id]) nearest[id] = nearest[behind[axis]], dist2[id] = d2;
+    }
+  }
+}
+
+// Newton's steps on the trilinear φ = density − iso, p ← p − φ ∇φ/|∇φ|², from p back onto the shell;
+// false when they do not reach it within `tolerance`. Leaves in `gradient` ∇φ at the point it returns,
+// which the slide's next round starts from.
+inline bool ontoShell(const Grid& density, const glm::vec3* gradients, double iso, double tolerance,
+                      glm::dvec3& p, glm::dvec3& gradient) {
+  ValueAndGradient at = sampleWithGradient(density, gradients, p);
+  double value = at.value - iso;
+  for (int step = 0; step < 16 && std::abs(value) > tolerance; ++step) {
+    const glm::dvec3 g = at.gradient;
+    const double g2 = glm::dot(g, g);
+    if (!(g2 > 0.0)) return false;
+    p -= (value / g2) * g;
+    at = sampleWithGradient(density, gradients, p);
+    value = at.value - iso;
+  }
+  gradient = at.gradient;
+  return std::abs(value) <= tolerance;
+}
+
+// Slides the nearest shell point of every node of z-slab k along the shell until x − p lies along the
+// shell's normal at p, the condition for the nearest point: a step along the tangent plane, then
+// ontoShell; kept while the distance falls. Most of signedDistance's time: built for AVX2 as well and
+// flattened, so the sampling it calls is built with it (the same scalar arithmetic in the same order,
+// with floor one instruction instead of a dozen and the cell's loads and weights scheduled together).
+HAIRGEN_VECTOR_CLONES __attribute__((flatten)) void slideSlab(const Grid& density, const glm::vec3* gradients,
+                                                              double iso, double tolerance, int k,
+                                                              glm::dvec3* nearest, double* dist2) {
+  const glm::ivec3 n = density.size;
+  const double h = density.voxel;
+  for (int j = 0; j < n.y; ++j)
+    for (int i = 0; i < n.x; ++i) {
+      const size_t id = density.index(i, j, k);
+      if (dist2[id] == kNone) continue;
+      const glm::dvec3 x = density.origin + h * glm::dvec3(i, j, k);
+      glm::dvec3 g = sampleGradient(density, gradients, nearest[id]);
+      for (int round = 0; round < 6; ++round) {
+        const glm::dvec3 p = nearest[id];
+        const double g2 = glm::dot(g, g);
+        if (!(g2 > 0.0)) break;
+        glm::dvec3 across = (x - p) - glm::dot(x - p, g) / g2 * g;
+        const double a2 = glm::dot(across, across);
+        if (a2 <= 1e-6 * dist2[id]) break;
+        if (a2 > h * h) across *= h / std::sqrt(a2);
+        glm::dvec3 q = p + across, gq;
+        if (!ontoShell(density, gradients, iso, tolerance, q, gq)) break;
+        const double d2 = glm::dot(q - x, q - x);
+        if (!(d2 < dist2[id])) break;
+        nearest[id] = q, dist2[id] = d2, g = gq;
+      }
+    }
+}
+
+}  // namespace
+
 Grid signedDistance(const Grid& density, double iso) {
   const glm::ivec3 n = density.size;
   const double h = density.voxel;
   const size_t count = density.values.size();
-  const size_t strideY = size_t(n.x), strideZ = size_t(n.x) * n.y;
   auto node = [&](int i, int j, int k) { return density.origin + h * glm::dvec3(i, j, k); };
   std::vector<char> inside(count);
   for (size_t i = 0; i < count; ++i) inside[i] = density.values[i] > iso;
@@ -384,7 +485,6 @@ Grid signedDistance(const Grid& density, double iso) {
   // Every node carries the nearest point of the shell it knows of. It starts at the nodes with an
   // edge across the shell, as the nearest crossing of φ = density − iso along their own edges (by
   // linear interpolation, which is exact on the trilinear φ).
-  constexpr double kNone = std::numeric_limits<double>::infinity();
   std::vector<glm::dvec3> nearest(count, glm::dvec3(kNone));
   std::vector<double> dist2(count, kNone);
   tbb::parallel_for(0, n.z, [&](int k) {
@@ -414,75 +514,21 @@ Grid signedDistance(const Grid& density, double iso) {
   // itself; so the x-lines (jj, kk) on one diagonal jj + kk = d depend on the diagonal before alone,
   // and sweeping the diagonals in turn, their lines at once, gives the bits of the raster order.
   auto sweep = [&] {  // one round of the 8 orders: the slide below mends what it leaves
-    for (int order = 0; order < 8; ++order) {
-      const bool fx = order & 1, fy = order & 2, fz = order & 4;
-      auto line = [&](int jj, int kk) {
-        for (int ii = 0; ii < n.x; ++ii) {
-          const int i = fx ? n.x - 1 - ii : ii, j = fy ? n.y - 1 - jj : jj, k = fz ? n.z - 1 - kk : kk;
-          const size_t id = density.index(i, j, k);
-          const glm::dvec3 x = node(i, j, k);
-          const bool has[3] = {fx ? i + 1 < n.x : i > 0, fy ? j + 1 < n.y : j > 0, fz ? k + 1 < n.z : k > 0};
-          const size_t behind[3] = {fx ? id + 1 : id - 1, fy ? id + strideY : id - strideY,
-                                    fz ? id + strideZ : id - strideZ};
-          for (int axis = 0; axis < 3; ++axis) {
-            if (!has[axis] || dist2[behind[axis]] == kNone) continue;
-            const glm::dvec3 e = nearest[behind[axis]] - x;
-            const double d2 = glm::dot(e, e);
-            if (d2 < dist2[id]) nearest[id] = nearest[behind[axis]], dist2[id] = d2;
-          }
-        }
-      };
+    for (int order = 0; order < 8; ++order)
       for (int d = 0; d <= (n.y - 1) + (n.z - 1); ++d)
-        tbb::parallel_for(std::max(0, d - (n.y - 1)), std::min(d, n.z - 1) + 1,
-                          [&](int kk) { line(d - kk, kk); });
-    }
+        tbb::parallel_for(std::max(0, d - (n.y - 1)), std::min(d, n.z - 1) + 1, [&](int kk) {
+          sweepLine(density.size, density.origin, h, order, d - kk, kk, nearest.data(), dist2.data());
+        });
   };
 
   // A nearest point carried from a neighbour is a shell point near the node's own nearest point, not
   // that point: off by up to a voxel along the shell, which makes the distance too long and ∇S wrong.
-  // Each node slides its point along the shell until x − p lies along the shell's normal at p, the
-  // condition for the nearest point: a step along the tangent plane, then Newton's steps on the
-  // trilinear φ, p ← p − φ ∇φ/|∇φ|², back onto the shell; kept while the distance falls.
+  // Each node slides its point along the shell (slideSlab).
   const double tolerance = 1e-4 * std::abs(iso) + 1e-12;
   const std::vector<glm::vec3> gradients = nodeGradients(density);
-  // ontoShell leaves in `gradient` ∇φ at the point it returns, which the slide's next round starts from.
-  auto ontoShell = [&](glm::dvec3& p, glm::dvec3& gradient) {
-    ValueAndGradient at = sampleWithGradient(density, gradients, p);
-    double value = at.value - iso;
-    for (int step = 0; step < 16 && std::abs(value) > tolerance; ++step) {
-      const glm::dvec3 g = at.gradient;
-      const double g2 = glm::dot(g, g);
-      if (!(g2 > 0.0)) return false;
-      p -= (value / g2) * g;
-      at = sampleWithGradient(density, gradients, p);
-      value = at.value - iso;
-    }
-    gradient = at.gradient;
-    return std::abs(value) <= tolerance;
-  };
   auto slide = [&] {
     tbb::parallel_for(0, n.z, [&](int k) {
-      for (int j = 0; j < n.y; ++j)
-        for (int i = 0; i < n.x; ++i) {
-          const size_t id = density.index(i, j, k);
-          if (dist2[id] == kNone) continue;
-          const glm::dvec3 x = node(i, j, k);
-          glm::dvec3 g = sampleGradient(density, gradients, nearest[id]);
-          for (int round = 0; round < 6; ++round) {
-            const glm::dvec3 p = nearest[id];
-            const double g2 = glm::dot(g, g);
-            if (!(g2 > 0.0)) break;
-            glm::dvec3 across = (x - p) - glm::dot(x - p, g) / g2 * g;
-            const double a2 = glm::dot(across, across);
-            if (a2 <= 1e-6 * dist2[id]) break;
-            if (a2 > h * h) across *= h / std::sqrt(a2);
-            glm::dvec3 q = p + across, gq;
-            if (!ontoShell(q, gq)) break;
-            const double d2 = glm::dot(q - x, q - x);
-            if (!(d2 < dist2[id])) break;
-            nearest[id] = q, dist2[id] = d2, g = gq;
-          }
-        }
+      slideSlab(density, gradients.data(), iso, tolerance, k, nearest.data(), dist2.data());
     });
   };
   sweep();
@@ -537,6 +583,24 @@ inline __attribute__((always_inline)) void addCorner(size_t count, const int sx,
   }
 }
 
+constexpr size_t kNormalsBlock = 256;  // points a block
+
+// The eight corners with x fastest, then y, then z: the order the one-point-at-a-time sum adds them. A
+// function forced inline, not a lambda: a lambda is a function of its own, built for the baseline, and
+// would run the corners without the caller's AVX2.
+template <int... k>
+inline __attribute__((always_inline)) void addCorners(std::integer_sequence<int, k...>, size_t count,
+                                                      const glm::ivec3& size,
+                                                      const glm::vec3* __restrict gradients,
+                                                      const int* __restrict c, const double* __restrict f,
+                                                      double* __restrict out) {
+  constexpr size_t kB = kNormalsBlock;
+  ((addCorner<(k & 1), ((k >> 1) & 1), (k >> 2)>(count, size.x, size.y, size.z, gradients, c, c + kB,
+                                                 c + 2 * kB, f, f + kB, f + 2 * kB, out, out + kB,
+                                                 out + 2 * kB)),
+   ...);
+}
+
 // Normals ∇S/|∇S| of up to 256 points: sampleGradient and the normalisation of volumeNormals, one stage
 // at a time over the block so each runs across points in vector registers (libcore/util/vectorise.h),
 // with the arithmetic of trilinear() per point. The cell is the truncation of the clamped grid
@@ -544,7 +608,7 @@ inline __attribute__((always_inline)) void addCorner(size_t count, const int sx,
 HAIRGEN_VECTOR_CLONES
 void normalsOfBlock(const Grid& grid, const glm::vec3* __restrict gradients,
                     const glm::vec3* __restrict points, size_t count, glm::vec3* __restrict normals) {
-  constexpr size_t kB = 256;
+  constexpr size_t kB = kNormalsBlock;
   int c[3 * kB];
   double f[3 * kB], out[3 * kB];
   const glm::dvec3 top = glm::dvec3(grid.size - 1) - 1e-9;
@@ -562,14 +626,7 @@ void normalsOfBlock(const Grid& grid, const glm::vec3* __restrict gradients,
       out[axis * kB + p] = 0.0;
     }
   }
-  const int sx = grid.size.x, sy = grid.size.y, sz = grid.size.z;
-  // The eight corners with x fastest, then y, then z: the order the one-point-at-a-time sum adds them.
-  [&]<int... k>(std::integer_sequence<int, k...>) {
-    ((addCorner<(k & 1), ((k >> 1) & 1), (k >> 2)>(count, sx, sy, sz, gradients, c, c + kB, c + 2 * kB, f,
-                                                   f + kB, f + 2 * kB, out, out + kB, out + 2 * kB)),
-     ...);
-  }
-  (std::make_integer_sequence<int, 8>{});
+  addCorners(std::make_integer_sequence<int, 8>{}, count, grid.size, gradients, c, f, out);
   float* const n = &normals[0].x;
   double* const lengths = f;  // the fractions are spent
   HAIRGEN_IVDEP
@@ -588,15 +645,20 @@ void normalsOfBlock(const Grid& grid, const glm::vec3* __restrict gradients,
 }  // namespace
 
 std::vector<glm::vec3> volumeNormals(const Grid& distance, const Strands& strands) {
+  std::vector<glm::vec3> normals;
+  volumeNormals(distance, strands, normals);
+  return normals;
+}
+
+void volumeNormals(const Grid& distance, const Strands& strands, std::vector<glm::vec3>& normals) {
   const std::vector<glm::vec3> gradients = nodeGradients(distance);
-  std::vector<glm::vec3> normals(strands.pointCount());
+  normals.resize(strands.pointCount());
   tbb::parallel_for(tbb::blocked_range<size_t>(0, strands.pointCount(), 8192),
                     [&](const tbb::blocked_range<size_t>& r) {
-                      for (size_t p = r.begin(); p < r.end(); p += 256)
+                      for (size_t p = r.begin(); p < r.end(); p += kNormalsBlock)
                         normalsOfBlock(distance, gradients.data(), &strands.points[p],
-                                       std::min<size_t>(256, r.end() - p), &normals[p]);
+                                       std::min(kNormalsBlock, r.end() - p), &normals[p]);
                     });
-  return normals;
 }
 
 }  // namespace hairgen

@@ -10,6 +10,7 @@
 
 #include <glm/glm.hpp>
 
+#include "libcore/model/mesh.h"
 #include "libcore/model/strands.h"
 
 namespace hairgen {
@@ -33,6 +34,10 @@ struct GridOf {
   Sample sample(const glm::dvec3& p) const;
 };
 using Grid = GridOf<float>;
+
+// bounds(points) from every core, for the millions of points of a coupe: a minimum or maximum does
+// not round, and the threads' boxes join in the points' order, so it is the same box to the bit.
+Bounds boundsInParallel(const std::vector<glm::vec3>& points);
 
 // A grid around `points` with `padding` empty nodes on every side, all values zero. Throws InputError
 // beyond 4e8 nodes.
@@ -93,5 +98,7 @@ HairVolume buildVolume(const Strands& strands, double voxel, int padding, double
 
 // Shading normals ∇S/|∇S| at every strand vertex.
 std::vector<glm::vec3> volumeNormals(const Grid& distance, const Strands& strands);
+// The same written over `normals`, resized to the vertex count (its storage kept when it has room).
+void volumeNormals(const Grid& distance, const Strands& strands, std::vector<glm::vec3>& normals);
 
 }  // namespace hairgen

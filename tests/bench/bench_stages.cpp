@@ -4,10 +4,14 @@
 //   GrowCoupe3:         the whole grow stage on every core, counters guides/s and evaluations/s.
 //   GrowDefault:        the same on the default coupe (configs/default), what the README's first
 //                       command grows.
-//   InterpolateCoupe3:  ~150,000 strands of 64 vertices from coupe 3's guides, every core.
+//   InterpolateCoupe3:  ~150,000 strands of 64 vertices from coupe 3's guides, every core, into a fresh
+//                       coupe each time, as `hairgen interpolate` makes a still: the kernel's faulting
+//                       in and clearing of ~230 MB of new pages is part of the figure.
+//   InterpolateCoupe3Frames: the same coupe into one reused Strands, as `interpolate --frames` does frame
+//                       after frame: the steady cost of a frame, its arrays already in place.
 //   ShadeCoupe3:        `shade` on that 150,000-strand coupe with coupe 3's Render Info (grid, signed
 //                       distance, normals), every core; counters give the grid's size and each part's
-//                       seconds.
+//                       seconds. Copying the coupe in and freeing the result are left out of the time.
 //   CantileverStyling:  Anjyo's figures, 20,000 hairs of 20 segments bent around the head ellipsoid.
 //   SimulateAnjyo:      those hairs through 25 frames of the gust shot while the head turns.
 //   ReadCache/WriteCache: the 150,000-strand coupe's .hair (points, tangents, ids, weights: ~240 MB at 64
@@ -122,17 +126,30 @@ void GrowDefault(benchmark::State& state) {
 }
 BENCHMARK(GrowDefault)->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(3.0);
 
-void InterpolateCoupe3(benchmark::State& state) {
+// Coupe 3's guides at 64 vertices and the style that gives ~150,000 strands from them.
+struct Coupe3At150k {
+  Hairstyle style;
+  Strands guides;
+  Coupe3At150k() : style(coupe3().config.hairstyle) {
+    const Coupe3& c = coupe3();
+    style.visualityStep = style.totalLength() / 63.0;  // 64 vertices per guide and strand
+    guides = grow(c.wick, style, c.config.collision, {}).guides;
+    style.hairDensity = 150000.0 / (surfaceArea(c.wick) * 1e4);
+  }
+};
+
+// Interpolates coupe 3 at 150,000 strands once an iteration; `reuse` keeps one Strands across them.
+void interpolateCoupe3(benchmark::State& state, bool reuse) {
   const Coupe3& c = coupe3();
-  Hairstyle style = c.config.hairstyle;
-  style.visualityStep = style.totalLength() / 63.0;  // 64 vertices per guide and strand
-  const Strands guides = grow(c.wick, style, c.config.collision, {}).guides;
-  const double area = surfaceArea(c.wick) * 1e4;
-  style.hairDensity = 150000.0 / area;
+  const Coupe3At150k in;
   uint64_t strands = 0, points = 0;
+  Strands reused;
+  if (reuse) interpolateInto(c.wick, in.guides, in.style, c.config.collision, {}, reused);  // its pages
   Stopwatch clock;
   for (auto _ : state) {
-    Strands coupe = interpolate(c.wick, guides, style, c.config.collision, {});
+    Strands fresh;
+    Strands& coupe = reuse ? reused : fresh;
+    interpolateInto(c.wick, in.guides, in.style, c.config.collision, {}, coupe);
     strands += coupe.strandCount();
     points += coupe.pointCount();
     benchmark::DoNotOptimize(coupe.points.data());
@@ -143,7 +160,14 @@ void InterpolateCoupe3(benchmark::State& state) {
   state.counters["vertices/s"] = benchmark::Counter(double(points), benchmark::Counter::kIsRate);
   timeTarget(state, clock.lap(), kInterpolateSeconds);
 }
+void InterpolateCoupe3(benchmark::State& state) {
+  interpolateCoupe3(state, false);
+}
 BENCHMARK(InterpolateCoupe3)->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(3.0);
+void InterpolateCoupe3Frames(benchmark::State& state) {
+  interpolateCoupe3(state, true);
+}
+BENCHMARK(InterpolateCoupe3Frames)->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(3.0);
 
 void ShadeCoupe3(benchmark::State& state) {
   const Coupe3& c = coupe3();
@@ -155,12 +179,16 @@ void ShadeCoupe3(benchmark::State& state) {
   ShadeTimings total;
   glm::ivec3 grid(0);
   double shading = 0.0;
+  ShadeResult r;
   for (auto _ : state) {
-    state.PauseTiming();  // the copy `shade` takes: hairgen shade moves its coupe in
+    // Neither the copy `shade` takes (hairgen shade moves its coupe in) nor freeing the last result
+    // (~370 MB, ~25 ms; hairgen shade writes it and exits) is shade's work.
+    state.PauseTiming();
+    r = {};
     Strands input = coupe;
     state.ResumeTiming();
     Stopwatch clock;
-    ShadeResult r = shade(std::move(input), c.config.visuality, c.config.render, {style.seed, ""});
+    r = shade(std::move(input), c.config.visuality, c.config.render, {style.seed, ""});
     shading += clock.lap();
     total.volume += r.timings.volume;
     total.normals += r.timings.normals;
