@@ -8,27 +8,27 @@
 namespace hairgen {
 namespace {
 
-// The squared distance from p to the segment a–b.
-double distance2(const glm::dvec3& p, const glm::dvec3& a, const glm::dvec3& b) {
-  const glm::dvec3 ab = b - a, ap = p - a;
-  const double length2 = glm::dot(ab, ab);
-  const double t = length2 > 0.0 ? glm::clamp(glm::dot(ap, ab) / length2, 0.0, 1.0) : 0.0;
-  const glm::dvec3 off = ap - t * ab;
-  return glm::dot(off, off);
-}
-
-// Marks in `keep` (one flag per point of strand s) the points its strip keeps; returns how many.
-uint32_t keepPoints(const Strands& strands, size_t s, double tolerance2, uint8_t* keep) {
-  const uint32_t p0 = strands.firstPoint[s], n = strands.pointsOf(s);
-  auto point = [&](uint32_t j) { return glm::dvec3(strands.points[p0 + j]); };
+// Marks in `keep` (one flag per point of strand s) the points its strip keeps; returns how many. In
+// floats, as the points are: a tolerance is a fraction of a pixel, ten thousand times a float's rounding
+// at a head's size.
+uint32_t keepPoints(const Strands& strands, size_t s, float tolerance2, uint8_t* keep) {
+  const glm::vec3* point = &strands.points[strands.firstPoint[s]];
+  const uint32_t n = strands.pointsOf(s);
   uint32_t kept = 1, a = 0;
   keep[0] = 1;
   while (a + 1 < n) {
     uint32_t b = a + 1;  // the farthest point whose chord from a holds every point between
     for (uint32_t c = a + 2; c < n && c - a <= kMostSegmentsPerChord; ++c) {
+      const glm::vec3 chord = point[c] - point[a];
+      const float length2 = glm::dot(chord, chord);
+      const float inverse = length2 > 0.0f ? 1.0f / length2 : 0.0f;
       bool holds = true;
-      for (uint32_t k = a + 1; k < c && holds; ++k)
-        holds = distance2(point(k), point(a), point(c)) <= tolerance2;
+      for (uint32_t k = a + 1; k < c && holds; ++k) {  // the distance from point k to the chord
+        const glm::vec3 along = point[k] - point[a];
+        const float t = glm::clamp(glm::dot(along, chord) * inverse, 0.0f, 1.0f);
+        const glm::vec3 off = along - t * chord;
+        holds = glm::dot(off, off) <= tolerance2;
+      }
       if (!holds) break;
       b = c;
     }
@@ -50,7 +50,7 @@ std::vector<uint32_t> decimatedLineStrips(const Strands& strands, double toleran
   const std::vector<uint32_t>& drawn = order.empty() ? all : order;
   std::vector<uint8_t> keep(strands.pointCount(), 0);
   std::vector<uint64_t> first(drawn.size() + 1, 0);  // per strip, where it starts in the indices
-  const double tolerance2 = tolerance * tolerance;
+  const float tolerance2 = float(tolerance * tolerance);
   tbb::parallel_for(size_t(0), drawn.size(), [&](size_t k) {
     const uint32_t s = drawn[k];
     first[k + 1] = keepPoints(strands, s, tolerance2, &keep[strands.firstPoint[s]]) + 1;  // + the restart

@@ -12,8 +12,9 @@ namespace hairgen {
 namespace {
 
 // How far from the hair the chords drawn for it may stray: a quarter of a pixel of the image being drawn
-// (a sub-pixel when Samples asks for them, a texel of the light's maps).
-constexpr double kChordPixels = 0.25;
+// (a sub-pixel when Samples asks for them), and half a texel of the light's maps, whose lookup takes the
+// nearest start and the largest opacity over 2×2 texels (shadow.glsl) and so cannot tell half a texel.
+constexpr double kChordPixels = 0.25, kChordTexels = 0.5;
 
 // k for Samples = k² (k ≤ 8), lowered until the sub-pixel image fits the device's largest texture.
 int subpixelBlock(const RenderSettings& r) {
@@ -168,9 +169,9 @@ Scene::Scene(const RenderInput& in)
   // fragments of exactly equal depth is kept. The light's passes are order-free: the nearest depth,
   // and sums of equal opacities.
   if (block == 1) hair.orderFrontToBack(*in.hair, camera.view);
-  // Chords (line_decimation.h) within kChordPixels of a pixel of the image or a texel of the light's
-  // maps, measured where the hair is nearest (where they are smallest): the light's passes and the
-  // shading pass, whose cost is llvmpipe's vertex stage on one thread, draw a fraction of the vertices
+  // Chords (line_decimation.h) within kChordPixels of a pixel of the image or kChordTexels of a texel of
+  // the light's maps, measured where the hair is nearest (where they are smallest): the light's passes and
+  // the shading pass, whose cost is llvmpipe's vertex stage on one thread, draw a fraction of the vertices
   // and the same picture to that.
   if (!in.shaders.hairVert) {
     auto nearest = [&](const View& v) {  // from the eye to the nearest of the scene
@@ -179,7 +180,7 @@ Scene::Scene(const RenderInput& in)
     const double lightNearest = nearest(light);
     if (lightNearest > 0.0)
       lightLines = std::make_unique<LineStrips>(
-          decimatedLineStrips(*in.hair, kChordPixels * lightNearest / light.focalPx));
+          decimatedLineStrips(*in.hair, kChordTexels * lightNearest / light.focalPx));
     const double cameraNearest = nearest(subpixel);
     if (!ribbons && cameraNearest > 0.0)
       cameraLines = std::make_unique<LineStrips>(
