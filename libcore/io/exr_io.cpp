@@ -15,6 +15,7 @@
 #include <OpenEXR/ImfOutputFile.h>
 #include <OpenEXR/ImfStandardAttributes.h>
 #include <OpenEXR/ImfStringAttribute.h>
+#include <OpenEXR/ImfThreading.h>
 #include <OpenEXR/ImfVecAttribute.h>
 #include <OpenEXR/openexr.h>
 #include <dlfcn.h>
@@ -149,11 +150,13 @@ void writeExr(const fs::path& file, const Image& image, const ExrMetadata& metad
   }
   writeThroughTemporary(file, [&](const fs::path& temporary) {
     try {
-      // Compressed on every core hairgen may use (--threads): each chunk is compressed alone, so the
+      // Compressed on every core hairgen may use (--threads), by OpenEXR's global pool (the file's own
+      // thread count only sets how many chunks are in flight): each chunk is compressed alone, so the
       // bytes are the same for any count.
-      Imf::OutputFile out(
-          temporary.c_str(), header,
-          int(tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism)));
+      const int threads =
+          int(tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism));
+      if (Imf::globalThreadCount() != threads) Imf::setGlobalThreadCount(threads);
+      Imf::OutputFile out(temporary.c_str(), header, threads);
       out.setFrameBuffer(frame);
       out.writePixels(image.height);
     } catch (const std::exception& e) {

@@ -237,26 +237,33 @@ HairGeometry::HairGeometry(const Strands& s, const std::vector<glm::vec3>& tange
   }
 }
 
-void HairGeometry::orderFrontToBack(const Strands& s, const glm::dmat4& view) {
+std::vector<uint32_t> frontToBack(const Strands& s, const glm::dmat4& view) {
   const glm::vec4 row{float(view[0][2]), float(view[1][2]), float(view[2][2]), float(view[3][2])};
-  std::vector<std::pair<float, uint32_t>> keys(lineFirsts.size());
-  for (size_t i = 0; i < lineFirsts.size(); ++i) {
+  std::vector<std::pair<float, uint32_t>> keys;
+  keys.reserve(s.strandCount());
+  for (uint32_t i = 0; i < s.strandCount(); ++i) {
+    if (s.pointsOf(i) < 2) continue;
     float nearest = std::numeric_limits<float>::infinity();
-    for (GLint p = lineFirsts[i]; p < lineFirsts[i] + lineCounts[i]; ++p)
+    for (uint32_t p = s.firstPoint[i]; p < s.firstPoint[i] + s.pointsOf(i); ++p)
       nearest =
           std::min(nearest, -(row.x * s.points[p].x + row.y * s.points[p].y + row.z * s.points[p].z + row.w));
-    keys[i] = {nearest, uint32_t(i)};
+    keys.emplace_back(nearest, i);
   }
   std::sort(keys.begin(), keys.end());
-  auto permute = [&](auto& v) {
-    auto old = v;
-    for (size_t i = 0; i < keys.size(); ++i) v[i] = old[keys[i].second];
-  };
-  permute(lineStrands);
-  permute(lineFirsts);
-  permute(lineCounts);
-  permute(ribbonFirsts);
-  permute(ribbonCounts);
+  std::vector<uint32_t> order(keys.size());
+  for (size_t i = 0; i < keys.size(); ++i) order[i] = keys[i].second;
+  return order;
+}
+
+void HairGeometry::drawInOrder(const Strands& s, const std::vector<uint32_t>& order) {
+  for (size_t i = 0; i < order.size(); ++i) {
+    const uint32_t strand = order[i];
+    lineStrands[i] = strand;
+    lineFirsts[i] = static_cast<GLint>(s.firstPoint[strand]);
+    lineCounts[i] = static_cast<GLsizei>(s.pointsOf(strand));
+    ribbonFirsts[i] = static_cast<GLint>(2 * s.firstPoint[strand]);
+    ribbonCounts[i] = static_cast<GLsizei>(2 * s.pointsOf(strand));
+  }
 }
 
 HairGeometry::~HairGeometry() {

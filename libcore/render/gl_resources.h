@@ -95,6 +95,11 @@ struct Buffer {
   GLuint id = 0;
 };
 
+// The strands of two points or more, those nearest `view`'s eye first (by their nearest point): drawn
+// so, a depth test made before shading skips more of what lies behind; the order changes no result but
+// ties of equal depth.
+std::vector<uint32_t> frontToBack(const Strands& strands, const glm::dmat4& view);
+
 // Line strips through some of a coupe's points (line_decimation.h: point indices, kRestartIndex
 // between strips) in an index buffer, for HairGeometry::drawLines.
 struct LineStrips {
@@ -123,9 +128,8 @@ struct HairGeometry {
   void draw(bool ribbon, bool drawing = true) const;
   // Draws the strands as `strips` gives them (null: every point, draw(false)).
   void drawLines(const struct LineStrips* strips) const;
-  // Draws the strands nearest `view`'s eye first (by their nearest point), so a depth test made before
-  // shading skips more of what lies behind; the order changes no result but ties of equal depth.
-  void orderFrontToBack(const Strands& strands, const glm::dmat4& view);
+  // Draws the strands in `order` (frontToBack's: every strand of two points or more, once).
+  void drawInOrder(const Strands& strands, const std::vector<uint32_t>& order);
 
   Buffer points, tangents, colors, normals, previous;
   bool hasColors, hasNormals, hasPrevious;

@@ -1,6 +1,7 @@
 // Greedy chord decimation of line strips, as line_decimation.h describes.
 #include "libcore/render/line_decimation.h"
 
+#include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
 #include <glm/glm.hpp>
@@ -48,13 +49,18 @@ std::vector<uint32_t> decimatedLineStrips(const Strands& strands, double toleran
     for (uint32_t s = 0; s < strands.strandCount(); ++s)
       if (strands.pointsOf(s) >= 2) all.push_back(s);
   const std::vector<uint32_t>& drawn = order.empty() ? all : order;
+  // The points each strip keeps, strand by strand in memory order (then gathered in `order`).
   std::vector<uint8_t> keep(strands.pointCount(), 0);
-  std::vector<uint64_t> first(drawn.size() + 1, 0);  // per strip, where it starts in the indices
+  std::vector<uint32_t> kept(strands.strandCount(), 0);
   const float tolerance2 = float(tolerance * tolerance);
-  tbb::parallel_for(size_t(0), drawn.size(), [&](size_t k) {
-    const uint32_t s = drawn[k];
-    first[k + 1] = keepPoints(strands, s, tolerance2, &keep[strands.firstPoint[s]]) + 1;  // + the restart
-  });
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, strands.strandCount(), 1024),
+                    [&](const tbb::blocked_range<size_t>& r) {
+                      for (size_t s = r.begin(); s != r.end(); ++s)
+                        if (strands.pointsOf(s) >= 2)
+                          kept[s] = keepPoints(strands, s, tolerance2, &keep[strands.firstPoint[s]]);
+                    });
+  std::vector<uint64_t> first(drawn.size() + 1, 0);  // per strip, where it starts in the indices
+  for (size_t k = 0; k < drawn.size(); ++k) first[k + 1] = kept[drawn[k]] + 1;  // + the restart
   for (size_t k = 0; k < drawn.size(); ++k) first[k + 1] += first[k];
   std::vector<uint32_t> indices(first.back());
   tbb::parallel_for(size_t(0), drawn.size(), [&](size_t k) {

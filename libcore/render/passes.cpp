@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include <tbb/task_group.h>
+
 #include "glsl/embedded_glsl.h"
 #include "libcore/render/line_decimation.h"
 #include "libcore/render/shader_interface.h"
@@ -142,6 +144,47 @@ Programs::Programs(bool ribbons, int block, const CustomShaders& custom, bool mo
                         "motion resolve");
 }
 
+// The strands' drawing order and their chords (line_decimation.h) for the light's passes and the shading
+// pass, computed on TBB's threads while the main thread, which holds the GL context, uploads the hair and
+// compiles the programs.
+//
+// Order: only without sub-pixels, where the shading stage is tested for depth before it runs (the screen
+// door's discard would defer the test); a different order could only change which of two fragments of
+// exactly equal depth is kept. The light's passes are order-free: the nearest depth, and sums of equal
+// opacities.
+//
+// Chords: within kChordPixels of a pixel of the image or kChordTexels of a texel of the light's maps,
+// measured where the hair is nearest the eye (where those are smallest); the passes, whose cost is
+// llvmpipe's vertex stage on one thread, draw a fraction of the vertices and the same picture to that.
+// Not for a custom HairVert, which gets every point.
+struct Scene::Preparation {
+  std::vector<uint32_t> order, light, camera;
+  bool lightChords = false, cameraChords = false;
+  tbb::task_group work;
+
+  Preparation(const Scene& scene, const RenderInput& in) {
+    auto nearest = [&](const View& v) {  // from the eye to the nearest of the scene
+      return glm::length(scene.sphere.centre - glm::dvec3(glm::inverse(v.view)[3])) - scene.sphere.radius;
+    };
+    const double lightNearest = nearest(scene.light), cameraNearest = nearest(scene.subpixel);
+    lightChords = !in.shaders.hairVert && lightNearest > 0.0;
+    cameraChords = !in.shaders.hairVert && !scene.ribbons && cameraNearest > 0.0;
+    const Strands& hair = *in.hair;
+    const double lightTolerance = kChordTexels * lightNearest / scene.light.focalPx;
+    const double cameraTolerance = kChordPixels * cameraNearest / scene.subpixel.focalPx;
+    const bool ordered = scene.block == 1;
+    const glm::dmat4 view = scene.camera.view;
+    work.run([=, this, &hair] {
+      if (lightChords) light = decimatedLineStrips(hair, lightTolerance);
+    });
+    work.run([=, this, &hair] {
+      if (ordered) order = frontToBack(hair, view);
+      if (cameraChords) camera = decimatedLineStrips(hair, cameraTolerance, order);
+    });
+  }
+  ~Preparation() { work.wait(); }  // a constructor that threw leaves none of its work running
+};
+
 Scene::Scene(const RenderInput& in)
     : settings(in.settings),
       visuality(in.visuality),
@@ -152,6 +195,7 @@ Scene::Scene(const RenderInput& in)
       light(lightView(in.settings, sphere, in.domResolution)),
       ribbons(drawsRibbons(in.settings, sphere, camera, block)),
       motion(in.previous.has_value()),
+      preparing(std::make_unique<Preparation>(*this, in)),
       hair(*in.hair, tangentsFor(*in.hair), motion ? in.previous->hair : nullptr),
       head(in.head && !in.head->triangles.empty()
                ? std::make_unique<HeadGeometry>(*in.head, motion ? in.previous->head : nullptr)
@@ -164,30 +208,15 @@ Scene::Scene(const RenderInput& in)
     previousViewProj = before.proj * before.view;
     viewProj = camera.proj * camera.view;
   }
-  // Only without sub-pixels: there the shading stage is tested for depth before it runs (the screen
-  // door's discard would defer the test), and a different order could only change which of two
-  // fragments of exactly equal depth is kept. The light's passes are order-free: the nearest depth,
-  // and sums of equal opacities.
-  if (block == 1) hair.orderFrontToBack(*in.hair, camera.view);
-  // Chords (line_decimation.h) within kChordPixels of a pixel of the image or kChordTexels of a texel of
-  // the light's maps, measured where the hair is nearest (where they are smallest): the light's passes and
-  // the shading pass, whose cost is llvmpipe's vertex stage on one thread, draw a fraction of the vertices
-  // and the same picture to that.
-  if (!in.shaders.hairVert) {
-    auto nearest = [&](const View& v) {  // from the eye to the nearest of the scene
-      return glm::length(sphere.centre - glm::dvec3(glm::inverse(v.view)[3])) - sphere.radius;
-    };
-    const double lightNearest = nearest(light);
-    if (lightNearest > 0.0)
-      lightLines = std::make_unique<LineStrips>(
-          decimatedLineStrips(*in.hair, kChordTexels * lightNearest / light.focalPx));
-    const double cameraNearest = nearest(subpixel);
-    if (!ribbons && cameraNearest > 0.0)
-      cameraLines = std::make_unique<LineStrips>(
-          decimatedLineStrips(*in.hair, kChordPixels * cameraNearest / subpixel.focalPx, hair.lineStrands));
-  }
+  preparing->work.wait();
+  if (!preparing->order.empty()) hair.drawInOrder(*in.hair, preparing->order);
+  if (preparing->lightChords) lightLines = std::make_unique<LineStrips>(preparing->light);
+  if (preparing->cameraChords) cameraLines = std::make_unique<LineStrips>(preparing->camera);
+  preparing.reset();
   checkGl("setting up");
 }
+
+Scene::~Scene() = default;
 
 LightDepth lightDepthPass(const Scene& scene) {
   const int n = scene.light.width;

@@ -38,6 +38,7 @@ struct Programs {
 // it uploads the geometry and compiles the programs.
 struct Scene {
   explicit Scene(const RenderInput& input);
+  ~Scene();
 
   const RenderSettings& settings;
   const Visuality& visuality;
@@ -48,6 +49,9 @@ struct Scene {
   bool ribbons;           // the shading pass draws ribbons, not lines
   bool motion;            // the previous frame was given: motion vectors too
   glm::dmat4 viewProj{1.0}, previousViewProj{1.0};  // world to clip: this frame's camera, the previous one's
+  // What the CPU prepares for drawing while the GL objects below are made (passes.cpp).
+  struct Preparation;
+  std::unique_ptr<Preparation> preparing;
   HairGeometry hair;
   // The hair as chords for the light's passes and for the shading pass when it draws lines (null: every
   // point; a custom HairVert always gets every point, since what it does to them is its own).
