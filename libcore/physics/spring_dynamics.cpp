@@ -5,7 +5,9 @@
 #include <algorithm>
 #include <cmath>
 
+#include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
+#include <tbb/parallel_reduce.h>
 
 #include "libcore/physics/strand_energy.h"
 #include "libcore/util/error.h"
@@ -30,12 +32,21 @@ constexpr double kMaxGridNodes = 2e7;
 template <class T>
 void latticeAround(const std::vector<glm::dvec3>& points, const std::vector<double>& inverseMass, double h,
                    GridOf<T>& g) {
-  glm::dvec3 lo(1e300), hi(-1e300);
-  for (size_t p = 0; p < points.size(); ++p) {
-    if (inverseMass[p] == 0.0) continue;
-    lo = glm::min(lo, points[p]);
-    hi = glm::max(hi, points[p]);
-  }
+  // The free points' bounds, on every core (a minimum and a maximum are the same in any order).
+  using Box = std::pair<glm::dvec3, glm::dvec3>;
+  const auto [lo, hi] = tbb::parallel_reduce(
+      tbb::blocked_range<size_t>(0, points.size(), 16384), Box(glm::dvec3(1e300), glm::dvec3(-1e300)),
+      [&](const tbb::blocked_range<size_t>& r, Box box) {
+        for (size_t p = r.begin(); p != r.end(); ++p) {
+          if (inverseMass[p] == 0.0) continue;
+          box.first = glm::min(box.first, points[p]);
+          box.second = glm::max(box.second, points[p]);
+        }
+        return box;
+      },
+      [](const Box& a, const Box& b) {
+        return Box(glm::min(a.first, b.first), glm::max(a.second, b.second));
+      });
   g.values.clear();
   if (!(lo.x <= hi.x)) return;
   for (;;) {
@@ -531,19 +542,28 @@ void SpringHair::smoothVelocities(double fraction) {
   std::vector<glm::dvec3>& where = smoothWhere_;
   std::vector<glm::dvec4>& what = smoothWhat_;
   std::vector<size_t>& which = smoothWhich_;
-  where.clear();
-  what.clear();
-  which.clear();
-  for (size_t p = 0; p < x_.size(); ++p) {
-    if (inverseMass_[p] == 0.0) continue;
-    where.push_back(x_[p]);
-    what.emplace_back(mass_[p] * v_[p], mass_[p]);
-    which.push_back(p);
-  }
+  if (which.empty())  // the free points, which never change
+    for (size_t p = 0; p < x_.size(); ++p)
+      if (inverseMass_[p] != 0.0) which.push_back(p);
+  where.resize(which.size());
+  what.resize(which.size());
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, which.size(), 16384),
+                    [&](const tbb::blocked_range<size_t>& r) {
+                      for (size_t k = r.begin(); k != r.end(); ++k) {
+                        const size_t p = which[k];
+                        where[k] = x_[p];
+                        what[k] = glm::dvec4(mass_[p] * v_[p], mass_[p]);
+                      }
+                    });
   splatValues(grid, where, what);
   smoothInPlace(grid);
-  for (glm::dvec4& node : grid.values)
-    node = node.w > 0.0 ? glm::dvec4(glm::dvec3(node) / node.w, 1.0) : glm::dvec4(0.0);
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, grid.values.size(), 16384),
+                    [&](const tbb::blocked_range<size_t>& r) {
+                      for (size_t i = r.begin(); i != r.end(); ++i) {
+                        glm::dvec4& node = grid.values[i];
+                        node = node.w > 0.0 ? glm::dvec4(glm::dvec3(node) / node.w, 1.0) : glm::dvec4(0.0);
+                      }
+                    });
   smoothInPlace(grid);
   tbb::parallel_for(size_t(0), which.size(), [&](size_t k) {
     const size_t p = which[k];
