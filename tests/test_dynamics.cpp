@@ -166,24 +166,10 @@ TEST(AnjyoDynamics, TheStepsSinAndCosAreTheLibrarys) {
 // is not a whole number of blocks, a strand of one point, collisions with an ellipsoid, a sphere and a
 // box, joint limits, fluctuations, the pseudo-force and a turning head.
 TEST(AnjyoDynamics, EveryKernelGivesTheSameBits) {
-  const glm::dvec3 axes(0.10, 0.12, 0.11);
-  Collision shapes;
-  shapes.shapes.push_back({ShapeKind::kEllipsoid, 0.0, 1.0, glm::dvec3(0.0), axes, glm::dmat3(1.0), {}});
-  shapes.shapes.push_back(
-      {ShapeKind::kSphere, 0.0, 1.0, glm::dvec3(0.11, -0.08, 0.0), glm::dvec3(0.03), glm::dmat3(1.0), {}});
-  shapes.shapes.push_back(
-      {ShapeKind::kCuboid, 0.0, 1.0, glm::dvec3(0.02, -0.16, 0.06), glm::dvec3(0.04), glm::dmat3(1.0), {}});
-  Strands hair;
-  for (int s = 0; s < 13; ++s) {  // down the +x side from 60° above the equator, 2 to 12 points
-    const double u = glm::radians(9.0 * (s - 6));
-    std::vector<glm::vec3> points;
-    for (int j = 0; j < (s == 5 ? 1 : 2 + (s * 5) % 11); ++j) {
-      const double v = glm::radians(60.0 - 7.0 * j);
-      points.push_back(glm::vec3(
-          1.02 * axes * glm::dvec3(std::cos(v) * std::cos(u), std::sin(v), std::cos(v) * std::sin(u))));
-    }
-    hair.addStrand(points);
-  }
+  const Collision shapes = test::kernelShapes();
+  std::vector<int> counts;  // 2 to 12 points, and one of 1
+  for (int s = 0; s < 13; ++s) counts.push_back(s == 5 ? 1 : 2 + (s * 5) % 11);
+  const Strands hair = test::kernelHair(counts);
   Hairstyle style;
   style.jointLimit = 25.0;
   style.jointLimitFrom = 2;

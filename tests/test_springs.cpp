@@ -151,25 +151,10 @@ TEST(Springs, ACurvedHairHoldsItsGroomedShapeUnderGravity) {
 // strands, not a whole number of blocks), one of 140 segments (past the lanes' limit), pushed hard into
 // an ellipsoid, a sphere and a box (so the collisions and the second solve run) while the head turns.
 TEST(Springs, EveryKernelGivesTheSameBits) {
-  const glm::dvec3 axes(0.10, 0.12, 0.11);
-  Collision shapes;
-  shapes.shapes.push_back({ShapeKind::kEllipsoid, 0.0, 1.0, glm::dvec3(0.0), axes, glm::dmat3(1.0), {}});
-  shapes.shapes.push_back(
-      {ShapeKind::kSphere, 0.0, 1.0, glm::dvec3(0.11, -0.08, 0.0), glm::dvec3(0.03), glm::dmat3(1.0), {}});
-  shapes.shapes.push_back(
-      {ShapeKind::kCuboid, 0.0, 1.0, glm::dvec3(0.02, -0.16, 0.06), glm::dvec3(0.04), glm::dmat3(1.0), {}});
-  Strands rest;
-  for (int s = 0; s < 14; ++s) {  // down the +x side from 60° above the equator
-    const double u = glm::radians(9.0 * (s - 6));
-    const int count = s == 13 ? 141 : s == 5 ? 1 : s < 8 ? 2 + (s * 5) % 11 : 9;
-    std::vector<glm::vec3> points;
-    for (int j = 0; j < count; ++j) {
-      const double v = glm::radians(60.0 - 7.0 * j * 11.0 / std::max(count, 11));
-      points.push_back(glm::vec3(
-          1.02 * axes * glm::dvec3(std::cos(v) * std::cos(u), std::sin(v), std::cos(v) * std::sin(u))));
-    }
-    rest.addStrand(points);
-  }
+  const Collision shapes = test::kernelShapes();
+  std::vector<int> counts;
+  for (int s = 0; s < 14; ++s) counts.push_back(s == 13 ? 141 : s == 5 ? 1 : s < 8 ? 2 + (s * 5) % 11 : 9);
+  const Strands rest = test::kernelHair(counts);
   Hairstyle style;
   style.gravity = 9.81;
   Dynamics d = springs();

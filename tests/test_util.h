@@ -112,6 +112,37 @@ inline void expectSameStrands(const Strands& a, const Strands& b) {
   EXPECT_EQ(a.provenance.yUp, b.provenance.yUp);
 }
 
+// The hair of the dynamics kernels' bit tests (Anjyo's and the springs'): an ellipsoid head of
+// semi-axes kKernelHeadAxes at the origin with a sphere and a box beside it below, and strand s of
+// counts[s] points down the head's +x side, 9° apart, from 60° above the equator 7° a point (closer for
+// strands of more than 12 points, which span 84°), 2% off the surface.
+constexpr glm::dvec3 kKernelHeadAxes(0.10, 0.12, 0.11);
+inline Collision kernelShapes() {
+  Collision shapes;
+  shapes.shapes.push_back(
+      {ShapeKind::kEllipsoid, 0.0, 1.0, glm::dvec3(0.0), kKernelHeadAxes, glm::dmat3(1.0), {}});
+  shapes.shapes.push_back(
+      {ShapeKind::kSphere, 0.0, 1.0, glm::dvec3(0.11, -0.08, 0.0), glm::dvec3(0.03), glm::dmat3(1.0), {}});
+  shapes.shapes.push_back(
+      {ShapeKind::kCuboid, 0.0, 1.0, glm::dvec3(0.02, -0.16, 0.06), glm::dvec3(0.04), glm::dmat3(1.0), {}});
+  return shapes;
+}
+inline Strands kernelHair(const std::vector<int>& counts) {
+  Strands hair;
+  for (size_t s = 0; s < counts.size(); ++s) {
+    const double u = glm::radians(9.0 * (double(s) - 6.0));
+    std::vector<glm::vec3> points;
+    for (int j = 0; j < counts[s]; ++j) {
+      const double v = glm::radians(60.0 - 7.0 * j * 12.0 / std::max(counts[s], 12));
+      points.push_back(
+          glm::vec3(1.02 * kKernelHeadAxes *
+                    glm::dvec3(std::cos(v) * std::cos(u), std::sin(v), std::cos(v) * std::sin(u))));
+    }
+    hair.addStrand(points);
+  }
+  return hair;
+}
+
 inline ConfigText text(const std::string& body, const std::string& name = "test.txt") {
   return parseConfigText(body, name, ".");
 }
