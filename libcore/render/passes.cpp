@@ -13,10 +13,12 @@ namespace hairgen {
 
 namespace {
 
-// How far from the hair the chords drawn for it may stray: a quarter of a pixel of the image being drawn
-// (a sub-pixel when Samples asks for them), and half a texel of the light's maps, whose lookup takes the
-// nearest start and the largest opacity over 2×2 texels (shadow.glsl) and so cannot tell half a texel.
-constexpr double kChordPixels = 0.25, kChordTexels = 0.5;
+// How far from the hair the chords drawn for it may stray: 3/8 of a pixel of the image being drawn (a
+// sub-pixel when Samples asks for them; a strand is drawn at least a pixel wide, so its chord's line
+// still overlaps the curve's), and half a texel of the light's maps, whose lookup takes the
+// nearest start and the largest opacity over 2×2 texels (shadow.glsl), so a shadow is two texels wide
+// at its sharpest; a shadow's edge may move by the half texel.
+constexpr double kChordPixels = 0.375, kChordTexels = 0.5;
 
 // k for Samples = k² (k ≤ 8), lowered until the sub-pixel image fits the device's largest texture.
 int subpixelBlock(const RenderSettings& r) {
@@ -163,15 +165,20 @@ struct Scene::Preparation {
   tbb::task_group work;
 
   Preparation(const Scene& scene, const RenderInput& in) {
-    auto nearest = [&](const View& v) {  // from the eye to the nearest of the scene
-      return glm::length(scene.sphere.centre - glm::dvec3(glm::inverse(v.view)[3])) - scene.sphere.radius;
+    // A pixel's width in metres at the nearest of the scene: depth over focalPx on the view's axis, and
+    // cos² of the angle smaller toward the corners of the view (a sideways offset at angle θ moves
+    // focalPx·δ/(z cos² θ) pixels), so the smallest is at the corner's angle.
+    auto nearestPixel = [&](const View& v) {
+      const double depth =
+          glm::length(scene.sphere.centre - glm::dvec3(glm::inverse(v.view)[3])) - scene.sphere.radius;
+      const double tanX = 1.0 / v.proj[0][0], tanY = 1.0 / v.proj[1][1];  // the half-angles' tangents
+      return depth / v.focalPx / (1.0 + tanX * tanX + tanY * tanY);
     };
-    const double lightNearest = nearest(scene.light), cameraNearest = nearest(scene.subpixel);
-    lightChords = !in.shaders.hairVert && lightNearest > 0.0;
-    cameraChords = !in.shaders.hairVert && !scene.ribbons && cameraNearest > 0.0;
+    const double lightPixel = nearestPixel(scene.light), cameraPixel = nearestPixel(scene.subpixel);
+    lightChords = !in.shaders.hairVert && lightPixel > 0.0;
+    cameraChords = !in.shaders.hairVert && !scene.ribbons && cameraPixel > 0.0;
     const Strands& hair = *in.hair;
-    const double lightTolerance = kChordTexels * lightNearest / scene.light.focalPx;
-    const double cameraTolerance = kChordPixels * cameraNearest / scene.subpixel.focalPx;
+    const double lightTolerance = kChordTexels * lightPixel, cameraTolerance = kChordPixels * cameraPixel;
     const bool ordered = scene.block == 1;
     const glm::dmat4 view = scene.camera.view;
     work.run([=, this, &hair] {
