@@ -8,6 +8,7 @@
 #include <tbb/info.h>
 
 #include "libcore/config/reader.h"
+#include "libcore/io/exr_io.h"
 #include "libcore/io/hair_cache.h"
 #include "libcore/util/error.h"
 #include "libcore/util/file_util.h"
@@ -137,6 +138,7 @@ int runCommand(const std::string& command, const CommonOptions& options, const s
   try {
     int threads = options.threads > 0 ? options.threads : static_cast<int>(tbb::info::default_concurrency());
     tbb::global_control limit(tbb::global_control::max_allowed_parallelism, static_cast<size_t>(threads));
+    setExrThreads(threads);
     body();
     forgetCommittedOutputs();
     return static_cast<int>(ExitCode::kSuccess);

@@ -13,6 +13,7 @@
 #include "libcore/physics/anjyo_sincos.h"
 #include "libcore/physics/head_motion.h"
 #include "libcore/physics/strand_energy.h"
+#include "libcore/util/cpu.h"
 #include "stages/grow.h"
 #include "stages/simulate.h"
 #include "tests/test_util.h"
@@ -166,6 +167,7 @@ TEST(AnjyoDynamics, TheStepsSinAndCosAreTheLibrarys) {
 // is not a whole number of blocks, a strand of one point, collisions with an ellipsoid, a sphere and a
 // box, joint limits, fluctuations, the pseudo-force and a turning head.
 TEST(AnjyoDynamics, EveryKernelGivesTheSameBits) {
+  if (!hasAvx512()) GTEST_SKIP() << "no AVX-512 here: the vector kernel cannot run, only the strands' does";
   const Collision shapes = test::kernelShapes();
   std::vector<int> counts;  // 2 to 12 points, and one of 1
   for (int s = 0; s < 13; ++s) counts.push_back(s == 5 ? 1 : 2 + (s * 5) % 11);

@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include "libcore/render/gl_context.h"
+#include "libcore/render/gl_resources.h"
 #include "libcore/render/line_decimation.h"
 #include "libcore/render/shader_interface.h"
 #include "libcore/render/shading.h"
@@ -26,7 +27,8 @@ TEST(LineDecimation, ChordsStayWithinToleranceOfEveryPointTheyDrop) {
     const double a = 0.05 * j;  // a 2 cm radius arc: 3 mm segments bend 0.06 mm off their chords of two
     arc.push_back(glm::vec3(float(0.02 * std::cos(a)), float(0.02 * std::sin(a)), 0.02f));
   }
-  for (const auto* points : {&straight, &single, &zigzag, &arc}) s.addStrand(*points);
+  std::vector<glm::vec3> pair = {glm::vec3(0.0f), glm::vec3(0.0f, -0.01f, 0.0f)};
+  for (const auto* points : {&straight, &single, &zigzag, &arc, &pair}) s.addStrand(*points);
   const double tolerance = 1e-4;
   auto stripsOf = [](const std::vector<uint32_t>& indices) {
     std::vector<std::vector<uint32_t>> strips(1);
@@ -41,13 +43,15 @@ TEST(LineDecimation, ChordsStayWithinToleranceOfEveryPointTheyDrop) {
     return strips;
   };
   const std::vector<std::vector<uint32_t>> strips = stripsOf(decimatedLineStrips(s, tolerance));
-  ASSERT_EQ(strips.size(), 3u);  // the one-point strand draws nothing
+  ASSERT_EQ(strips.size(), 4u);  // the one-point strand draws nothing
+  EXPECT_EQ(strips[3], (std::vector<uint32_t>{s.firstPoint[4], s.firstPoint[4] + 1}))
+      << "a pair is one chord";
   // The straight strand: one chord every kMostSegmentsPerChord segments.
   EXPECT_EQ(strips[0].size(), 63 / kMostSegmentsPerChord + 2);
   EXPECT_EQ(strips[1].size(), 64u) << "a zigzag of 1 mm against 0.1 mm keeps every point";
   EXPECT_GT(strips[2].size(), 64u / kMostSegmentsPerChord);
   EXPECT_LT(strips[2].size(), 64u);
-  const size_t strandOf[3] = {0, 2, 3};
+  const size_t strandOf[4] = {0, 2, 3, 4};
   for (size_t k = 0; k < strips.size(); ++k) {
     const std::vector<uint32_t>& strip = strips[k];
     const size_t strand = strandOf[k];
@@ -66,9 +70,38 @@ TEST(LineDecimation, ChordsStayWithinToleranceOfEveryPointTheyDrop) {
   }
   // Tolerance 0 keeps every point of the bent strands.
   const std::vector<std::vector<uint32_t>> exact = stripsOf(decimatedLineStrips(s, 0.0));
-  ASSERT_EQ(exact.size(), 3u);
+  ASSERT_EQ(exact.size(), 4u);
   EXPECT_EQ(exact[1].size(), 64u);
   EXPECT_EQ(exact[2].size(), 64u);
+}
+
+// In a drawing order, the strips come in that order, each the strip its strand has alone; frontToBack
+// gives every strand of two points or more once, the nearest to the eye first.
+TEST(LineDecimation, StripsFollowTheDrawingOrderFrontToBack) {
+  Strands s;
+  for (int k = 0; k < 6; ++k) {  // strand k at depth 1 + (k * 5) % 6 metres in front of an eye at the origin
+    const float z = -1.0f - float((k * 5) % 6);
+    std::vector<glm::vec3> points;
+    for (int j = 0; j < (k == 3 ? 1 : 5); ++j) points.push_back(glm::vec3(0.01f * j, 0.002f * j * j, z));
+    s.addStrand(points);
+  }
+  const std::vector<uint32_t> order =
+      frontToBack(s, glm::dmat4(1.0));  // the eye at the origin, looking down −z
+  ASSERT_EQ(order.size(), 5u) << "the one-point strand is not drawn";
+  EXPECT_EQ(order.front(), 0u);
+  EXPECT_EQ(order.back(), 1u) << "the farthest, drawn last";
+  for (size_t i = 0; i + 1 < order.size(); ++i)
+    EXPECT_GT(s.points[s.firstPoint[order[i]]].z, s.points[s.firstPoint[order[i + 1]]].z) << "nearest first";
+  const std::vector<uint32_t> ordered = decimatedLineStrips(s, 1e-4, order);
+  std::vector<uint32_t> expected;
+  for (uint32_t strand : order) {
+    Strands alone;
+    alone.addStrand(std::vector<glm::vec3>(s.points.begin() + s.firstPoint[strand],
+                                           s.points.begin() + s.firstPoint[strand] + s.pointsOf(strand)));
+    for (uint32_t i : decimatedLineStrips(alone, 1e-4))
+      expected.push_back(i == kRestartIndex ? i : i + s.firstPoint[strand]);
+  }
+  EXPECT_EQ(ordered, expected);
 }
 
 GlContext& gl() {

@@ -21,7 +21,6 @@
 #include <dlfcn.h>
 #include <half.h>
 #include <png.h>
-#include <tbb/global_control.h>
 
 #include "libcore/util/error.h"
 #include "libcore/util/file_util.h"
@@ -121,6 +120,10 @@ bool isHalf(const std::string& c) {
 
 }  // namespace
 
+void setExrThreads(int threads) {
+  Imf::setGlobalThreadCount(threads);
+}
+
 void writeExr(const fs::path& file, const Image& image, const ExrMetadata& metadata) {
   Imf::Header header(image.width, image.height);
   header.compression() = Imf::ZIP_COMPRESSION;
@@ -150,13 +153,9 @@ void writeExr(const fs::path& file, const Image& image, const ExrMetadata& metad
   }
   writeThroughTemporary(file, [&](const fs::path& temporary) {
     try {
-      // Compressed on every core hairgen may use (--threads), by OpenEXR's global pool (the file's own
-      // thread count only sets how many chunks are in flight): each chunk is compressed alone, so the
-      // bytes are the same for any count.
-      const int threads =
-          int(tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism));
-      if (Imf::globalThreadCount() != threads) Imf::setGlobalThreadCount(threads);
-      Imf::OutputFile out(temporary.c_str(), header, threads);
+      // Compressed on OpenEXR's global thread pool, which the command sets to its --threads: each chunk
+      // is compressed alone, so the bytes are the same for any count.
+      Imf::OutputFile out(temporary.c_str(), header, Imf::globalThreadCount());
       out.setFrameBuffer(frame);
       out.writePixels(image.height);
     } catch (const std::exception& e) {

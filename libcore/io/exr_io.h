@@ -23,6 +23,10 @@ struct ExrMetadata {
   bool camera = false;  // write worldToCamera / worldToNDC
 };
 
+// The threads that compress a written EXR's chunks (OpenEXR's global pool, process-wide; 0 for none):
+// a command sets it once, to its --threads. The file's bytes are the same for any count.
+void setExrThreads(int threads);
+
 void writeExr(const std::filesystem::path& file, const Image& image, const ExrMetadata& metadata);
 
 // An image, every channel as float: an EXR with OpenEXR, any other format OpenImageIO reads through

@@ -1,6 +1,7 @@
 // Anjyo et al. 1992 §3, as anjyo_dynamics.h describes it.
 #include "libcore/physics/anjyo_dynamics.h"
 #include "libcore/model/strand_frames.h"
+#include "libcore/util/cpu.h"
 
 #include <algorithm>
 #include <cmath>
@@ -19,9 +20,8 @@ constexpr uint64_t kFluctuationKey = 0x666c756374ull;  // "fluct": apart from ev
 
 // The kernel asked for, or the strands where this processor has no AVX-512 for the lanes.
 AnjyoHair::Kernel available(AnjyoHair::Kernel asked) {
-  static const bool avx512 = __builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512dq");
-  return asked != AnjyoHair::Kernel::kStrands && avx512 ? AnjyoHair::Kernel::kLanes
-                                                        : AnjyoHair::Kernel::kStrands;
+  return asked != AnjyoHair::Kernel::kStrands && hasAvx512() ? AnjyoHair::Kernel::kLanes
+                                                             : AnjyoHair::Kernel::kStrands;
 }
 
 SegmentFrame frameFor(const glm::dvec3& rest) {

@@ -36,6 +36,8 @@ template <class T>
   // The quadrant k mod 4 (two's complement: −1 is 3), as integers: comparisons of doubles here were
   // split into one scalar compare per lane when inlined into the vector step, a third of its time.
   // Odd quadrants swap sin and cos; quadrants 2 and 3 negate sin, 1 and 2 cos (a flip of the sign bit).
+  // (k is an exact integer for finite x; a NaN, which restore() and the step's callers never pass, would
+  // make the conversion undefined.)
   if constexpr (std::is_same_v<T, double>) {
     const int64_t q = int64_t(k) & 3;
     const double sinR = (q & 1) ? cr : sr, cosR = (q & 1) ? sr : cr;

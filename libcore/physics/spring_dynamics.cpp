@@ -1,6 +1,7 @@
 // Petrovic et al. 2006 §5, as spring_dynamics.h describes it.
 #include "libcore/physics/spring_dynamics.h"
 #include "libcore/model/strand_frames.h"
+#include "libcore/util/cpu.h"
 
 #include <algorithm>
 #include <cmath>
@@ -16,9 +17,8 @@ namespace hairgen {
 namespace {
 
 SpringHair::Kernel available(SpringHair::Kernel asked) {
-  static const bool avx512 = __builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512dq");
-  return asked != SpringHair::Kernel::kStrands && avx512 ? SpringHair::Kernel::kLanes
-                                                         : SpringHair::Kernel::kStrands;
+  return asked != SpringHair::Kernel::kStrands && hasAvx512() ? SpringHair::Kernel::kLanes
+                                                              : SpringHair::Kernel::kStrands;
 }
 
 // Density targeting: the grids of a spacing, shifted by half a cell along each combination of axes.
@@ -555,7 +555,7 @@ void SpringHair::smoothVelocities(double fraction) {
                         what[k] = glm::dvec4(mass_[p] * v_[p], mass_[p]);
                       }
                     });
-  splatValues(grid, where, what);
+  splatValues(grid, where, what, smoothSorted_);
   smoothInPlace(grid);
   tbb::parallel_for(tbb::blocked_range<size_t>(0, grid.values.size(), 16384),
                     [&](const tbb::blocked_range<size_t>& r) {

@@ -184,6 +184,7 @@ class SpringHair {
   std::vector<glm::dvec3> smoothWhere_;
   std::vector<glm::dvec4> smoothWhat_;
   std::vector<size_t> smoothWhich_;
+  SplatEntries<glm::dvec4> smoothSorted_;
 };
 
 }  // namespace hairgen

@@ -1,4 +1,5 @@
-// Model springs' stretch solve (spring_dynamics.cpp, projectStretch) for kLanes strands of the same
+// Model springs' stretch solve (Petrovic et al. 2006 §5 keyhairs kept inextensible by XPBD, Macklin,
+// Müller and Chentanez 2016; spring_dynamics.cpp, projectStretch) for kLanes strands of the same
 // segment count at once, in AVX-512 vectors: the same operations in the same order on each lane, so
 // every lane's bits are the strand's own (IEEE arithmetic and square roots are exact per lane; this file
 // and spring_dynamics.cpp are built without contraction into fused multiply-adds). The solve is a chain

@@ -214,14 +214,10 @@ HairGeometry::HairGeometry(const Strands& s, const std::vector<glm::vec3>& tange
   if (before && before->points.size() != s.points.size())
     renderFailure("the previous frame's hair has " + std::to_string(before->points.size()) + " points, not " +
                   std::to_string(s.points.size()));
-  for (size_t i = 0; i < s.strandCount(); ++i) {
-    if (s.pointsOf(i) < 2) continue;
-    lineStrands.push_back(static_cast<uint32_t>(i));
-    lineFirsts.push_back(static_cast<GLint>(s.firstPoint[i]));
-    lineCounts.push_back(static_cast<GLsizei>(s.pointsOf(i)));
-    ribbonFirsts.push_back(static_cast<GLint>(2 * s.firstPoint[i]));
-    ribbonCounts.push_back(static_cast<GLsizei>(2 * s.pointsOf(i)));
-  }
+  std::vector<uint32_t> drawn;  // in strand order until drawInOrder
+  for (uint32_t i = 0; i < s.strandCount(); ++i)
+    if (s.pointsOf(i) >= 2) drawn.push_back(i);
+  drawInOrder(s, drawn);
   glCreateVertexArrays(1, &vao);
   glVertexArrayVertexBuffer(vao, 0, points.id, 0, sizeof(glm::vec3));
   glVertexArrayVertexBuffer(vao, 1, tangents.id, 0, sizeof(glm::vec3));
@@ -256,9 +252,10 @@ std::vector<uint32_t> frontToBack(const Strands& s, const glm::dmat4& view) {
 }
 
 void HairGeometry::drawInOrder(const Strands& s, const std::vector<uint32_t>& order) {
+  for (auto* v : {&lineFirsts, &ribbonFirsts}) v->resize(order.size());
+  for (auto* v : {&lineCounts, &ribbonCounts}) v->resize(order.size());
   for (size_t i = 0; i < order.size(); ++i) {
     const uint32_t strand = order[i];
-    lineStrands[i] = strand;
     lineFirsts[i] = static_cast<GLint>(s.firstPoint[strand]);
     lineCounts[i] = static_cast<GLsizei>(s.pointsOf(strand));
     ribbonFirsts[i] = static_cast<GLint>(2 * s.firstPoint[strand]);

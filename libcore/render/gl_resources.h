@@ -127,7 +127,7 @@ struct HairGeometry {
   // Binds the buffers and draws every strand as lines, or as ribbons (with `drawing` false, only binds).
   void draw(bool ribbon, bool drawing = true) const;
   // Draws the strands as `strips` gives them (null: every point, draw(false)).
-  void drawLines(const struct LineStrips* strips) const;
+  void drawLines(const LineStrips* strips) const;
   // Draws the strands in `order` (frontToBack's: every strand of two points or more, once).
   void drawInOrder(const Strands& strands, const std::vector<uint32_t>& order);
 
@@ -135,7 +135,6 @@ struct HairGeometry {
   bool hasColors, hasNormals, hasPrevious;
   std::vector<GLint> lineFirsts, ribbonFirsts;
   std::vector<GLsizei> lineCounts, ribbonCounts;
-  std::vector<uint32_t> lineStrands;  // the strand of each line strip, in drawing order
   GLuint vao = 0;
 };
 

@@ -1,4 +1,7 @@
-// Greedy chord decimation of line strips, as line_decimation.h describes.
+// Greedy chord decimation of line strips, as line_decimation.h describes. The test, every dropped point
+// within a tolerance of its chord, is Ramer's (1972) and Douglas and Peucker's (1973); the walk is greedy
+// from the root rather than their recursive split, so a strip is made in one pass and its chords are
+// bounded in length.
 #include "libcore/render/line_decimation.h"
 
 #include <tbb/blocked_range.h>

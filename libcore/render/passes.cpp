@@ -189,7 +189,14 @@ struct Scene::Preparation {
       if (cameraChords) camera = decimatedLineStrips(hair, cameraTolerance, order);
     });
   }
-  ~Preparation() { work.wait(); }  // a constructor that threw leaves none of its work running
+  // Waits for the work when the Scene's constructor throws before it did (a task's own failure is then
+  // moot: the constructor's is the one that goes on).
+  ~Preparation() {
+    try {
+      work.wait();
+    } catch (...) {
+    }
+  }
 };
 
 Scene::Scene(const RenderInput& in)

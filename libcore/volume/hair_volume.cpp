@@ -260,7 +260,8 @@ void splat(Grid& d, const std::vector<glm::vec3>& points) {
 }
 
 template <class T>
-void splatValues(GridOf<T>& d, const std::vector<glm::dvec3>& points, const std::vector<T>& values) {
+void splatValues(GridOf<T>& d, const std::vector<glm::dvec3>& points, const std::vector<T>& values,
+                 SplatEntries<T>& sorted) {
   // Slab s holds the points whose cell starts at node plane z = s − 1 (z = −1 for a point just below
   // the grid): they add to planes z and z + 1 only, so slabs two apart never share a node and each
   // phase (even slabs, then odd) may run its slabs at once. A counting sort keeps each slab's points in
@@ -281,15 +282,8 @@ void splatValues(GridOf<T>& d, const std::vector<glm::dvec3>& points, const std:
   for (int s = 0; s < slabs; ++s) first[s + 1] += first[s];
   std::vector<uint32_t> next(first.begin(), first.end() - 1);
   // The points and values themselves, sorted: the splat then reads them in order (through an index it
-  // missed the cache on most points, a third of its time). Kept between calls, as a shot splats every
-  // frame.
-  struct Entry {
-    glm::dvec3 point;
-    T value;
-  };
-  thread_local std::vector<Entry> kept;
-  kept.resize(first[size_t(slabs)]);
-  Entry* sorted = kept.data();  // the caller's, not each worker thread's own
+  // missed the cache on most points, a third of its time).
+  sorted.resize(first[size_t(slabs)]);
   for (size_t p = 0; p < points.size(); ++p)
     if (slabOf[p] != kOutside) sorted[next[slabOf[p]]++] = {points[p], values[p]};
   const glm::ivec3 size = d.size;
@@ -297,8 +291,8 @@ void splatValues(GridOf<T>& d, const std::vector<glm::dvec3>& points, const std:
     tbb::parallel_for(0, (slabs - phase + 1) / 2, [&](int half) {
       const int s = 2 * half + phase;
       for (uint32_t o = first[s]; o < first[s + 1]; ++o) {
-        const Entry& e = sorted[o];
-        const glm::dvec3 g = (e.point - d.origin) / d.voxel;
+        const auto& [point, value] = sorted[o];
+        const glm::dvec3 g = (point - d.origin) / d.voxel;
         const glm::ivec3 c = glm::ivec3(glm::floor(g));
         const glm::dvec3 f = g - glm::dvec3(c);
         for (int dz = 0; dz < 2; ++dz)
@@ -308,7 +302,7 @@ void splatValues(GridOf<T>& d, const std::vector<glm::dvec3>& points, const std:
               if (glm::any(glm::lessThan(n, glm::ivec3(0))) || glm::any(glm::greaterThanEqual(n, size)))
                 continue;
               const double w = (dx ? f.x : 1 - f.x) * (dy ? f.y : 1 - f.y) * (dz ? f.z : 1 - f.z);
-              d.values[d.index(n.x, n.y, n.z)] += w * e.value;
+              d.values[d.index(n.x, n.y, n.z)] += w * value;
             }
       }
     });
@@ -390,7 +384,7 @@ template void smoothInPlace<glm::dvec4>(GridOf<glm::dvec4>&);
 template GridOf<float> smoothed<float>(const GridOf<float>&);
 template GridOf<glm::dvec4> smoothed<glm::dvec4>(const GridOf<glm::dvec4>&);
 template void splatValues<glm::dvec4>(GridOf<glm::dvec4>&, const std::vector<glm::dvec3>&,
-                                      const std::vector<glm::dvec4>&);
+                                      const std::vector<glm::dvec4>&, SplatEntries<glm::dvec4>&);
 
 namespace {
 

@@ -6,6 +6,7 @@
 
 #include <cstdint>
 #include <type_traits>
+#include <utility>
 #include <vector>
 
 #include <glm/glm.hpp>
@@ -55,9 +56,13 @@ void splat(Grid& density, const std::vector<glm::vec3>& points);
 // Adds values[i] times point i's tent weights to the 8 nodes around it (the outer corners of a point
 // at the grid's edge fall away). Sums in a fixed order, whatever the thread count: points by z-slab of
 // the grid, even slabs then odd ones (the two never share a node), each slab's points in index order;
-// so the grid holds the same bits for 1 thread or 64. `values` has one entry per point.
+// so the grid holds the same bits for 1 thread or 64. `values` has one entry per point. `sorted`: the
+// points and values in that order, the caller's memory (kept between calls, it is reused).
 template <class T>
-void splatValues(GridOf<T>& grid, const std::vector<glm::dvec3>& points, const std::vector<T>& values);
+using SplatEntries = std::vector<std::pair<glm::dvec3, T>>;
+template <class T>
+void splatValues(GridOf<T>& grid, const std::vector<glm::dvec3>& points, const std::vector<T>& values,
+                 SplatEntries<T>& sorted);
 
 // One pass of a separable binomial [1 2 1]/4 filter, edges clamped. As a matrix it is symmetric,
 // non-negative and doubly stochastic (every row and column sums to 1): it keeps the total, and a
