@@ -12,6 +12,7 @@
 #include "libcore/physics/anjyo_dynamics.h"
 #include "libcore/physics/anjyo_sincos.h"
 #include "libcore/physics/head_motion.h"
+#include "libcore/physics/lanes.h"
 #include "libcore/physics/strand_energy.h"
 #include "libcore/util/cpu.h"
 #include "stages/grow.h"
@@ -160,6 +161,31 @@ TEST(AnjyoDynamics, TheStepsSinAndCosAreTheLibrarys) {
   sinCos(0.0, s, c);
   EXPECT_EQ(s, 0.0);
   EXPECT_EQ(c, 1.0);
+}
+
+// sinCos of 8 lanes in AVX-512 vectors, as the vector step calls it, over the same ±74 rad (every
+// quadrant, negative ones too): the scalar's bits in every lane.
+[[gnu::target("avx512f,avx512dq")]] void sinCosLanes(const double* x, double* s, double* c) {
+  lanes::Vd v, vs, vc;
+  std::memcpy(&v, x, sizeof(v));
+  sinCos(v, vs, vc);
+  std::memcpy(s, &vs, sizeof(vs));
+  std::memcpy(c, &vc, sizeof(vc));
+}
+
+TEST(AnjyoDynamics, TheVectorSinAndCosAreTheScalarsBits) {
+  if (!hasAvx512()) GTEST_SKIP() << "no AVX-512 here";
+  for (int i = -200000; i <= 200000; i += 8) {
+    double x[8], s[8], c[8];
+    for (int l = 0; l < 8; ++l) x[l] = (i + l) * 3.7e-4;
+    sinCosLanes(x, s, c);
+    for (int l = 0; l < 8; ++l) {
+      double ss, cc;
+      sinCos(x[l], ss, cc);
+      ASSERT_EQ(std::memcmp(&ss, &s[l], sizeof(double)), 0) << "sin " << x[l];
+      ASSERT_EQ(std::memcmp(&cc, &c[l], sizeof(double)), 0) << "cos " << x[l];
+    }
+  }
 }
 
 // Every kernel of the step (strand by strand, in AVX-512 vectors) gives the same bits, with what
