@@ -106,6 +106,10 @@ SpringHair::SpringHair(const Strands& rest, const Hairstyle& style, const Dynami
   xRest_.resize(points);
   for (size_t p = 0; p < points; ++p) xRest_[p] = glm::dvec3(rest.points[p]);
   x_ = xRest_;
+  restUnit_.assign(points, glm::dvec3(0.0));
+  for (size_t st = 0; st < strands; ++st)
+    for (uint32_t p = rest.firstPoint[st]; p + 1 < rest.firstPoint[st] + rest.pointsOf(st); ++p)
+      restUnit_[p] = glm::normalize(xRest_[p + 1] - xRest_[p]);
   v_.assign(points, glm::dvec3(0.0));
   mass_.assign(points, 0.0);
   inverseMass_.assign(points, 0.0);
@@ -587,12 +591,13 @@ void SpringHair::posedInto(const Pose& pose, Strands& out) const {
     for (uint32_t j = 0; j < count; ++j) {
       const uint32_t p = p0 + j;
       // The input point plus the motion: at rest exactly the input.
-      out.points[p] = glm::vec3(pose.apply(glm::dvec3(rest_.points[p]) + (x_[p] - xRest_[p])));
+      // (xRest_ holds the input points exactly, in doubles.)
+      out.points[p] = glm::vec3(pose.apply(xRest_[p] + (x_[p] - xRest_[p])));
       glm::dvec3 t(restTangents_[p]);
       if (count >= 2) {
         // Turned with its segment (the one it starts, or the last): the minimal rotation.
         if (j + 1 < count) {
-          restDir = glm::normalize(xRest_[p + 1] - xRest_[p]);
+          restDir = restUnit_[p];
           dir = glm::normalize(x_[p + 1] - x_[p]);
         }
         t = transportFast(restDir, dir, t);

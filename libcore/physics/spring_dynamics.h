@@ -162,6 +162,7 @@ class SpringHair {
   // stiffness as compliance < 0.
   std::vector<double> twistLength_, twistCompliance_;
   std::vector<glm::vec3> restTangents_;
+  std::vector<glm::dvec3> restUnit_;  // per point but each strand's last, its segment's rest direction
   // The implicit solve, per free point: 1/D and the two sub-diagonals of L in M(1 + cΔt) + Δt²K = L D Lᵀ,
   // for the step dt_.
   std::vector<double> inverseD_, lower1_, lower2_;
