@@ -208,11 +208,7 @@ TEST(AnjyoDynamics, EveryKernelGivesTheSameBits) {
   dynamics.pseudoReach = 0.02;
   dynamics.fluctuation = 0.01;
   dynamics.fluctuationEvery = 3;
-  AccelerationField field;
-  field.base = {-60.0, -9.81, 15.0};  // hard into the head
-  field.rotating = true;
-  field.omega = {0.3, 4.0, 0.5};
-  field.alpha = {2.0, 0.0, -1.0};
+  const AccelerationField field = test::kernelField();
   Pose pose;
   pose.rotation = eulerRotation({5.0, 30.0, -10.0});
   pose.translation = {0.01, 0.02, -0.03};

@@ -161,11 +161,7 @@ TEST(Springs, EveryKernelGivesTheSameBits) {
   style.gravity = 9.81;
   Dynamics d = springs();
   d.damping = 0.5;
-  AccelerationField field;
-  field.base = {-60.0, -9.81, 15.0};  // hard into the head
-  field.rotating = true;
-  field.omega = {0.3, 4.0, 0.5};
-  field.alpha = {2.0, 0.0, -1.0};
+  const AccelerationField field = test::kernelField();
   using Kernel = SpringHair::Kernel;
   auto run = [&](Kernel kernel) {
     SpringHair hair(rest, style, d, shapes, nullptr);

@@ -11,6 +11,7 @@
 #include "libcore/config/setup.h"
 #include "libcore/io/obj_io.h"
 #include "libcore/model/strands.h"
+#include "libcore/physics/head_motion.h"
 
 namespace hairgen::test {
 
@@ -126,6 +127,15 @@ inline Collision kernelShapes() {
   shapes.shapes.push_back(
       {ShapeKind::kCuboid, 0.0, 1.0, glm::dvec3(0.02, -0.16, 0.06), glm::dvec3(0.04), glm::dmat3(1.0), {}});
   return shapes;
+}
+// Their field: a wind hard into the head beside gravity, in a head turning and speeding up.
+inline AccelerationField kernelField() {
+  AccelerationField field;
+  field.base = {-60.0, -9.81, 15.0};
+  field.rotating = true;
+  field.omega = {0.3, 4.0, 0.5};
+  field.alpha = {2.0, 0.0, -1.0};
+  return field;
 }
 inline Strands kernelHair(const std::vector<int>& counts) {
   Strands hair;
