@@ -148,9 +148,10 @@ TEST(Springs, ACurvedHairHoldsItsGroomedShapeUnderGravity) {
 }
 
 // The stretch solve in vectors (8 strands at once, on AVX-512) gives the strand-by-strand step's bits:
-// strands of 1 to 12 points (a block of 8 with mixed counts, some solved in lanes, some alone, and 13
-// strands, not a whole number of blocks), one of 140 segments (past the lanes' limit), pushed hard into
-// an ellipsoid, a sphere and a box (so the collisions and the second solve run) while the head turns.
+// and so does the posing, eight points at a time: strands of 1 to 12 points (a block of 8 with mixed counts,
+// some solved in lanes, some alone, and 13 strands, not a whole number of blocks), one of 140 segments (past
+// the lanes' limit), pushed hard into an ellipsoid, a sphere and a box (so the collisions and the second
+// solve run) while the head turns.
 TEST(Springs, EveryKernelGivesTheSameBits) {
   if (!hasAvx512()) GTEST_SKIP() << "no AVX-512 here: the vector kernel cannot run, only the strands' does";
   const Collision shapes = test::kernelShapes();
@@ -163,21 +164,33 @@ TEST(Springs, EveryKernelGivesTheSameBits) {
   d.damping = 0.5;
   const AccelerationField field = test::kernelField();
   using Kernel = SpringHair::Kernel;
+  Pose turned;  // the posed output too, moved and turned as a head that looks aside
+  turned.rotation = eulerRotation({10.0, 35.0, -5.0});
+  turned.translation = {0.01, -0.02, 0.03};
+  turned.centre = {0.0, 0.1, 0.0};
   auto run = [&](Kernel kernel) {
     SpringHair hair(rest, style, d, shapes, nullptr);
     for (int n = 0; n < 40; ++n) hair.step(field, 1.0 / 96.0, n % 2 == 0, n % 2 == 1, kernel);
-    return std::pair(hair.positions(), hair.velocities());
+    Strands still, posed;
+    hair.posedInto(Pose{}, still, kernel);
+    hair.posedInto(turned, posed, kernel);
+    return std::tuple(hair.positions(), hair.velocities(), still, posed);
   };
-  const auto [x, v] = run(Kernel::kStrands);
+  const auto [x, v, still, posed] = run(Kernel::kStrands);
   double deepest = -1.0;
   for (const glm::dvec3& p : x) deepest = std::max(deepest, penetration(shapes.shapes[0], p));
   EXPECT_GT(deepest, -1e-3) << "the hair must reach the head";
   for (Kernel kernel : {Kernel::kLanes, Kernel::kFastest}) {  // the strands' again without AVX-512
-    const auto [xk, vk] = run(kernel);
+    const auto [xk, vk, stillk, posedk] = run(kernel);
     ASSERT_EQ(xk.size(), x.size());
     for (size_t p = 0; p < x.size(); ++p) {
       ASSERT_EQ(0, std::memcmp(&xk[p], &x[p], sizeof(glm::dvec3))) << "position of point " << p;
       ASSERT_EQ(0, std::memcmp(&vk[p], &v[p], sizeof(glm::dvec3))) << "velocity of point " << p;
+    }
+    for (const auto& [a, b] : {std::pair(&stillk, &still), std::pair(&posedk, &posed)}) {
+      ASSERT_EQ(a->points.size(), x.size());
+      ASSERT_EQ(0, std::memcmp(a->points.data(), b->points.data(), x.size() * sizeof(glm::vec3)));
+      ASSERT_EQ(0, std::memcmp(a->tangents.data(), b->tangents.data(), x.size() * sizeof(glm::vec3)));
     }
   }
 }

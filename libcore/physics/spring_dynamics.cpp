@@ -238,6 +238,10 @@ SpringHair::SpringHair(const Strands& rest, const Hairstyle& style, const Dynami
     }
     for (size_t level = 0; level < targets_.size(); ++level) startEnergy_.push_back(densityEnergy(level));
   }
+  // posedInto writes the points and tangents (xRest_ and restTangents_ keep the rest's), so that handing
+  // every other attribute to a frame's guides copies no points.
+  rest_.points = {};
+  rest_.tangents = {};
 }
 
 std::vector<glm::vec3> SpringHair::floatPoints() const {
@@ -323,6 +327,54 @@ void SpringHair::factor(double dt) {
       inverseD_[p0 + i] = 1.0 / dd[i];
       lower1_[p0 + i] = l1[i];
       lower2_[p0 + i] = l2[i];
+    }
+  });
+  if (available(Kernel::kFastest) == Kernel::kLanes) buildLanePoints();
+}
+
+size_t SpringHair::blockLanes(size_t s0, size_t* lanes, uint32_t& n) const {
+  const size_t end = std::min(s0 + kLanes, rest_.strandCount());
+  size_t count = 0;
+  n = 0;
+  for (size_t s = s0; s < end; ++s) {
+    if (rest_.pointsOf(s) < 2) continue;
+    if (n == 0) n = rest_.pointsOf(s) - 1;
+    if (rest_.pointsOf(s) - 1 == n && n <= kMaxLaneSegments) lanes[count++] = s;
+  }
+  return count;
+}
+
+void SpringHair::buildLanePoints() {
+  const size_t blocks = (rest_.strandCount() + kLanes - 1) / kLanes;
+  laneFirst_.assign(blocks + 1, 0);
+  for (size_t b = 0; b < blocks; ++b) {
+    size_t lanes[kLanes];
+    uint32_t n;
+    laneFirst_[b + 1] = laneFirst_[b] + (blockLanes(b * kLanes, lanes, n) ? n + 1 : 0);
+  }
+  lanePoints_.resize(laneFirst_.back());
+  tbb::parallel_for(size_t(0), blocks, [&](size_t b) {
+    size_t lanes[kLanes];
+    uint32_t n;
+    const size_t count = blockLanes(b * kLanes, lanes, n);
+    for (size_t l = 0; l < kLanes && count; ++l) {
+      const uint32_t p0 = rest_.firstPoint[lanes[l < count ? l : 0]];
+      for (uint32_t j = 0; j <= n; ++j) {
+        LanePoint& to = lanePoints_[laneFirst_[b] + j];
+        const uint32_t p = p0 + j;
+        to.mass[l] = mass_[p];
+        to.inverseMass[l] = inverseMass_[p];
+        to.length[l] = length_[p];
+        to.compliance[l] = compliance_[p];
+        to.restTension[l] = restTension_[p];
+        to.bend[l] = bend_[p];
+        to.lower1[l] = lower1_[p];
+        to.lower2[l] = lower2_[p];
+        to.inverseD[l] = inverseD_[p];
+        to.twistLength[l] = twistLength_[p];
+        to.twistCompliance[l] = twistCompliance_[p];
+        for (int c = 0; c < 3; ++c) to.target[c][l] = target_[p][c];
+      }
     }
   });
 }
@@ -471,19 +523,19 @@ bool SpringHair::constrain(size_t s, double dt) {
     x_[b] += inverseMass_[b] * dl * e / len;
   }
   bool moved = twisted;
-  for (size_t c = 0; c < shapes_.size(); ++c) {
+  for (size_t c = 0; c < shapes_.size(); ++c)
     for (uint32_t i = 1; i <= n; ++i) {
-      const uint32_t p = p0 + i;
-      const glm::dvec3 v = x_[p] - shapes_[c].centre;
-      if (glm::dot(v, v) >= shapeReach2_[c]) continue;
-      const double inside = penetration(shapes_[c], x_[p]), allowed = restDepth_[c][p];
-      if (inside > allowed + 1e-9) {
-        x_[p] = pushedOut(shapes_[c], x_[p], inside, allowed);
-        moved = true;
-      }
+      const glm::dvec3 v = x_[p0 + i] - shapes_[c].centre;
+      if (glm::dot(v, v) < shapeReach2_[c]) moved = collide(c, p0 + i, x_[p0 + i]) || moved;
     }
-  }
   return moved;
+}
+
+bool SpringHair::collide(size_t c, uint32_t p, glm::dvec3& x) const {
+  const double inside = penetration(shapes_[c], x), allowed = restDepth_[c][p];
+  if (!(inside > allowed + 1e-9)) return false;
+  x = pushedOut(shapes_[c], x, inside, allowed);
+  return true;
 }
 
 void SpringHair::finish(size_t s, double dt, const glm::dvec3* before) {
@@ -510,29 +562,33 @@ void SpringHair::stepStrand(size_t s, const AccelerationField& field, double dt)
 }
 
 void SpringHair::stepBlock(size_t s0, const AccelerationField& field, double dt) {
-  // stepStrand for the block's strands of one segment count together (the first such strand's), their
-  // stretch solved in vectors; any other strand on its own.
-  const size_t end = std::min(s0 + kLanes, rest_.strandCount());
-  size_t lanes[kLanes], count = 0;
-  uint32_t n = 0;
-  for (size_t s = s0; s < end; ++s) {
-    if (rest_.pointsOf(s) < 2) continue;
-    if (count == 0) n = rest_.pointsOf(s) - 1;
-    if (rest_.pointsOf(s) - 1 == n && n <= kMaxLaneSegments)
-      lanes[count++] = s;
-    else
+  // stepStrand for the block's lanes together, their predict and stretch solves in vectors; any other
+  // strand on its own.
+  size_t lanes[kLanes];
+  uint32_t n;
+  const size_t count = blockLanes(s0, lanes, n);
+  for (size_t s = s0, l = 0; s < std::min(s0 + kLanes, rest_.strandCount()); ++s) {
+    if (l < count && lanes[l] == s)
+      ++l;
+    else if (rest_.pointsOf(s) >= 2)
       stepStrand(s, field, dt);
   }
   if (count == 0) return;
+  const size_t block = s0 / kLanes;
+  bool again[kLanes] = {};
+  std::fill(again, again + count, true);
+  if (difference_.empty() || !(densityStrength_ > 0.0)) {
+    stepLanes(block, lanes, count, n, field, dt);
+    return;
+  }
+  // With density targeting: its forces strand by strand.
   thread_local std::vector<glm::dvec3> before;
   before.resize(kLanes * (n + 1));
   for (size_t l = 0; l < count; ++l) predict(lanes[l], field, dt, &before[l * (n + 1)]);
-  bool again[kLanes] = {};
-  std::fill(again, again + count, true);
-  projectStretchLanes(lanes, count, n, dt, again);
+  projectStretchLanes(block, lanes, count, n, dt, again);
   bool any = false;
   for (size_t l = 0; l < count; ++l) any = (again[l] = constrain(lanes[l], dt)) || any;
-  if (any) projectStretchLanes(lanes, count, n, dt, again);
+  if (any) projectStretchLanes(block, lanes, count, n, dt, again);
   for (size_t l = 0; l < count; ++l) finish(lanes[l], dt, &before[l * (n + 1)]);
 }
 
@@ -582,13 +638,24 @@ Strands SpringHair::posed(const Pose& pose) const {
   return out;
 }
 
-void SpringHair::posedInto(const Pose& pose, Strands& out) const {
+void SpringHair::posedInto(const Pose& pose, Strands& out, Kernel kernel) const {
   out.assignRestKeepingBuffers(rest_);  // every attribute but the points and tangents is the rest's
-  const bool still = pose.isIdentity();
+  const bool still = pose.isIdentity(), lanes = available(kernel) == Kernel::kLanes;
   tbb::parallel_for(size_t(0), rest_.strandCount(), [&](size_t s) {
     const uint32_t p0 = rest_.firstPoint[s], count = rest_.pointsOf(s);
+    uint32_t j = 0;
+    if (lanes && count > kLanes) {  // eight at a time while each point starts a segment (the last
+                                    // eight overlapping the ones before)
+      for (; j + kLanes < count; j += kLanes) poseEightLanes(s, j, pose, out);
+      if (j + 1 < count) poseEightLanes(s, count - 1 - kLanes, pose, out);
+      j = count - 1;
+    }
     glm::dvec3 restDir(0.0), dir(0.0);
-    for (uint32_t j = 0; j < count; ++j) {
+    if (j > 0) {
+      restDir = restUnit_[p0 + j - 1];
+      dir = glm::normalize(x_[p0 + j] - x_[p0 + j - 1]);
+    }
+    for (; j < count; ++j) {
       const uint32_t p = p0 + j;
       // The input point plus the motion: at rest exactly the input.
       // (xRest_ holds the input points exactly, in doubles.)
@@ -615,16 +682,21 @@ std::vector<double> SpringHair::state() const {
 
 void SpringHair::stateInto(std::vector<double>& out) const {
   // Per segment, its end point: the roots are the head's and never move.
+  // (Each strand's first point is its root, so strand s's points after it are segments
+  // firstPoint[s] − s onward.)
   out.resize((x_.size() - rest_.strandCount()) * kStateValues);
-  size_t k = 0;
-  for (size_t p = 0; p < x_.size(); ++p) {
-    if (length_[p] == 0.0) continue;  // a root
-    double* v = &out[kStateValues * k++];
-    for (int c = 0; c < 3; ++c) {
-      v[c] = x_[p][c];
-      v[3 + c] = v_[p][c];
-    }
-  }
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, rest_.strandCount(), 1024),
+                    [&](const tbb::blocked_range<size_t>& r) {
+                      for (size_t s = r.begin(); s != r.end(); ++s) {
+                        const uint32_t p0 = rest_.firstPoint[s], count = rest_.pointsOf(s);
+                        double* v = &out[kStateValues * (p0 - s)];
+                        for (uint32_t p = p0 + 1; p < p0 + count; ++p, v += kStateValues)
+                          for (int c = 0; c < 3; ++c) {
+                            v[c] = x_[p][c];
+                            v[3 + c] = v_[p][c];
+                          }
+                      }
+                    });
 }
 
 void SpringHair::restore(const std::vector<double>& state, const std::string& source) {

@@ -86,8 +86,8 @@ class SpringHair {
 
   // One substep of `dt` seconds for every strand. At the first substep of a frame the density spacing
   // is chosen; after the last (`lastSubstep`) the velocities are smoothed by VelocitySmoothing.
-  // How a substep is computed; each gives the same bits. kStrands: strand by strand. kLanes: the stretch
-  // solve of kLanes strands at once in AVX-512 vectors, where the processor has it (else kStrands).
+  // How a substep is computed; each gives the same bits. kStrands: strand by strand. kLanes: kLanes
+  // strands at once in AVX-512 vectors (spring_lanes.cpp), where the processor has it (else kStrands).
   // kFastest: kLanes.
   enum class Kernel { kFastest, kStrands, kLanes };
   static constexpr size_t kLanes = 8;
@@ -102,7 +102,8 @@ class SpringHair {
   // The hair in world coordinates: the head frame moved by `pose`. At rest the input points exactly;
   // tangents are the input's turned with their segment.
   Strands posed(const Pose& pose) const;
-  void posedInto(const Pose& pose, Strands& out) const;
+  // (kLanes: each strand's points eight at a time in vectors, the same bits.)
+  void posedInto(const Pose& pose, Strands& out, Kernel kernel = Kernel::kFastest) const;
 
   // What a restart needs: per segment, its end point's position and velocity in the head's frame
   // (kStateValues doubles; the roots are the head's); and the inverse.
@@ -134,20 +135,43 @@ class SpringHair {
   void stepStrand(size_t strand, const AccelerationField& field, double dt);
   void predict(size_t strand, const AccelerationField& field, double dt, glm::dvec3* before);
   bool constrain(size_t strand, double dt);
+  // Point p at `x` out of collision shape c to the depth it sat at in the rest shape; whether it moved.
+  bool collide(size_t c, uint32_t p, glm::dvec3& x) const;
   void finish(size_t strand, double dt, const glm::dvec3* before);
   // stepStrand for the strands s0 .. s0 + kLanes − 1, the stretch solves in vectors (spring_lanes.cpp)
   // for those of the first one's segment count (at most kMaxLaneSegments).
   void stepBlock(size_t s0, const AccelerationField& field, double dt);
-  // projectStretch(s, dt, 1, zeros) for the `count` strands `strands` (all of n segments) at once, lane
-  // by lane the same bits; only those whose `take` is set.
-  void projectStretchLanes(const size_t* strands, size_t count, uint32_t n, double dt, const bool* take);
+  // The strands of block s0 / kLanes that step in vectors (into `lanes`, their count returned) and their
+  // segment count n: those of the first strand's count (of at least one segment, at most
+  // kMaxLaneSegments). The block's other strands step on their own.
+  size_t blockLanes(size_t s0, size_t* lanes, uint32_t& n) const;
+  // stepStrand for the `count` strands `strands` of block `block` (blockLanes') at once, lane by lane the
+  // same bits. Not with density targeting (its forces are read strand by strand).
+  void stepLanes(size_t block, const size_t* strands, size_t count, uint32_t n,
+                 const AccelerationField& field, double dt);
+  // projectStretch(s, dt, 1, zeros) for those of the strands whose `take` is set.
+  void projectStretchLanes(size_t block, const size_t* strands, size_t count, uint32_t n, double dt,
+                           const bool* take);
+  // posedInto's points j0 .. j0 + 7 of strand s, each of which starts a segment (j0 + 8 < its count).
+  void poseEightLanes(size_t s, uint32_t j0, const Pose& pose, Strands& out) const;
   struct Lanes;
+  // What the vector kernel reads of every point, lane by lane, so it loads a vector where the strands'
+  // own arrays would need eight loads: block by block (laneFirst_), points 0..n of the block's lanes; a
+  // lane without a strand repeats the first lane's. Built by factor() where the processor has AVX-512.
+  struct LanePoint {
+    double mass[kLanes], inverseMass[kLanes], length[kLanes], compliance[kLanes], restTension[kLanes],
+        bend[kLanes], lower1[kLanes], lower2[kLanes], inverseD[kLanes], twistLength[kLanes],
+        twistCompliance[kLanes], target[3][kLanes];
+  };
+  std::vector<LanePoint> lanePoints_;
+  std::vector<size_t> laneFirst_;  // per block its first LanePoint, and their count last
+  void buildLanePoints();
   void factor(double dt);
   void projectStretch(size_t strand, double dt, int iterations, std::vector<double>& lambda);
   std::vector<Grid> densityDifference(size_t level) const;  // D_s − D_t at the current positions
   std::vector<glm::vec3> floatPoints() const;
 
-  Strands rest_;
+  Strands rest_;  // every attribute of the rest guides but their points and tangents
   std::vector<glm::dvec3> xRest_, x_, v_;
   std::vector<double> mass_, inverseMass_;
   // Per segment, indexed by its end point: rest length, stretch compliance l/(E·A) (m/N), rest tension
