@@ -8,10 +8,12 @@
 #include <cstdio>
 #include <limits>
 
+#include <tbb/blocked_range.h>
 #include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
 
 #include "libcore/util/error.h"
+#include "libcore/util/huge_pages.h"
 #include "libcore/util/random.h"
 #include "libcore/util/vectorise.h"
 #include "stages/estimate.h"
@@ -251,8 +253,8 @@ void interpolateInto(const Mesh& wick, const Strands& guides, const Hairstyle& s
   const size_t strands = firstStrand[endTriangle] - strandBase, points = firstPoint[endTriangle] - pointBase;
   // Every array is resized, not made anew: a coupe of the same size (the next frame's) keeps its
   // storage, and every element below is written whatever it held.
-  coupe.points.resize(points);
-  coupe.tangents.resize(points);
+  resizeLarge(coupe.points, points);
+  resizeLarge(coupe.tangents, points);
   coupe.firstPoint.resize(strands + 1);
   coupe.strandId.resize(strands);
   coupe.rootTriangle.resize(strands);

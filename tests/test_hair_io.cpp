@@ -8,6 +8,7 @@
 #include "libcore/io/hair_io.h"
 #include "libcore/util/error.h"
 #include "libcore/util/file_util.h"
+#include "libcore/util/huge_pages.h"
 #include "tests/test_util.h"
 
 namespace hairgen {
@@ -202,6 +203,26 @@ TEST(HairFile, RealCyHairFilesRead) {
   EXPECT_EQ(straight.pointCount(), 160000u);
   Strands bangs = readHair(test::realData() / "hairutil" / "Bangs_100.hair");  // a segments array
   EXPECT_EQ(bangs.strandCount(), 100u);
+}
+
+// The large arrays a cache is read into grow as resize grows them: the old values kept, the new ones
+// zero, past the 8 MiB at which their pages are asked for in 2 MiB and faulted in on every core.
+TEST(HugePages, ResizeLargeKeepsValuesAndZeroesTheRest) {
+  std::vector<glm::vec3> v = {{1.0f, 2.0f, 3.0f}, {4.0f, 5.0f, 6.0f}};
+  const size_t n = (size_t(20) << 20) / sizeof(glm::vec3) + 7;  // 20 MiB, not a whole number of pages
+  resizeLarge(v, n);
+  ASSERT_EQ(v.size(), n);
+  EXPECT_EQ(v[0], glm::vec3(1.0f, 2.0f, 3.0f));
+  EXPECT_EQ(v[1], glm::vec3(4.0f, 5.0f, 6.0f));
+  size_t nonZero = 0;
+  for (size_t i = 2; i < n; ++i) nonZero += v[i] != glm::vec3(0.0f);
+  EXPECT_EQ(nonZero, 0u);
+  v[n - 1] = glm::vec3(7.0f);
+  resizeLarge(v, 3);  // shrinking keeps the first ones
+  EXPECT_EQ(v.size(), 3u);
+  EXPECT_EQ(v[1], glm::vec3(4.0f, 5.0f, 6.0f));
+  resizeLarge(v, n);  // and growing within the capacity zeroes what comes back
+  EXPECT_EQ(v[n - 1], glm::vec3(0.0f));
 }
 
 }  // namespace

@@ -16,6 +16,7 @@
 
 #include "libcore/util/error.h"
 #include "libcore/util/file_util.h"
+#include "libcore/util/huge_pages.h"
 #include "libcore/util/text.h"
 
 namespace hairgen {
@@ -184,7 +185,7 @@ class Reader {
   template <size_t Word, typename T>
   void array(std::vector<T>& v, uint64_t count, uint32_t* crc = nullptr) {
     static_assert(sizeof(T) % Word == 0);
-    v.resize(count);
+    resizeLarge(v, count);
     const size_t n = size_t(count) * sizeof(T);
     bytes(v.data(), n);
     if (crc) *crc = crcOf(*crc, reinterpret_cast<const uint8_t*>(v.data()), n);

@@ -1,0 +1,45 @@
+// Large arrays made fast to first touch: for hundreds of MB (a coupe's points and tangents), faulting
+// in 4 KiB pages one at a time on one thread took longer than filling them.
+#pragma once
+
+#include <sys/mman.h>
+
+#include <cstddef>
+#include <cstdint>
+#include <type_traits>
+#include <vector>
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+namespace hairgen {
+
+// v resized to n. When it grows past 8 MiB, its new storage is asked of the kernel in 2 MiB pages
+// (madvise; only advice: where transparent huge pages are off, it has 4 KiB ones) and faulted in by
+// every core at once before resize fills it. The values are resize's (zeros for new elements, the old
+// ones kept).
+template <class T>
+void resizeLarge(std::vector<T>& v, size_t n) {
+  static_assert(std::is_trivially_copyable_v<T>, "its storage is touched before it holds elements");
+  constexpr size_t kLarge = size_t(8) << 20;
+  if (n > v.capacity() && n * sizeof(T) >= kLarge) {
+    std::vector<T> fresh;
+    fresh.reserve(n);
+    constexpr uintptr_t kHuge = uintptr_t(2) << 20;
+    const uintptr_t begin = (reinterpret_cast<uintptr_t>(fresh.data()) + kHuge - 1) & ~(kHuge - 1);
+    const uintptr_t end = reinterpret_cast<uintptr_t>(fresh.data() + n) & ~(kHuge - 1);
+    if (end > begin) madvise(reinterpret_cast<void*>(begin), end - begin, MADV_HUGEPAGE);
+    // A zero byte in every 4 KiB page of the storage not yet holding elements: its faults (the kernel
+    // clears each page) on every core. (resize writes every byte after.)
+    volatile unsigned char* bytes = reinterpret_cast<unsigned char*>(fresh.data());
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, n * sizeof(T), kHuge),
+                      [&](const tbb::blocked_range<size_t>& r) {
+                        for (size_t b = r.begin(); b < r.end(); b += 4096) bytes[b] = 0;
+                      });
+    fresh.assign(v.begin(), v.end());
+    v.swap(fresh);
+  }
+  v.resize(n);
+}
+
+}  // namespace hairgen
