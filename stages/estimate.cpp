@@ -179,10 +179,11 @@ WorkEstimate estimateSimulate(const Dynamics& d, size_t segments, const FrameRan
   e.stage = "simulate";
   const double steps = double(frames.count()) * double(d.substeps);
   // Per segment: state, rest, constants and a posed copy. Model springs keeps more (bytes): positions,
-  // velocities and rest points in doubles 72, per-point constants and the factored matrix 136, rest
-  // directions and tangents 36, a collision shape's rest depths 8, the vector kernel's lane-by-lane copy
-  // of its constants 128, the smoothing's point lists 120, the posed copy and the restart state 72.
-  e.bytes = bytesOf(double(segments) * (d.model == DynamicsModel::kSprings ? 572.0 : 200.0));
+  // velocities and rest points in doubles 72, per-point constants (eight numbers and the bending target)
+  // and the factored matrix 112, rest directions and tangents 36, a collision shape's rest depths 8,
+  // the vector kernel's lane-by-lane copy of its constants 112, the smoothing's point lists 120, the
+  // posed copy and the restart state 72.
+  e.bytes = bytesOf(double(segments) * (d.model == DynamicsModel::kSprings ? 532.0 : 200.0));
   const double perStep = d.model == DynamicsModel::kSprings ? kSecondsPerSpringStep : kSecondsPerSegmentStep;
   e.seconds = double(segments) * steps * perStep / cores(threads);
   e.memoryKey = "the guides' size";

@@ -8,7 +8,6 @@
 #include <cstdio>
 #include <limits>
 
-#include <tbb/blocked_range.h>
 #include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
 

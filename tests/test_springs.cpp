@@ -147,11 +147,11 @@ TEST(Springs, ACurvedHairHoldsItsGroomedShapeUnderGravity) {
   EXPECT_GT(worst(), 1e-3);
 }
 
-// The stretch solve in vectors (8 strands at once, on AVX-512) gives the strand-by-strand step's bits:
-// and so does the posing, eight points at a time: strands of 1 to 12 points (a block of 8 with mixed counts,
-// some solved in lanes, some alone, and 13 strands, not a whole number of blocks), one of 140 segments (past
-// the lanes' limit), pushed hard into an ellipsoid, a sphere and a box (so the collisions and the second
-// solve run) while the head turns.
+// The substep in vectors (8 strands at once, on AVX-512) gives the strand-by-strand step's bits, and so
+// does the posing, eight points at a time: strands of 1 to 12 points (a block of 8 with mixed counts,
+// some stepped in lanes, some alone, and 13 strands, not a whole number of blocks), one of 140 segments
+// (past the lanes' limit), pushed hard into an ellipsoid, a sphere and a box (so the collisions and the
+// second solve run) while the head turns.
 TEST(Springs, EveryKernelGivesTheSameBits) {
   if (!hasAvx512()) GTEST_SKIP() << "no AVX-512 here: the vector kernel cannot run, only the strands' does";
   const Collision shapes = test::kernelShapes();
@@ -192,6 +192,64 @@ TEST(Springs, EveryKernelGivesTheSameBits) {
       ASSERT_EQ(0, std::memcmp(a->points.data(), b->points.data(), x.size() * sizeof(glm::vec3)));
       ASSERT_EQ(0, std::memcmp(a->tangents.data(), b->tangents.data(), x.size() * sizeof(glm::vec3)));
     }
+  }
+}
+
+// The same on curled hair, whose twist springs act (planar strands have none): two full blocks of
+// helices of 20 points hanging from around the crown, one rooted at −0 in x and z (a root never moves,
+// so its bits stay), and the same hair drawn toward a density target, whose forces are read strand by
+// strand before the stretch solve in lanes.
+TEST(Springs, EveryKernelGivesTheSameBitsOnCurls) {
+  if (!hasAvx512()) GTEST_SKIP() << "no AVX-512 here: the vector kernel cannot run, only the strands' does";
+  Strands rest, target;
+  for (int s = 0; s < 16; ++s) {
+    const double around = glm::radians(22.5 * s);
+    const glm::dvec3 root = s == 0 ? glm::dvec3(-0.0, 0.125, -0.0)
+                                   : glm::dvec3(0.05 * std::cos(around), 0.115, 0.05 * std::sin(around));
+    std::vector<glm::vec3> points, shifted;
+    for (int j = 0; j < 20; ++j) {
+      const double turn = 0.9 * j + around;
+      const glm::dvec3 p =
+          root + glm::dvec3(0.008 * (std::cos(turn) - std::cos(around)) + 0.004 * j * std::cos(around),
+                            -0.006 * j,
+                            0.008 * (std::sin(turn) - std::sin(around)) + 0.004 * j * std::sin(around));
+      points.push_back(glm::vec3(j == 0 ? root : p));  // (−0 + 0 would be +0)
+      shifted.push_back(glm::vec3(p + glm::dvec3(0.03, 0.0, 0.0) * (double(j) / 19.0)));
+    }
+    rest.addStrand(points);
+    target.addStrand(shifted);
+  }
+  ASSERT_TRUE(std::signbit(rest.points[0].x) && std::signbit(rest.points[0].z));
+  Hairstyle style;
+  style.gravity = 9.81;
+  const AccelerationField field = test::kernelField();
+  using Kernel = SpringHair::Kernel;
+  for (const bool density : {false, true}) {
+    Dynamics d = springs();
+    d.damping = 0.5;
+    if (density) {
+      d.densityStrength = 5.0;
+      d.densitySpacings = {0.01};
+    }
+    auto run = [&](Kernel kernel, bool* twisted) {
+      SpringHair hair(rest, style, d, test::kernelShapes(), density ? &target : nullptr);
+      const std::vector<glm::dvec3> start = hair.positions();
+      for (int n = 0; n < 40; ++n) hair.step(field, 1.0 / 96.0, n % 2 == 0, n % 2 == 1, kernel);
+      if (twisted) *twisted = hair.positions() != start;
+      return std::pair(hair.positions(), hair.velocities());
+    };
+    bool moved = false;
+    const auto [x, v] = run(Kernel::kStrands, &moved);
+    EXPECT_TRUE(moved);
+    const auto [xk, vk] = run(Kernel::kLanes, nullptr);
+    ASSERT_EQ(xk.size(), x.size());
+    for (size_t p = 0; p < x.size(); ++p) {
+      ASSERT_EQ(0, std::memcmp(&xk[p], &x[p], sizeof(glm::dvec3)))
+          << "position of point " << p << (density ? " (density)" : "");
+      ASSERT_EQ(0, std::memcmp(&vk[p], &v[p], sizeof(glm::dvec3)))
+          << "velocity of point " << p << (density ? " (density)" : "");
+    }
+    EXPECT_TRUE(std::signbit(x[0].x) && std::signbit(x[0].z)) << "the root at −0 stays there";
   }
 }
 

@@ -126,6 +126,8 @@ SpringHair::SpringHair(const Strands& rest, const Hairstyle& style, const Dynami
   const double lineDensity = style.massDensity * M_PI * style.hairRadius1 * style.hairRadius2;  // kg/m
   const glm::dvec3 load(0.0, -dynamicsGravity(style, dynamics), 0.0);
   for (size_t s = 0; s < strands; ++s) {
+    // (The restart state counts a strand's segments from its first point, its root.)
+    if (rest.pointsOf(s) == 0) throw InputError("guide " + std::to_string(s) + " has no points");
     const uint32_t p0 = rest.firstPoint[s], n = rest.pointsOf(s) - 1;  // n segments
     if (rest.pointsOf(s) < 2) continue;
     for (uint32_t j = 1; j <= n; ++j) {
@@ -519,7 +521,7 @@ bool SpringHair::constrain(size_t s, double dt) {
     const double len = glm::length(e);
     const double wsum = inverseMass_[a] + inverseMass_[b] + twistCompliance_[a] / (dt * dt);
     const double dl = -(len - twistLength_[a]) / wsum;
-    x_[a] -= inverseMass_[a] * dl * e / len;
+    if (inverseMass_[a] > 0.0) x_[a] -= inverseMass_[a] * dl * e / len;  // a root stays where it is
     x_[b] += inverseMass_[b] * dl * e / len;
   }
   bool moved = twisted;

@@ -138,8 +138,8 @@ class SpringHair {
   // Point p at `x` out of collision shape c to the depth it sat at in the rest shape; whether it moved.
   bool collide(size_t c, uint32_t p, glm::dvec3& x) const;
   void finish(size_t strand, double dt, const glm::dvec3* before);
-  // stepStrand for the strands s0 .. s0 + kLanes − 1, the stretch solves in vectors (spring_lanes.cpp)
-  // for those of the first one's segment count (at most kMaxLaneSegments).
+  // stepStrand for the strands s0 .. s0 + kLanes − 1: those of the first one's segment count (at most
+  // kMaxLaneSegments) together in vectors (spring_lanes.cpp), the others on their own.
   void stepBlock(size_t s0, const AccelerationField& field, double dt);
   // The strands of block s0 / kLanes that step in vectors (into `lanes`, their count returned) and their
   // segment count n: those of the first strand's count (of at least one segment, at most
@@ -157,7 +157,8 @@ class SpringHair {
   struct Lanes;
   // What the vector kernel reads of every point, lane by lane, so it loads a vector where the strands'
   // own arrays would need eight loads: block by block (laneFirst_), points 0..n of the block's lanes; a
-  // lane without a strand repeats the first lane's. Built by factor() where the processor has AVX-512.
+  // lane without a strand repeats the first lane's (112 bytes a point in a full block). Built by
+  // factor() where the processor has AVX-512.
   struct LanePoint {
     double mass[kLanes], inverseMass[kLanes], length[kLanes], compliance[kLanes], restTension[kLanes],
         bend[kLanes], lower1[kLanes], lower2[kLanes], inverseD[kLanes], twistLength[kLanes],

@@ -26,6 +26,8 @@ using namespace lanes;
 static_assert(SpringHair::kLanes == kLaneWidth);
 
 struct SpringHair::Lanes {
+  // A block's arrays live on the stack, sized for the longest lane strand: about 210 KB for a step
+  // (-fstack-usage), well inside TBB's 4 MB worker stacks; a strand of n segments touches n + 2 of each.
   static constexpr size_t kMost = kMaxLaneSegments + 2;
   static constexpr uint32_t kAhead = 4;  // points
   // A block's lanes: the points and what the stretch solve reads of them.
@@ -235,7 +237,7 @@ void SpringHair::Lanes::constrain(const SpringHair& hair, size_t block, size_t c
     const Vd len = sqrt(dot(e, e));
     const Vd wsum = ia + ib + compliance / dt2;
     const Vd dl = -(len - load(at[i].twistLength)) / wsum;
-    x[i] = select(spring, x[i] - ((ia * dl) * e) / len, x[i]);
+    x[i] = select(spring & (ia > 0.0), x[i] - ((ia * dl) * e) / len, x[i]);  // a root stays
     x[i + 3] = select(spring, x[i + 3] + ((ib * dl) * e) / len, x[i + 3]);
   }
   for (size_t c = 0; c < hair.shapes_.size(); ++c) {

@@ -30,7 +30,9 @@ void resizeLarge(std::vector<T>& v, size_t n) {
     const uintptr_t end = reinterpret_cast<uintptr_t>(fresh.data() + n) & ~(kHuge - 1);
     if (end > begin) madvise(reinterpret_cast<void*>(begin), end - begin, MADV_HUGEPAGE);
     // A zero byte in every 4 KiB page of the storage not yet holding elements: its faults (the kernel
-    // clears each page) on every core. (resize writes every byte after.)
+    // clears each page) on every core. This writes past size() into reserved storage, which holds no
+    // objects yet: fine for a trivially copyable T, whose bytes assign and resize then write whole (a
+    // checked vector, as _GLIBCXX_SANITIZE_VECTOR makes, would call it an overflow).
     volatile unsigned char* bytes = reinterpret_cast<unsigned char*>(fresh.data());
     tbb::parallel_for(tbb::blocked_range<size_t>(0, n * sizeof(T), kHuge),
                       [&](const tbb::blocked_range<size_t>& r) {

@@ -53,9 +53,10 @@ typename GridOf<T>::Sample GridOf<T>::sample(const glm::dvec3& p) const {
   if (size.x < 2 || size.y < 2 || size.z < 2)
     return trilinear<Sample>(*this, p, [&](int i, int j, int k) { return Sample(at(i, j, k)); });
   // trilinear's operations in its order, with the cell found once: g < size − 1, so the cell's far
-  // corners are inside the grid and need no clamp.
+  // corners are inside the grid and need no clamp (the min only matters past 2²⁴ nodes an axis, where
+  // size − 1 − 1e-9 rounds to size − 1).
   const glm::dvec3 g = glm::clamp((p - origin) / voxel, glm::dvec3(0.0), glm::dvec3(size - 1) - 1e-9);
-  const glm::ivec3 c = glm::ivec3(glm::floor(g));
+  const glm::ivec3 c = glm::min(glm::ivec3(glm::floor(g)), size - 2);
   const glm::dvec3 f = g - glm::dvec3(c);
   const size_t row = size_t(size.x), slab = row * size_t(size.y);
   const T* corner = &values[index(c.x, c.y, c.z)];
