@@ -339,9 +339,10 @@ size_t SpringHair::blockLanes(size_t s0, size_t* lanes, uint32_t& n) const {
   size_t count = 0;
   n = 0;
   for (size_t s = s0; s < end; ++s) {
-    if (rest_.pointsOf(s) < 2) continue;
-    if (n == 0) n = rest_.pointsOf(s) - 1;
-    if (rest_.pointsOf(s) - 1 == n && n <= kMaxLaneSegments) lanes[count++] = s;
+    const uint32_t segments = rest_.pointsOf(s) - 1;
+    if (rest_.pointsOf(s) < 2 || segments > kMaxLaneSegments) continue;
+    if (n == 0) n = segments;
+    if (segments == n) lanes[count++] = s;
   }
   return count;
 }
@@ -564,8 +565,7 @@ void SpringHair::stepStrand(size_t s, const AccelerationField& field, double dt)
 }
 
 void SpringHair::stepBlock(size_t s0, const AccelerationField& field, double dt) {
-  // stepStrand for the block's lanes together, their predict and stretch solves in vectors; any other
-  // strand on its own.
+  // stepStrand for the block's lanes together, in vectors; any other strand on its own.
   size_t lanes[kLanes];
   uint32_t n;
   const size_t count = blockLanes(s0, lanes, n);

@@ -142,8 +142,8 @@ class SpringHair {
   // kMaxLaneSegments) together in vectors (spring_lanes.cpp), the others on their own.
   void stepBlock(size_t s0, const AccelerationField& field, double dt);
   // The strands of block s0 / kLanes that step in vectors (into `lanes`, their count returned) and their
-  // segment count n: those of the first strand's count (of at least one segment, at most
-  // kMaxLaneSegments). The block's other strands step on their own.
+  // segment count n: those with as many segments as the block's first strand of 1 to kMaxLaneSegments.
+  // The block's other strands step on their own.
   size_t blockLanes(size_t s0, size_t* lanes, uint32_t& n) const;
   // stepStrand for the `count` strands `strands` of block `block` (blockLanes') at once, lane by lane the
   // same bits. Not with density targeting (its forces are read strand by strand).
