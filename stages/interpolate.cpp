@@ -10,6 +10,7 @@
 
 #include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
+#include <tbb/parallel_invoke.h>
 
 #include "libcore/util/error.h"
 #include "libcore/util/huge_pages.h"
@@ -252,8 +253,9 @@ void interpolateInto(const Mesh& wick, const Strands& guides, const Hairstyle& s
   const size_t strands = firstStrand[endTriangle] - strandBase, points = firstPoint[endTriangle] - pointBase;
   // Every array is resized, not made anew: a coupe of the same size (the next frame's) keeps its
   // storage, and every element below is written whatever it held.
-  resizeLarge(coupe.points, points);
-  resizeLarge(coupe.tangents, points);
+  // (The two large arrays at once: resize fills each on one thread.)
+  tbb::parallel_invoke([&] { resizeLarge(coupe.points, points); },
+                       [&] { resizeLarge(coupe.tangents, points); });
   coupe.firstPoint.resize(strands + 1);
   coupe.strandId.resize(strands);
   coupe.rootTriangle.resize(strands);
