@@ -1,7 +1,10 @@
 #include "libcore/render/gl_resources.h"
 
+#include <sys/mman.h>
+
 #include <algorithm>
 #include <cstdio>
+#include <cstring>
 #include <limits>
 #include <utility>
 
@@ -192,7 +195,24 @@ void Framebuffer::bind() const {
 
 Buffer::Buffer(const void* data, size_t bytes) {
   glCreateBuffers(1, &id);
-  glNamedBufferStorage(id, static_cast<GLsizeiptr>(std::max<size_t>(bytes, 4)), bytes ? data : nullptr, 0);
+  constexpr size_t kLarge = size_t(8) << 20;
+  if (!data || bytes < kLarge) {
+    glNamedBufferStorage(id, static_cast<GLsizeiptr>(std::max<size_t>(bytes, 4)), bytes ? data : nullptr, 0);
+    return;
+  }
+  // A coupe's points and tangents (hundreds of MB): copied through a mapping, so the driver's fresh
+  // memory can be asked for in 2 MiB pages first (llvmpipe faulted it in 4 KiB at a time, most of the
+  // upload). Only advice: a GPU driver's mapping may refuse it, and the copy is the same.
+  glNamedBufferStorage(id, static_cast<GLsizeiptr>(bytes), nullptr, GL_MAP_WRITE_BIT);
+  void* to = glMapNamedBufferRange(id, 0, static_cast<GLsizeiptr>(bytes),
+                                   GL_MAP_WRITE_BIT | GL_MAP_INVALIDATE_BUFFER_BIT);
+  if (!to) renderFailure("could not map a buffer of " + std::to_string(bytes) + " bytes to fill it");
+  constexpr uintptr_t kHuge = uintptr_t(2) << 20;
+  const uintptr_t begin = (reinterpret_cast<uintptr_t>(to) + kHuge - 1) & ~(kHuge - 1);
+  const uintptr_t end = (reinterpret_cast<uintptr_t>(to) + bytes) & ~(kHuge - 1);
+  if (end > begin) madvise(reinterpret_cast<void*>(begin), end - begin, MADV_HUGEPAGE);
+  std::memcpy(to, data, bytes);
+  if (!glUnmapNamedBuffer(id)) renderFailure("a buffer's contents were lost while it was filled");
 }
 
 Buffer::~Buffer() {
