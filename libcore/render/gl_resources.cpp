@@ -1,7 +1,5 @@
 #include "libcore/render/gl_resources.h"
 
-#include <sys/mman.h>
-
 #include <algorithm>
 #include <cstdio>
 #include <cstring>
@@ -13,6 +11,7 @@
 #include "libcore/render/custom_shaders.h"
 #include "libcore/render/shader_interface.h"
 #include "libcore/util/error.h"
+#include "libcore/util/huge_pages.h"
 
 namespace hairgen {
 
@@ -207,10 +206,7 @@ Buffer::Buffer(const void* data, size_t bytes) {
   void* to = glMapNamedBufferRange(id, 0, static_cast<GLsizeiptr>(bytes),
                                    GL_MAP_WRITE_BIT | GL_MAP_INVALIDATE_BUFFER_BIT);
   if (!to) renderFailure("could not map a buffer of " + std::to_string(bytes) + " bytes to fill it");
-  constexpr uintptr_t kHuge = uintptr_t(2) << 20;
-  const uintptr_t begin = (reinterpret_cast<uintptr_t>(to) + kHuge - 1) & ~(kHuge - 1);
-  const uintptr_t end = (reinterpret_cast<uintptr_t>(to) + bytes) & ~(kHuge - 1);
-  if (end > begin) madvise(reinterpret_cast<void*>(begin), end - begin, MADV_HUGEPAGE);
+  adviseHugePages(to, bytes);
   std::memcpy(to, data, bytes);
   if (!glUnmapNamedBuffer(id)) renderFailure("a buffer's contents were lost while it was filled");
 }

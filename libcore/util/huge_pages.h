@@ -14,6 +14,17 @@
 
 namespace hairgen {
 
+constexpr size_t kHugePage = size_t(2) << 20;  // bytes, x86-64's transparent huge page
+
+// Asks the kernel to back the whole 2 MiB pages within [data, data + bytes) with huge pages (madvise;
+// only advice: where transparent huge pages are off, or the memory is a device's, nothing changes).
+inline void adviseHugePages(void* data, size_t bytes) {
+  constexpr uintptr_t kHuge = kHugePage;
+  const uintptr_t begin = (reinterpret_cast<uintptr_t>(data) + kHuge - 1) & ~(kHuge - 1);
+  const uintptr_t end = (reinterpret_cast<uintptr_t>(data) + bytes) & ~(kHuge - 1);
+  if (end > begin) madvise(reinterpret_cast<void*>(begin), end - begin, MADV_HUGEPAGE);
+}
+
 // v resized to n. When it grows past 8 MiB, its new storage is asked of the kernel in 2 MiB pages
 // (madvise; only advice: where transparent huge pages are off, it has 4 KiB ones) and faulted in by
 // every core at once before resize fills it. The values are resize's (zeros for new elements, the old
@@ -25,16 +36,13 @@ void resizeLarge(std::vector<T>& v, size_t n) {
   if (n > v.capacity() && n * sizeof(T) >= kLarge) {
     std::vector<T> fresh;
     fresh.reserve(n);
-    constexpr uintptr_t kHuge = uintptr_t(2) << 20;
-    const uintptr_t begin = (reinterpret_cast<uintptr_t>(fresh.data()) + kHuge - 1) & ~(kHuge - 1);
-    const uintptr_t end = reinterpret_cast<uintptr_t>(fresh.data() + n) & ~(kHuge - 1);
-    if (end > begin) madvise(reinterpret_cast<void*>(begin), end - begin, MADV_HUGEPAGE);
+    adviseHugePages(fresh.data(), n * sizeof(T));
     // A zero byte in every 4 KiB page of the storage not yet holding elements: its faults (the kernel
     // clears each page) on every core. This writes past size() into reserved storage, which holds no
     // objects yet: fine for a trivially copyable T, whose bytes assign and resize then write whole (a
     // checked vector, as _GLIBCXX_SANITIZE_VECTOR makes, would call it an overflow).
     volatile unsigned char* bytes = reinterpret_cast<unsigned char*>(fresh.data());
-    tbb::parallel_for(tbb::blocked_range<size_t>(0, n * sizeof(T), kHuge),
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, n * sizeof(T), kHugePage),
                       [&](const tbb::blocked_range<size_t>& r) {
                         for (size_t b = r.begin(); b < r.end(); b += 4096) bytes[b] = 0;
                       });
