@@ -11,6 +11,7 @@
 #include <tbb/parallel_reduce.h>
 
 #include "libcore/physics/strand_energy.h"
+#include "libcore/physics/tridiagonal.h"
 #include "libcore/util/error.h"
 
 namespace hairgen {
@@ -434,16 +435,7 @@ void SpringHair::projectStretch(size_t s, double dt, int iterations, std::vector
     }
     if (it >= iterations && worst <= kStretchTolerance) break;
     for (uint32_t j = 1; j < n; ++j) upper[j] = -inverseMass_[p0 + j] * glm::dot(u[j], u[j + 1]);
-    // Thomas: forward elimination, back substitution; one division a row.
-    inverseDiag[1] = 1.0 / diag[1];
-    for (uint32_t j = 2; j <= n; ++j) {
-      const double m = upper[j - 1] * inverseDiag[j - 1];
-      diag[j] -= m * upper[j - 1];
-      rhs[j] -= m * rhs[j - 1];
-      inverseDiag[j] = 1.0 / diag[j];
-    }
-    rhs[n] *= inverseDiag[n];
-    for (uint32_t j = n - 1; j >= 1; --j) rhs[j] = (rhs[j] - upper[j] * rhs[j + 1]) * inverseDiag[j];
+    solveTridiagonal(upper.data(), diag.data(), rhs.data(), inverseDiag.data(), n);
     for (uint32_t j = 1; j <= n; ++j) {
       lambda[j] += rhs[j];
       const double next = j < n ? rhs[j + 1] : 0.0;

@@ -13,6 +13,7 @@
 
 #include "libcore/physics/lanes.h"
 #include "libcore/physics/spring_dynamics.h"
+#include "libcore/physics/tridiagonal.h"
 
 // Everything below runs on AVX-512 only (the dispatch in spring_dynamics.cpp checks the processor), and is
 // built for it whole: GCC 12 fails (an internal compiler error) on this file's vector masks when they are
@@ -292,15 +293,7 @@ void SpringHair::Lanes::projectStretch(uint32_t n, double dt, Block& b) {
     for (size_t l = 0; l < w; ++l) all = all && done[l] > 0.0;
     if (all) break;
     for (uint32_t j = 1; j < n; ++j) upper[j] = -inverseMass[j] * dot(u[j], u[j + 1]);
-    inverseDiag[1] = 1.0 / diag[1];
-    for (uint32_t j = 2; j <= n; ++j) {
-      const Vd m = upper[j - 1] * inverseDiag[j - 1];
-      diag[j] -= m * upper[j - 1];
-      rhs[j] -= m * rhs[j - 1];
-      inverseDiag[j] = 1.0 / diag[j];
-    }
-    rhs[n] *= inverseDiag[n];
-    for (uint32_t j = n - 1; j >= 1; --j) rhs[j] = (rhs[j] - upper[j] * rhs[j + 1]) * inverseDiag[j];
+    solveTridiagonal(upper, diag, rhs, inverseDiag, n);
     const Vm keep = done > 0.0;
     for (uint32_t j = 1; j <= n; ++j) {
       lambda[j] = select(keep, lambda[j], lambda[j] + rhs[j]);
