@@ -33,6 +33,14 @@ SegmentFrame frameFor(const glm::dvec3& rest) {
   return {rest, pole, glm::cross(pole, rest)};
 }
 
+// The direction at angles (θ, φ) in frame b.
+glm::dvec3 directionAt(const SegmentFrame& b, double theta, double phi) {
+  double st, ct, sp, cp;
+  sinCos(theta, st, ct);
+  sinCos(phi, sp, cp);
+  return ct * (cp * b.rest + sp * b.side) + st * b.pole;
+}
+
 // The (θ, φ) of unit `dir` nearest to a segment's previous angles: past the pole the same direction is
 // (±π − θ, φ + π), and φ is unwrapped, so the recurrences see no jump.
 void anglesNear(const SegmentFrame& b, const glm::dvec3& dir, double& theta, double& phi) {
@@ -142,8 +150,8 @@ AnjyoHair::AnjyoHair(const Strands& rest, const Hairstyle& style, const Dynamics
   firstSegment_.assign(strands + 1, 0);
   for (size_t s = 0; s < strands; ++s)
     firstSegment_[s + 1] = firstSegment_[s] + std::max(rest.pointsOf(s), 1u) - 1;
-  const size_t segments = firstSegment_.back();
-  segments_.resize(segments);
+  // Each segment's values, laid out lane by lane once they are all known (lanes_).
+  std::vector<Segment> segments(firstSegment_.back());
   // Blocks of kLanes strands for stepLanes, each as long as its longest strand.
   const size_t blocks = (strands + kLanes - 1) / kLanes;
   blockFirst_.assign(blocks + 1, 0);
@@ -177,7 +185,7 @@ AnjyoHair::AnjyoHair(const Strands& rest, const Hairstyle& style, const Dynamics
       if (!(d > 0.0))
         throw InputError("guide " + std::to_string(s) + " has two points at the same place (points " +
                          std::to_string(j) + " and " + std::to_string(j + 1) + "); a segment needs a length");
-      Segment& segment = segments_[firstSegment_[s] + j];
+      Segment& segment = segments[firstSegment_[s] + j];
       segment.frame = frameFor((b - a) / d);
       segment.length = d;
       total += d;
@@ -189,14 +197,14 @@ AnjyoHair::AnjyoHair(const Strands& rest, const Hairstyle& style, const Dynamics
     // response is the same however finely the hair is cut into segments.
     for (uint32_t j = 0; j < k; ++j) {
       const double root = int(j) < dynamics.rootSegments ? dynamics.rootInertia : 1.0;
-      segments_[firstSegment_[s] + j].coefficient =
+      segments[firstSegment_[s] + j].coefficient =
           3.0 * std::pow(double(j + 1) / double(k), dynamics.inertiaExponent) / (2.0 * root * total);
     }
   }
   const double frequency =
       dynamics.restFrequencyAuto ? firstBendingFrequency(style, longest) : dynamics.restFrequency;
   springOmega2_ = std::pow(2.0 * M_PI * frequency, 2);
-  for (Segment& segment : segments_) segment.springOverC = springOmega2_ / segment.coefficient;
+  for (Segment& segment : segments) segment.springOverC = springOmega2_ / segment.coefficient;
   for (const CollisionShape& c : shapes_) {
     const double r = c.kind == ShapeKind::kSphere ? c.halfExtents.x
                      : c.kind == ShapeKind::kEllipsoid
@@ -224,8 +232,8 @@ AnjyoHair::AnjyoHair(const Strands& rest, const Hairstyle& style, const Dynamics
     restForward_[p0] = node;
     glm::dvec3 before(0.0);
     for (uint32_t j = 0; j < k; ++j) {
-      Segment& segment = segments_[firstSegment_[s] + j];
-      const glm::dvec3 dir = directionOf(s, j);  // at rest
+      Segment& segment = segments[firstSegment_[s] + j];
+      const glm::dvec3 dir = directionAt(segment.frame, 0.0, 0.0);  // at rest
       const double restTurn = j > 0 ? std::acos(std::clamp(glm::dot(before, dir), -1.0, 1.0)) : 0.0;
       // The turn allowed at the node before segment i: JointAngleLimit from its node on, or the rest's.
       const bool limited = j > 0 && int(j) >= jointFrom_ && jointLimit_ < M_PI;
@@ -258,20 +266,40 @@ AnjyoHair::AnjyoHair(const Strands& rest, const Hairstyle& style, const Dynamics
   // The same segments lane by lane, for stepLanes.
   lanes_.assign(blockFirst_.back(), LaneSegment{});
   for (size_t s = 0; s < strands; ++s)
-    for (uint32_t j = 0; j < firstSegment_[s + 1] - firstSegment_[s]; ++j) {
-      const Segment& from = segments_[firstSegment_[s] + j];
-      LaneSegment& to = lanes_[blockFirst_[s / kLanes] + j];
-      const size_t l = s % kLanes;
-      for (int c = 0; c < 3; ++c) {
-        to.rest[c][l] = from.frame.rest[c];
-        to.pole[c][l] = from.frame.pole[c];
-        to.side[c][l] = from.frame.side[c];
-      }
-      to.length[l] = from.length;
-      to.coefficient[l] = from.coefficient;
-      to.springOverC[l] = from.springOverC;
-      to.cosAllowed[l] = from.cosAllowed;
-    }
+    for (uint32_t j = 0; j < firstSegment_[s + 1] - firstSegment_[s]; ++j)
+      lanes_[blockFirst_[s / kLanes] + j].set(s % kLanes, segments[firstSegment_[s] + j]);
+}
+
+AnjyoHair::Segment AnjyoHair::LaneSegment::at(size_t l) const {
+  Segment s;
+  for (int c = 0; c < 3; ++c) {
+    s.frame.rest[c] = rest[c][l];
+    s.frame.pole[c] = pole[c][l];
+    s.frame.side[c] = side[c][l];
+  }
+  s.length = length[l];
+  s.coefficient = coefficient[l];
+  s.springOverC = springOverC[l];
+  s.cosAllowed = cosAllowed[l];
+  s.sinAllowed = sinAllowed[l];
+  return s;
+}
+
+void AnjyoHair::LaneSegment::set(size_t l, const Segment& s) {
+  for (int c = 0; c < 3; ++c) {
+    rest[c][l] = s.frame.rest[c];
+    pole[c][l] = s.frame.pole[c];
+    side[c][l] = s.frame.side[c];
+  }
+  length[l] = s.length;
+  coefficient[l] = s.coefficient;
+  springOverC[l] = s.springOverC;
+  cosAllowed[l] = s.cosAllowed;
+  sinAllowed[l] = s.sinAllowed;
+}
+
+AnjyoHair::Segment AnjyoHair::segmentOf(size_t strand, uint32_t j) const {
+  return lanes_[blockFirst_[strand / kLanes] + j].at(strand % kLanes);
 }
 
 bool AnjyoHair::fluctuates(int frame, bool firstSubstep) const {
@@ -312,8 +340,7 @@ void AnjyoHair::stepStrand(size_t s, const AccelerationField& field, double dt, 
   glm::dvec3 nodeVelocity(0.0);        // its velocity in the head's frame, for Coriolis
   glm::dvec3 newBefore(0.0);           // the direction just placed before this one
   for (uint32_t j = 0; j < k; ++j) {
-    const size_t i = first + j;
-    const Segment& segment = segments_[i];
+    const Segment segment = segmentOf(s, j);
     const SegmentFrame& basis = segment.frame;
     double* state = &state_[stateAt(s, j)];  // value v at state[v * kLanes]
     auto value = [&](StateValue v) -> double& { return state[v * kLanes]; };
@@ -366,7 +393,7 @@ void AnjyoHair::stepStrand(size_t s, const AccelerationField& field, double dt, 
     sinCos(theta, nst, nct);
     sinCos(phi, nsp, ncp);
     glm::dvec3 placed = nct * (ncp * basis.rest + nsp * basis.side) + nst * basis.pole;
-    if (settle(i, p0 + j + 1, node, newBefore, placed, theta, phi)) {
+    if (settle(segment, p0 + j + 1, node, newBefore, placed, theta, phi)) {
       sinCos(theta, nst, nct);
       sinCos(phi, nsp, ncp);
     }
@@ -379,9 +406,8 @@ void AnjyoHair::stepStrand(size_t s, const AccelerationField& field, double dt, 
   }
 }
 
-bool AnjyoHair::settle(size_t i, size_t nodeIndex, const glm::dvec3& node, const glm::dvec3& before,
-                       glm::dvec3& placed, double& theta, double& phi) const {
-  const Segment& segment = segments_[i];
+bool AnjyoHair::settle(const Segment& segment, size_t nodeIndex, const glm::dvec3& node,
+                       const glm::dvec3& before, glm::dvec3& placed, double& theta, double& phi) const {
   const double d = segment.length;
   bool adjusted = false;
   // Out of every collision shape (no deeper than the node sat at rest), then the joint angle at the
@@ -414,12 +440,8 @@ bool AnjyoHair::settle(size_t i, size_t nodeIndex, const glm::dvec3& node, const
 }
 
 glm::dvec3 AnjyoHair::directionOf(size_t s, uint32_t j) const {
-  const SegmentFrame& b = segments_[firstSegment_[s] + j].frame;
   const double* v = &state_[stateAt(s, j)];
-  double st, ct, sp, cp;
-  sinCos(v[kTheta * kLanes], st, ct);
-  sinCos(v[kPhi * kLanes], sp, cp);
-  return ct * (cp * b.rest + sp * b.side) + st * b.pole;
+  return directionAt(segmentOf(s, j).frame, v[kTheta * kLanes], v[kPhi * kLanes]);
 }
 
 std::array<double, AnjyoHair::kStateValues> AnjyoHair::segmentState(size_t s, uint32_t j) const {
@@ -439,8 +461,7 @@ std::vector<glm::dvec3> AnjyoHair::nodes() const {
     glm::dvec3 node = restForward_[p0];
     out[p0] = node;
     for (uint32_t j = 0; j < k; ++j) {
-      const size_t i = first + j;
-      node += segments_[i].length * directionOf(s, j);
+      node += segmentOf(s, j).length * directionOf(s, j);
       out[p0 + j + 1] = node;
     }
   });
@@ -467,7 +488,7 @@ void AnjyoHair::posedInto(const Pose& pose, Strands& out, Kernel kernel) const {
     bool moved = false;  // whether the segment at hand has left its rest direction
     for (uint32_t j = 0; j <= k; ++j) {
       const uint32_t p = p0 + j;
-      if (j > 0) node += segments_[first + j - 1].length * dir;
+      if (j > 0) node += segmentOf(s, j - 1).length * dir;
       if (j < k) {  // the segment the point starts (the last point takes the last segment's)
         const double* v = &state_[stateAt(s, j)];
         dir = directionOf(s, j);
@@ -477,7 +498,7 @@ void AnjyoHair::posedInto(const Pose& pose, Strands& out, Kernel kernel) const {
       out.points[p] = glm::vec3(pose.apply(glm::dvec3(restPoints_[p]) + (node - restForward_[p])));
       glm::dvec3 t(restTangents_[p]);
       // Turned with its segment: the minimal rotation from the rest direction to the current one.
-      if (k > 0 && moved) t = transportFast(segments_[first + std::min(j, k - 1)].frame.rest, dir, t);
+      if (k > 0 && moved) t = transportFast(segmentOf(s, std::min(j, k - 1)).frame.rest, dir, t);
       out.tangents[p] = glm::vec3(still ? t : pose.rotation * t);  // a rotation keeps it unit
     }
   });

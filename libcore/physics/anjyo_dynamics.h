@@ -98,7 +98,7 @@ class AnjyoHair {
   std::array<double, kStateValues> segmentState(size_t strand, uint32_t j) const;
   void setSegmentState(size_t strand, uint32_t j, const std::array<double, kStateValues>& values);
 
-  size_t segmentCount() const { return segments_.size(); }
+  size_t segmentCount() const { return firstSegment_.back(); }
   // Diagnostics for tests: every node's position (head frame), and each joint's turn in radians.
   std::vector<glm::dvec3> nodes() const;
 
@@ -113,7 +113,8 @@ class AnjyoHair {
   // The new direction `placed` of segment i, from `node` (point nodeIndex − 1) after `before`: out of the
   // collision shapes and within the joint limit; where it moved, the angles are read off it. Returns
   // whether it moved.
-  bool settle(size_t i, size_t nodeIndex, const glm::dvec3& node, const glm::dvec3& before,
+  struct Segment;
+  bool settle(const Segment& segment, size_t nodeIndex, const glm::dvec3& node, const glm::dvec3& before,
               glm::dvec3& placed, double& theta, double& phi) const;
   glm::dvec3 directionOf(size_t strand, uint32_t j) const;  // segment j's, from its angles
   // Where segment j of `strand` keeps its first value in state_; value v is kLanes further on per v.
@@ -121,13 +122,14 @@ class AnjyoHair {
     return kStateHeader + ((blockFirst_[strand / kLanes] + j) * kStateValues) * kLanes + strand % kLanes;
   }
 
-  // What a step reads of a segment, together: its frame (README, Dynamics), d_i, c_i u_i m_i (1/m),
-  // ω² / c_i (the rest spring as an acceleration), and the turn allowed at the node before it (cos −2
-  // where there is no limit).
+  // What a step reads of a segment: its frame (README, Dynamics), d_i, c_i u_i m_i (1/m), ω² / c_i (the
+  // rest spring as an acceleration), and the turn allowed at the node before it (cos −2 where there is
+  // no limit). Kept only lane by lane (lanes_); segmentOf gathers one.
   struct Segment {
     SegmentFrame frame;
     double length, coefficient, springOverC, cosAllowed, sinAllowed;
   };
+  Segment segmentOf(size_t strand, uint32_t j) const;
   // The state's values of a segment, in the restart layout.
   enum StateValue { kTheta, kPhi, kThetaPrev, kPhiPrev };
 
@@ -136,24 +138,28 @@ class AnjyoHair {
   struct Lanes;  // anjyo_lanes.cpp
   struct LaneSegment {
     double rest[3][kLanes], pole[3][kLanes], side[3][kLanes];
-    double length[kLanes], coefficient[kLanes], springOverC[kLanes], cosAllowed[kLanes];
+    double length[kLanes], coefficient[kLanes], springOverC[kLanes], cosAllowed[kLanes], sinAllowed[kLanes];
+    Segment at(size_t lane) const;  // lane `lane`'s values
+    void set(size_t lane, const Segment& segment);
   };
   std::vector<LaneSegment> lanes_;
   std::vector<size_t> blockFirst_;  // per block, its first LaneSegment, + 1
   // Point j of a block's strands, lane by lane (a lane past its strand's last point repeats it): the
-  // input point, the rest node and the input tangent that posing starts from. Block b's points start
-  // at blockFirst_[b] + b (one more point than segments per block).
+  // input point, the rest node and the input tangent that posing starts from (the input's floats, kept
+  // as floats: posing reads them once a frame). Block b's points start at blockFirst_[b] + b (one more
+  // point than segments per block).
   struct LanePoint {
-    double point[3][kLanes], forward[3][kLanes], tangent[3][kLanes];
+    float point[3][kLanes];
+    double forward[3][kLanes];
+    float tangent[3][kLanes];
   };
   std::vector<LanePoint> lanePoints_;
 
   Strands rest_;  // every attribute of the rest guides but their points and tangents
   std::vector<glm::vec3> restPoints_;
   std::vector<uint32_t> firstSegment_;  // per strand, + 1
-  std::vector<Segment> segments_;
-  std::vector<double> state_;        // kStateValues per segment: 0 at rest but the cosines, 1
-  std::vector<double> shapeReach2_;  // per shape: beyond this squared distance nothing reaches it
+  std::vector<double> state_;           // kStateValues per segment: 0 at rest but the cosines, 1
+  std::vector<double> shapeReach2_;     // per shape: beyond this squared distance nothing reaches it
   // Per shape, a test cheaper than penetration() that rules out most points (exact for ellipsoids,
   // always "maybe" for the other shapes). `v` is the point less the shape's centre.
   struct ShapeTest {

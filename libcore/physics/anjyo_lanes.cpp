@@ -117,10 +117,13 @@ struct AnjyoHair::Lanes::PoseOut {
     const V3 flipped{-tangent.x, -tangent.y, -tangent.z};
     V3 t = select(moved, select(c < -1.0 + 1e-12, flipped, turned), tangent);
     if (!still) t = rotate(t);
+    // Rounded to floats in vectors (as glm::vec3's cast rounds each), then stored lane by lane.
+    const Vf px = toFloats(posed.x), py = toFloats(posed.y), pz = toFloats(posed.z);
+    const Vf tx = toFloats(t.x), ty = toFloats(t.y), tz = toFloats(t.z);
     for (size_t l = 0; l < kLanes; ++l) {
       if (s0 + l >= strands || j > count[l]) continue;
-      out.points[p0[l] + j] = glm::vec3(lane(posed, l));
-      out.tangents[p0[l] + j] = glm::vec3(lane(t, l));
+      out.points[p0[l] + j] = glm::vec3(px[l], py[l], pz[l]);
+      out.tangents[p0[l] + j] = glm::vec3(tx[l], ty[l], tz[l]);
     }
   }
 };
@@ -169,12 +172,11 @@ void AnjyoHair::Lanes::step(AnjyoHair& hair, size_t s0, const AccelerationField&
   const double keep = std::max(0.0, 1.0 - hair.damping_ * dt), dt2 = dt * dt;
   const CollisionShape* head = hair.head_ >= 0 ? &hair.shapes_[size_t(hair.head_)] : nullptr;
   const bool pseudo = head && hair.pseudoEpsilon_ < 1.0;
-  uint32_t first[n], count[n], p0[n];
+  uint32_t count[n], p0[n];
   V3 node{};
   for (size_t l = 0; l < n; ++l) {
     const size_t s = s0 + l;
-    first[l] = s < strands ? hair.firstSegment_[s] : 0;
-    count[l] = s < strands ? hair.firstSegment_[s + 1] - first[l] : 0;
+    count[l] = s < strands ? hair.firstSegment_[s + 1] - hair.firstSegment_[s] : 0;
     p0[l] = s < strands ? hair.rest_.firstPoint[s] : 0;
     if (s < strands) setLane(node, l, hair.restForward_[p0[l]]);
   }
@@ -263,7 +265,7 @@ void AnjyoHair::Lanes::step(AnjyoHair& hair, size_t s0, const AccelerationField&
     for (size_t l = 0; l < n; ++l) {
       if (!check[l] || j >= count[l]) continue;
       glm::dvec3 placedLane = lane(placed, l);
-      if (hair.settle(first[l] + j, p0[l] + j + 1, lane(node, l), lane(newBefore, l), placedLane, theta[l],
+      if (hair.settle(segment.at(l), p0[l] + j + 1, lane(node, l), lane(newBefore, l), placedLane, theta[l],
                       phi[l])) {
         setLane(placed, l, placedLane);
         settled = true;

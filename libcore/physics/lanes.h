@@ -38,6 +38,17 @@ HAIRGEN_LANE V3 load(const double (&v)[3][kLaneWidth]) {
   __builtin_memcpy(&r.z, v[2], sizeof(Vd));
   return r;
 }
+// Floats widened to doubles (exactly), and doubles rounded to floats as a cast does, lane by lane.
+using Vf = float __attribute__((vector_size(kLaneWidth * sizeof(float))));
+HAIRGEN_LANE V3 load(const float (&v)[3][kLaneWidth]) {
+  Vf f[3];
+  __builtin_memcpy(f, v, sizeof(f));
+  return {__builtin_convertvector(f[0], Vd), __builtin_convertvector(f[1], Vd),
+          __builtin_convertvector(f[2], Vd)};
+}
+HAIRGEN_LANE Vf toFloats(Vd v) {
+  return __builtin_convertvector(v, Vf);
+}
 HAIRGEN_LANE Vd loadLanes(const double* v) {
   Vd r;
   __builtin_memcpy(&r, v, sizeof(Vd));
