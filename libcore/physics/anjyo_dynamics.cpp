@@ -78,30 +78,21 @@ glm::dvec3 outward(const CollisionShape& s, const glm::dvec3& p) {
 }
 
 // The segment from `node` along `dir` turned out of `shape` until its end is at most `depth` deep: in the
-// plane of the segment and the shape's outward direction at `node`, by bisection between the two, so it
-// ends as near its place as possible (as the cantilever styling turns its nodes out). The bisection is
-// on the blend of the two directions (monotone in the angle, no trigonometry), to 1e-6 of the turn.
+// plane of the segment and the shape's outward direction at `node`, so it ends as near its place as
+// possible (as the cantilever styling turns its nodes out). The search is on the blend of the two
+// directions (monotone in the angle, no trigonometry), to 1e-7 of the blend. `excessAtDir`: how much
+// deeper than `depth` the end along `dir` is, as the caller found (> 0).
+// (Moving the end radially out of a convex shape and aiming the segment at it never gets there: the
+// aimed end falls short of the moved point, on the chord inside. The search starts at once.)
 glm::dvec3 turnOut(const CollisionShape& shape, const glm::dvec3& node, const glm::dvec3& dir, double length,
-                   double depth) {
-  // Grazing contact, the usual case: the segment toward its end moved radially out to the allowed depth,
-  // a few times over (each turn shortens the reach a little), is enough.
-  if (shape.kind != ShapeKind::kCuboid) {
-    glm::dvec3 toward = dir;
-    for (int i = 0; i < 3; ++i) {
-      const glm::dvec3 end = node + length * toward, v = end - shape.centre;
-      const double inside = penetration(shape, end), dist = glm::length(v);
-      if (inside <= depth) return toward;
-      if (!(dist > 0.0)) break;
-      toward = glm::normalize(shape.centre + v * ((dist - inside - depth) / dist) - node);
-    }
-  }
+                   double depth, double excessAtDir) {
   const glm::dvec3 out = glm::normalize(outward(shape, node));
   if (glm::dot(dir, out) < -0.999) return out;  // pointing straight in: straight out
   auto blend = [&](double u) { return glm::normalize(dir + u * (out - dir)); };
   auto excess = [&](double u) { return penetration(shape, node + length * blend(u)) - depth; };
   // The Illinois variant of regula falsi on the blend: a few evaluations where bisection takes twenty,
   // and the bracket keeps `hi` outside, which is what is returned.
-  double lo = 0.0, hi = 1.0, flo = excess(lo), fhi = excess(hi);
+  double lo = 0.0, hi = 1.0, flo = excessAtDir, fhi = excess(hi);
   if (fhi > 0.0) return out;
   int side = 0;
   for (int i = 0; i < 30 && hi - lo > 1e-7; ++i) {
@@ -420,8 +411,9 @@ bool AnjyoHair::settle(const Segment& segment, size_t nodeIndex, const glm::dvec
       const glm::dvec3 next = node + d * placed, v = next - shapes_[c].centre;
       if (glm::dot(v, v) >= shapeReach2_[c] || !shapeTests_[c].mayBeInside(v)) continue;
       const double allowedDepth = std::max(restDepth_[c][nodeIndex], 0.0);
-      if (penetration(shapes_[c], next) <= allowedDepth + 1e-9) continue;
-      placed = turnOut(shapes_[c], node, placed, d, allowedDepth);
+      const double depth = penetration(shapes_[c], next);
+      if (depth <= allowedDepth + 1e-9) continue;
+      placed = turnOut(shapes_[c], node, placed, d, allowedDepth, depth - allowedDepth);
       moved = true;
     }
     const double cosTurn = glm::dot(before, placed);
