@@ -30,11 +30,11 @@ HAIRGEN_LANE Vm deeperThanAtRest(const CollisionShape& shape, const V3& v, const
                   local.z / shape.halfExtents.z};
   const Vd ratio = sqrt(dot(scaled, scaled));
   const double smallest = std::min(shape.halfExtents.x, std::min(shape.halfExtents.y, shape.halfExtents.z));
-  const Vd inside = select(ratio > 0.0, dist / ratio - dist, splat(smallest));
+  const Vd inside = select(greater(ratio, Vd{}), dist / ratio - dist, splat(smallest));
   Vd allowed;
   for (size_t l = 0; l < AnjyoHair::kLanes; ++l)
     allowed[l] = node <= count[l] ? std::max(depth[p0[l] + node], 0.0) : 0.0;
-  return !(inside <= allowed + 1e-9);
+  return !lessEqual(inside, allowed + 1e-9);
 }
 
 }  // namespace
@@ -115,7 +115,7 @@ struct AnjyoHair::Lanes::PoseOut {
     const Vd c = dot(restDir, dir);
     const V3 turned = c * tangent + cross(w, tangent) + (dot(w, tangent) / (1.0 + c)) * w;
     const V3 flipped{-tangent.x, -tangent.y, -tangent.z};
-    V3 t = select(moved, select(c < -1.0 + 1e-12, flipped, turned), tangent);
+    V3 t = select(moved, select(less(c, splat(-1.0 + 1e-12)), flipped, turned), tangent);
     if (!still) t = rotate(t);
     // Rounded to floats in vectors (as glm::vec3's cast rounds each), then stored lane by lane.
     const Vf px = toFloats(posed.x), py = toFloats(posed.y), pz = toFloats(posed.z);
@@ -148,7 +148,7 @@ void AnjyoHair::Lanes::pose(const AnjyoHair& hair, size_t s0, const Pose& pose, 
     if (j > 0) node = node + load(segments[j - 1].length) * writer.dir;
     if (j < most) {
       const double* state = &hair.state_[kStateHeader + (hair.blockFirst_[block] + j) * kStateValues * n];
-      auto value = [&](StateValue v) { return loadLanes(state + v * n); };
+      auto value = [&](StateValue v) HAIRGEN_LANE_LAMBDA { return loadLanes(state + v * n); };
       const LaneSegment& segment = segments[j];
       const Vm here =
           Vm{} + int64_t(j) < counts;  // a lane past its strand's last segment keeps the last one's
@@ -193,7 +193,7 @@ void AnjyoHair::Lanes::step(AnjyoHair& hair, size_t s0, const AccelerationField&
     prefetchAhead(hair, block, j + 2);
     // The block's state for segment j: each value a vector of the lanes (anjyo_dynamics.h, state()).
     double* state = &hair.state_[kStateHeader + (hair.blockFirst_[block] + j) * kStateValues * n];
-    auto value = [&](StateValue v) { return loadLanes(state + v * n); };
+    auto value = [&](StateValue v) HAIRGEN_LANE_LAMBDA { return loadLanes(state + v * n); };
     const Vd theta0 = value(kTheta), phi0 = value(kPhi), thetaPrev = value(kThetaPrev),
              phiPrev = value(kPhiPrev);
     Vd st, ct, sp, cp;
@@ -224,10 +224,10 @@ void AnjyoHair::Lanes::step(AnjyoHair& hair, size_t s0, const AccelerationField&
       const V3 s0v = splat(test.scaled[0]), s1v = splat(test.scaled[1]), s2v = splat(test.scaled[2]);
       const V3 r{dot(v, s0v), dot(v, s1v), dot(v, s2v)};
       const Vm nonzero = nonZero(departure.x) | nonZero(departure.y) | nonZero(departure.z);
-      const Vm near = dot(r, r) < test.near2;
+      const Vm near = less(dot(r, r), splat(test.near2));
       const V3 grad = r.x * s0v + r.y * s1v + r.z * s2v;
-      const Vm into =
-          dot(grad, departure) < hair.pseudoAlpha_ * sqrt(dot(grad, grad)) * sqrt(dot(departure, departure));
+      const Vm into = less(dot(grad, departure),
+                           hair.pseudoAlpha_ * sqrt(dot(grad, grad)) * sqrt(dot(departure, departure)));
       departure = select(nonzero & near & into, splat(hair.pseudoEpsilon_) * departure, departure);
     }
     const Vd c = load(segment.coefficient);
@@ -242,17 +242,17 @@ void AnjyoHair::Lanes::step(AnjyoHair& hair, size_t s0, const AccelerationField&
     V3 placed = nct * (ncp * rest + nsp * side) + nst * pole;
     // Which lanes may meet a shape or their joint limit: those go through the strand's own code (which
     // finds, as here, that nothing moves where nothing reaches).
-    Vm check = dot(newBefore, placed) < load(segment.cosAllowed) - 1e-12;
+    Vm check = less(dot(newBefore, placed), load(segment.cosAllowed) - 1e-12);
     const V3 next = node + d * placed;
     for (size_t c2 = 0; c2 < hair.shapes_.size(); ++c2) {
       if (!(hair.shapes_[c2].penalty > 0.0)) continue;
       const ShapeTest& test = hair.shapeTests_[c2];
       const V3 v = next - splat(hair.shapes_[c2].centre);
-      Vm maybe = dot(v, v) < hair.shapeReach2_[c2];
+      Vm maybe = less(dot(v, v), splat(hair.shapeReach2_[c2]));
       if (test.ellipsoid) {
         const V3 r{dot(v, splat(test.scaled[0])), dot(v, splat(test.scaled[1])),
                    dot(v, splat(test.scaled[2]))};
-        maybe = maybe & (dot(r, r) < 1.0);
+        maybe = maybe & less(dot(r, r), splat(1.0));
         bool any = false;
         for (size_t l = 0; l < n; ++l) any = any || (maybe[l] && j < count[l]);
         if (any)
@@ -275,7 +275,8 @@ void AnjyoHair::Lanes::step(AnjyoHair& hair, size_t s0, const AccelerationField&
       sinCos(theta, nst, nct);
       sinCos(phi, nsp, ncp);
     }
-    auto store = [&](StateValue v, Vd to) { storeLanes(state + v * n, select(active, to, value(v))); };
+    auto store = [&](StateValue v, Vd to)
+                     HAIRGEN_LANE_LAMBDA { storeLanes(state + v * n, select(active, to, value(v))); };
     store(kThetaPrev, theta0);
     store(kPhiPrev, phi0);
     store(kTheta, theta);

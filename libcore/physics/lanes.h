@@ -7,6 +7,8 @@
 
 #include <cstddef>
 
+#include <immintrin.h>
+
 #include <glm/glm.hpp>
 
 namespace hairgen::lanes {
@@ -23,10 +25,16 @@ struct V3 {
   Vd x, y, z;
 };
 
-#define HAIRGEN_LANE [[gnu::always_inline]] inline
+// Every lane function is built for AVX-512, the instruction set its callers are built for.
+#define HAIRGEN_LANE [[gnu::always_inline, gnu::target("avx512f,avx512dq")]] inline
+// The same for a lambda (after its parameters), which does not take its function's target.
+#define HAIRGEN_LANE_LAMBDA __attribute__((always_inline, target("avx512f,avx512dq")))
 
+// Every lane v (a broadcast: −0 stays −0, where 0 + v would make it +0 and cost a scalar add).
 HAIRGEN_LANE Vd splat(double v) {
-  return Vd{} + v;
+  Vd r;
+  for (size_t l = 0; l < kLaneWidth; ++l) r[l] = v;
+  return r;
 }
 HAIRGEN_LANE V3 splat(const glm::dvec3& v) {
   return {splat(v.x), splat(v.y), splat(v.z)};
@@ -93,10 +101,25 @@ HAIRGEN_LANE Vm select(Vm m, Vm a, Vm b) {
 HAIRGEN_LANE V3 select(Vm m, const V3& a, const V3& b) {
   return {m ? a.x : b.x, m ? a.y : b.y, m ? a.z : b.z};
 }
-// Lanes where v != 0 (NaN included), written with ordered comparisons: GCC splits an equality test of
-// double vectors into one scalar compare per lane in large functions.
+// Comparisons lane by lane as single AVX-512 instructions: GCC splits a comparison of double vectors
+// (`a < b`) into one scalar compare per lane in large functions.
+template <int kPredicate>
+HAIRGEN_LANE Vm compare(Vd a, Vd b) {
+  static_assert(kLaneWidth == 8);
+  return Vm(_mm512_movm_epi64(_mm512_cmp_pd_mask(__m512d(a), __m512d(b), kPredicate)));
+}
+HAIRGEN_LANE Vm less(Vd a, Vd b) {  // a < b (false where either is NaN)
+  return compare<_CMP_LT_OQ>(a, b);
+}
+HAIRGEN_LANE Vm lessEqual(Vd a, Vd b) {  // a <= b (false where either is NaN)
+  return compare<_CMP_LE_OQ>(a, b);
+}
+HAIRGEN_LANE Vm greater(Vd a, Vd b) {  // a > b (false where either is NaN)
+  return compare<_CMP_GT_OQ>(a, b);
+}
+// Lanes where v != 0 (NaN included).
 HAIRGEN_LANE Vm nonZero(Vd v) {
-  return !((v <= 0.0) & (v >= 0.0));
+  return compare<_CMP_NEQ_UQ>(v, Vd{});
 }
 HAIRGEN_LANE Vd abs(Vd v) {
   return v < 0.0 ? -v : v;

@@ -174,8 +174,11 @@ void SpringHair::projectStretchLanes(size_t block, const size_t* strands, size_t
 }
 
 // SpringHair::predict's operations in its order, lane by lane; the old points into `before`.
-void SpringHair::Lanes::predict(const SpringHair& hair, size_t block, const size_t* strands, size_t count,
-                                uint32_t n, const AccelerationField& field, double dt, Block& b, V3* before) {
+[[gnu::target("avx512f,avx512dq")]] void SpringHair::Lanes::predict(const SpringHair& hair, size_t block,
+                                                                    const size_t* strands, size_t count,
+                                                                    uint32_t n,
+                                                                    const AccelerationField& field, double dt,
+                                                                    Block& b, V3* before) {
   const LanePoint* at = &hair.lanePoints_[hair.laneFirst_[block]];
   V3 v[kMost], unit[kMost], turn[kMost], force[kMost];
   Vd inverseLength[kMost];
@@ -223,8 +226,9 @@ void SpringHair::Lanes::predict(const SpringHair& hair, size_t block, const size
   }
 }
 
-void SpringHair::Lanes::constrain(const SpringHair& hair, size_t block, size_t count, uint32_t n, double dt,
-                                  Block& b) {
+[[gnu::target("avx512f,avx512dq")]] void SpringHair::Lanes::constrain(const SpringHair& hair, size_t block,
+                                                                      size_t count, uint32_t n, double dt,
+                                                                      Block& b) {
   const LanePoint* at = &hair.lanePoints_[hair.laneFirst_[block]];
   V3* x = b.x;
   Vd moved = splat(0.0);  // 1 where a lane's point moved (a double, as Block::done)
@@ -258,7 +262,7 @@ void SpringHair::Lanes::constrain(const SpringHair& hair, size_t block, size_t c
   for (size_t l = 0; l < kLaneWidth; ++l) b.done[l] = l < count && moved[l] > 0.0 ? 0.0 : 1.0;
 }
 
-void SpringHair::Lanes::projectStretch(uint32_t n, double dt, Block& b) {
+[[gnu::target("avx512f,avx512dq")]] void SpringHair::Lanes::projectStretch(uint32_t n, double dt, Block& b) {
   constexpr size_t w = kLaneWidth;
   V3* x = b.x;
   V3 u[kMost];
