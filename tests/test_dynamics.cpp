@@ -249,6 +249,29 @@ TEST(AnjyoDynamics, EveryKernelGivesTheSameBits) {
   }
 }
 
+// The hair is set up on every core; a guide with a zero-length segment is refused by the first such
+// guide's number and points, whatever the thread count.
+TEST(AnjyoDynamics, TheFirstGuideWithAZeroLengthSegmentIsNamed) {
+  Strands hair;
+  for (int s = 0; s < 40; ++s) {
+    std::vector<glm::vec3> points;
+    for (int j = 0; j < 6; ++j) points.emplace_back(0.01f * float(s), -0.01f * float(j), 0.0f);
+    if (s == 17 || s == 31) points[3] = points[2];  // segment 2 of guides 17 and 31 has no length
+    hair.addStrand(points);
+  }
+  for (int threads : {1, 2, 4}) {
+    tbb::global_control limit(tbb::global_control::max_allowed_parallelism, size_t(threads));
+    try {
+      AnjyoHair dynamic(hair, Hairstyle{}, still(), Collision{}, 1);
+      ADD_FAILURE() << "the hair was accepted with " << threads << " threads";
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find("guide 17 has two points at the same place (points 2 and 3)"),
+                std::string::npos)
+          << e.what();
+    }
+  }
+}
+
 TEST(AnjyoDynamics, JointLimitsHoldAndSegmentsKeepTheirLength) {
   Fig11 f = fig11();
   Hairstyle style;

@@ -4,6 +4,7 @@
 #include "libcore/util/cpu.h"
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 
 #include <tbb/parallel_for.h>
@@ -11,6 +12,7 @@
 #include "libcore/physics/anjyo_sincos.h"
 #include "libcore/physics/strand_energy.h"
 #include "libcore/util/error.h"
+#include "libcore/util/huge_pages.h"
 #include "libcore/util/random.h"
 
 namespace hairgen {
@@ -141,8 +143,6 @@ AnjyoHair::AnjyoHair(const Strands& rest, const Hairstyle& style, const Dynamics
   firstSegment_.assign(strands + 1, 0);
   for (size_t s = 0; s < strands; ++s)
     firstSegment_[s + 1] = firstSegment_[s] + std::max(rest.pointsOf(s), 1u) - 1;
-  // Each segment's values, laid out lane by lane once they are all known (lanes_).
-  std::vector<Segment> segments(firstSegment_.back());
   // Blocks of kLanes strands for stepLanes, each as long as its longest strand.
   const size_t blocks = (strands + kLanes - 1) / kLanes;
   blockFirst_.assign(blocks + 1, 0);
@@ -152,12 +152,14 @@ AnjyoHair::AnjyoHair(const Strands& rest, const Hairstyle& style, const Dynamics
       most = std::max(most, firstSegment_[s + 1] - firstSegment_[s]);
     blockFirst_[b + 1] = blockFirst_[b] + most;
   }
-  // At rest every angle is 0.
-  state_.assign(kStateHeader + blockFirst_.back() * kStateValues * kLanes, 0.0);
+  // At rest every angle is 0. The large arrays are made in huge pages on every core (huge_pages.h), and
+  // filled strand by strand on every core: each strand's values depend on that strand alone.
+  resizeLarge(state_, kStateHeader + blockFirst_.back() * kStateValues * kLanes);
   state_[0] = kStateTag;
   state_[1] = double(kLanes);
   state_[2] = double(kStateValues);
-  restForward_.resize(rest.pointCount());
+  resizeLarge(lanes_, blockFirst_.back());  // zeros past a strand's last segment
+  resizeLarge(restForward_, rest.pointCount());
   restTangents_ = tangentsOf(rest);
   // posedInto writes the points and tangents; the rest's are kept apart, so that handing every other
   // attribute to a frame's guides copies no points.
@@ -166,36 +168,42 @@ AnjyoHair::AnjyoHair(const Strands& rest, const Hairstyle& style, const Dynamics
   shapes_ = collision.shapes;
   for (size_t c = 0; c < shapes_.size() && head_ < 0; ++c)
     if (shapes_[c].kind == ShapeKind::kEllipsoid) head_ = int(c);
-  double longest = 0.0;
-  for (size_t s = 0; s < strands; ++s) {
+  auto laneOf = [&](size_t s, uint32_t j) -> LaneSegment& { return lanes_[blockFirst_[s / kLanes] + j]; };
+  // Each segment's frame and length, and each strand's length; the first strand with a zero-length
+  // segment, if any, is refused (the first, whatever the thread count).
+  std::vector<double> totals(strands, 0.0);
+  std::atomic<size_t> firstBad{strands};
+  tbb::parallel_for(size_t(0), strands, [&](size_t s) {
     const uint32_t p0 = rest.firstPoint[s], k = firstSegment_[s + 1] - firstSegment_[s];
     double total = 0.0;
     for (uint32_t j = 0; j < k; ++j) {
       const glm::dvec3 a(rest.points[p0 + j]), b(rest.points[p0 + j + 1]);
       const double d = glm::length(b - a);
-      if (!(d > 0.0))
-        throw InputError("guide " + std::to_string(s) + " has two points at the same place (points " +
-                         std::to_string(j) + " and " + std::to_string(j + 1) + "); a segment needs a length");
-      Segment& segment = segments[firstSegment_[s] + j];
+      if (!(d > 0.0)) {
+        for (size_t seen = firstBad.load(); s < seen && !firstBad.compare_exchange_weak(seen, s);) {
+        }
+        return;
+      }
+      Segment segment{};
       segment.frame = frameFor((b - a) / d);
       segment.length = d;
+      laneOf(s, j).set(s % kLanes, segment);
       total += d;
     }
-    longest = std::max(longest, total);
-    // I_i = f (k/i)^p m_i d_i L/3, c_i = 1/I_i, u_i = d_i/2: c_i u_i m_i = 3 (i/k)^p / (2 f L). The tip
-    // segment turns like the whole hair as one stick, as a single segment does (the compound pendulum),
-    // and the inertia grows toward the root as 1/i (§3.2.1): at a given fraction of the length the
-    // response is the same however finely the hair is cut into segments.
-    for (uint32_t j = 0; j < k; ++j) {
-      const double root = int(j) < dynamics.rootSegments ? dynamics.rootInertia : 1.0;
-      segments[firstSegment_[s] + j].coefficient =
-          3.0 * std::pow(double(j + 1) / double(k), dynamics.inertiaExponent) / (2.0 * root * total);
-    }
+    totals[s] = total;
+  });
+  if (firstBad < strands) {
+    const size_t s = firstBad;
+    const uint32_t p0 = rest.firstPoint[s];
+    uint32_t j = 0;
+    while (glm::length(glm::dvec3(rest.points[p0 + j + 1]) - glm::dvec3(rest.points[p0 + j])) > 0.0) ++j;
+    throw InputError("guide " + std::to_string(s) + " has two points at the same place (points " +
+                     std::to_string(j) + " and " + std::to_string(j + 1) + "); a segment needs a length");
   }
+  const double longest = totals.empty() ? 0.0 : *std::max_element(totals.begin(), totals.end());
   const double frequency =
       dynamics.restFrequencyAuto ? firstBendingFrequency(style, longest) : dynamics.restFrequency;
   springOmega2_ = std::pow(2.0 * M_PI * frequency, 2);
-  for (Segment& segment : segments) segment.springOverC = springOmega2_ / segment.coefficient;
   for (const CollisionShape& c : shapes_) {
     const double r = c.kind == ShapeKind::kSphere ? c.halfExtents.x
                      : c.kind == ShapeKind::kEllipsoid
@@ -214,33 +222,47 @@ AnjyoHair::AnjyoHair(const Strands& rest, const Hairstyle& style, const Dynamics
     }
     shapeTests_.push_back(test);
   }
-  // The rest nodes as the recurrence will compute them, the turn at each node and each node's depth in
-  // each shape: what the motion is measured from.
+  // Per strand: the inertias, the rest nodes as the recurrence will compute them, the turn allowed at
+  // each node and each node's depth in each shape (what the motion is measured from).
   restDepth_.assign(shapes_.size(), std::vector<double>(rest.pointCount(), 0.0));
-  for (size_t s = 0; s < strands; ++s) {
+  tbb::parallel_for(size_t(0), strands, [&](size_t s) {
+    if (rest.pointsOf(s) == 0) return;
     const uint32_t p0 = rest.firstPoint[s], k = firstSegment_[s + 1] - firstSegment_[s];
+    const size_t l = s % kLanes;
+    // I_i = f (k/i)^p m_i d_i L/3, c_i = 1/I_i, u_i = d_i/2: c_i u_i m_i = 3 (i/k)^p / (2 f L). The tip
+    // segment turns like the whole hair as one stick, as a single segment does (the compound pendulum),
+    // and the inertia grows toward the root as 1/i (§3.2.1): at a given fraction of the length the
+    // response is the same however finely the hair is cut into segments.
+    for (uint32_t j = 0; j < k; ++j) {
+      const double root = int(j) < dynamics.rootSegments ? dynamics.rootInertia : 1.0;
+      LaneSegment& to = laneOf(s, j);
+      to.coefficient[l] =
+          3.0 * std::pow(double(j + 1) / double(k), dynamics.inertiaExponent) / (2.0 * root * totals[s]);
+      to.springOverC[l] = springOmega2_ / to.coefficient[l];
+    }
     glm::dvec3 node(rest.points[p0]);
     restForward_[p0] = node;
     glm::dvec3 before(0.0);
     for (uint32_t j = 0; j < k; ++j) {
-      Segment& segment = segments[firstSegment_[s] + j];
+      LaneSegment& to = laneOf(s, j);
+      const Segment segment = to.at(l);
       const glm::dvec3 dir = directionAt(segment.frame, 0.0, 0.0);  // at rest
       const double restTurn = j > 0 ? std::acos(std::clamp(glm::dot(before, dir), -1.0, 1.0)) : 0.0;
       // The turn allowed at the node before segment i: JointAngleLimit from its node on, or the rest's.
       const bool limited = j > 0 && int(j) >= jointFrom_ && jointLimit_ < M_PI;
       const double allowed = limited ? std::max(jointLimit_, restTurn) : M_PI;
-      segment.cosAllowed = limited ? std::cos(allowed) : -2.0;
-      segment.sinAllowed = std::sin(allowed);
+      to.cosAllowed[l] = limited ? std::cos(allowed) : -2.0;
+      to.sinAllowed[l] = std::sin(allowed);
       node += segment.length * dir;
       restForward_[p0 + j + 1] = node;
       before = dir;
     }
     for (uint32_t p = p0; p < rest.firstPoint[s + 1]; ++p)
       for (size_t c = 0; c < shapes_.size(); ++c) restDepth_[c][p] = penetration(shapes_[c], restForward_[p]);
-  }
+  });
   // The same points lane by lane, for posing.
-  lanePoints_.resize(blockFirst_.back() + blocks);
-  for (size_t b = 0; b < blocks; ++b)
+  resizeLarge(lanePoints_, blockFirst_.back() + blocks);
+  tbb::parallel_for(size_t(0), blocks, [&](size_t b) {
     for (size_t l = 0; l < kLanes; ++l) {
       const size_t s = std::min(b * kLanes + l, strands - 1);  // past the last strand: the last one's
       if (rest.pointsOf(s) == 0) continue;
@@ -254,11 +276,7 @@ AnjyoHair::AnjyoHair(const Strands& rest, const Hairstyle& style, const Dynamics
         }
       }
     }
-  // The same segments lane by lane, for stepLanes.
-  lanes_.assign(blockFirst_.back(), LaneSegment{});
-  for (size_t s = 0; s < strands; ++s)
-    for (uint32_t j = 0; j < firstSegment_[s + 1] - firstSegment_[s]; ++j)
-      lanes_[blockFirst_[s / kLanes] + j].set(s % kLanes, segments[firstSegment_[s] + j]);
+  });
 }
 
 AnjyoHair::Segment AnjyoHair::LaneSegment::at(size_t l) const {
