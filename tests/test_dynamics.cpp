@@ -270,6 +270,14 @@ TEST(AnjyoDynamics, TheFirstGuideWithAZeroLengthSegmentIsNamed) {
           << e.what();
     }
   }
+  // A guide of no points has nothing to step or pose (posing would write its neighbour's first point).
+  hair.firstPoint.insert(hair.firstPoint.begin() + 5, hair.firstPoint[5]);
+  try {
+    AnjyoHair dynamic(hair, Hairstyle{}, still(), Collision{}, 1);
+    ADD_FAILURE() << "a guide of no points was accepted";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("guide 5 has no points"), std::string::npos) << e.what();
+  }
 }
 
 TEST(AnjyoDynamics, JointLimitsHoldAndSegmentsKeepTheirLength) {

@@ -141,8 +141,10 @@ AnjyoHair::AnjyoHair(const Strands& rest, const Hairstyle& style, const Dynamics
       seed_(seed) {
   const size_t strands = rest.strandCount();
   firstSegment_.assign(strands + 1, 0);
-  for (size_t s = 0; s < strands; ++s)
-    firstSegment_[s + 1] = firstSegment_[s] + std::max(rest.pointsOf(s), 1u) - 1;
+  for (size_t s = 0; s < strands; ++s) {
+    if (rest.pointsOf(s) == 0) throw InputError("guide " + std::to_string(s) + " has no points");
+    firstSegment_[s + 1] = firstSegment_[s] + rest.pointsOf(s) - 1;
+  }
   // Blocks of kLanes strands for stepLanes, each as long as its longest strand.
   const size_t blocks = (strands + kLanes - 1) / kLanes;
   blockFirst_.assign(blocks + 1, 0);
@@ -226,7 +228,6 @@ AnjyoHair::AnjyoHair(const Strands& rest, const Hairstyle& style, const Dynamics
   // each node and each node's depth in each shape (what the motion is measured from).
   restDepth_.assign(shapes_.size(), std::vector<double>(rest.pointCount(), 0.0));
   tbb::parallel_for(size_t(0), strands, [&](size_t s) {
-    if (rest.pointsOf(s) == 0) return;
     const uint32_t p0 = rest.firstPoint[s], k = firstSegment_[s + 1] - firstSegment_[s];
     const size_t l = s % kLanes;
     // I_i = f (k/i)^p m_i d_i L/3, c_i = 1/I_i, u_i = d_i/2: c_i u_i m_i = 3 (i/k)^p / (2 f L). The tip
@@ -265,7 +266,6 @@ AnjyoHair::AnjyoHair(const Strands& rest, const Hairstyle& style, const Dynamics
   tbb::parallel_for(size_t(0), blocks, [&](size_t b) {
     for (size_t l = 0; l < kLanes; ++l) {
       const size_t s = std::min(b * kLanes + l, strands - 1);  // past the last strand: the last one's
-      if (rest.pointsOf(s) == 0) continue;
       for (size_t j = 0; j <= blockFirst_[b + 1] - blockFirst_[b]; ++j) {
         const size_t p = rest.firstPoint[s] + std::min<size_t>(j, rest.pointsOf(s) - 1);
         LanePoint& to = lanePoints_[blockFirst_[b] + b + j];

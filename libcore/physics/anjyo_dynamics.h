@@ -53,7 +53,8 @@ struct SegmentFrame {
 class AnjyoHair {
  public:
   // `rest`: the styled guides, in the head's rest pose (the pose the wick and Collision Info describe).
-  // Strands of one point stay put. Throws InputError for a strand with a zero-length segment.
+  // Strands of one point stay put. Throws InputError for a strand with no points or a zero-length
+  // segment.
   AnjyoHair(const Strands& rest, const Hairstyle& style, const Dynamics& dynamics, const Collision& collision,
             uint64_t seed);
 
