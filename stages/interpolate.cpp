@@ -223,7 +223,7 @@ void interpolateInto(const Mesh& wick, const Strands& guides, const Hairstyle& s
   requireFits(estimateInterpolate(style, surfaceArea(wick) * 1e4, triangleCount, pointsPerGuide),
               options.force);
   const uint64_t seed = style.seed;
-  const std::vector<glm::vec3> guideTangents = tangentsOf(guides);
+  const PointArray guideTangents = tangentsOf(guides);
 
   // Counts and offsets first, so every triangle writes its own slice of the arrays in parallel.
   std::vector<uint32_t> count(triangleCount), vertices(triangleCount);

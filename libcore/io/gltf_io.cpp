@@ -24,8 +24,8 @@ struct Builder {
   std::vector<unsigned char> buffer;
 
   // Appends a tightly packed accessor; returns its index.
-  template <typename T>
-  int add(const std::vector<T>& values, int componentType, int type, int target, bool minMax = false) {
+  template <typename T, class A>
+  int add(const std::vector<T, A>& values, int componentType, int type, int target, bool minMax = false) {
     while (buffer.size() % 4) buffer.push_back(0);
     tinygltf::BufferView view;
     view.buffer = 0;
@@ -534,7 +534,7 @@ Strands decodeGltf(const uint8_t* data, size_t size, const std::string& name,
                                           " entries for " + std::to_string(n) + " vertices");
         return view;
       };
-      auto vec3s = [&](const char* key, std::vector<glm::vec3>& out) {
+      auto vec3s = [&](const char* key, auto& out) {
         if (auto v = attribute(key)) {
           v->expect(TINYGLTF_COMPONENT_TYPE_FLOAT, 3);
           out.resize(n);

@@ -83,8 +83,8 @@ class Writer {
     f32(v.z);
   }
   // An array of Word-byte words (floats, uint32s, doubles, and vectors of them), as little-endian bytes.
-  template <size_t Word, typename T>
-  void array(const std::vector<T>& v) {
+  template <size_t Word, typename T, class A>
+  void array(const std::vector<T, A>& v) {
     static_assert(sizeof(T) % Word == 0);
     const size_t n = v.size() * sizeof(T);
     if constexpr (kLittleEndian) {
@@ -103,8 +103,8 @@ class Writer {
 
 // A chunk: tag, length, the payload as Word-byte words, and the CRC-32 of all three (of the bytes as
 // written, so the payload is swapped first on a big-endian machine).
-template <size_t Word, typename T>
-void chunk(Writer& w, const char tag[4], const std::vector<T>& values) {
+template <size_t Word, typename T, class A>
+void chunk(Writer& w, const char tag[4], const std::vector<T, A>& values) {
   const uint64_t length = values.size() * sizeof(T);
   uint8_t head[12];
   std::memcpy(head, tag, 4);
@@ -182,8 +182,8 @@ class Reader {
   }
   // `count` values of Word-byte words into `v`, after need() has checked they are there; returns the
   // bytes as they were in the file (for a CRC) through `crc` when it is given.
-  template <size_t Word, typename T>
-  void array(std::vector<T>& v, uint64_t count, uint32_t* crc = nullptr) {
+  template <size_t Word, typename T, class A>
+  void array(std::vector<T, A>& v, uint64_t count, uint32_t* crc = nullptr) {
     static_assert(sizeof(T) % Word == 0);
     resizeLarge(v, count);
     const size_t n = size_t(count) * sizeof(T);

@@ -1,6 +1,7 @@
 #include "libcore/io/info.h"
 
 #include <cmath>
+#include <span>
 #include <sstream>
 
 #include "libcore/io/exr_io.h"
@@ -18,7 +19,7 @@
 namespace hairgen {
 namespace {
 
-nlohmann::ordered_json boundsJson(const std::vector<glm::vec3>& points) {
+nlohmann::ordered_json boundsJson(std::span<const glm::vec3> points) {
   Bounds b = bounds(points);
   return {{"min", {b.min.x, b.min.y, b.min.z}}, {"max", {b.max.x, b.max.y, b.max.z}}};
 }

@@ -98,8 +98,8 @@ constexpr const char* kCommentTag = "hairgen ";  // `comment hairgen key=value`
 
 // The address of component c of a vector array's first element, or null for an empty array (whose
 // element has no records to store).
-template <typename Vec>
-auto* component(std::vector<Vec>& values, int c) {
+template <typename Vec, class A>
+auto* component(std::vector<Vec, A>& values, int c) {
   return values.empty() ? nullptr : &values[0][c];
 }
 
@@ -388,7 +388,7 @@ Strands decodePly(const uint8_t* data, size_t size, const std::string& name, Ply
     sinks[i] = {base, nullptr, stride, scale, e.name + " property " + property};
     return true;
   };
-  auto sinkVec3 = [&](const char* const names[3], std::vector<glm::vec3>& out) {
+  auto sinkVec3 = [&](const char* const names[3], auto& out) {
     for (int c = 0; c < 3; ++c)
       if (vertex->find(names[c]) < 0) return;
     out.resize(n);

@@ -38,8 +38,8 @@ std::string item(const glm::uvec3& v) {
   return "(" + std::to_string(v.x) + ", " + std::to_string(v.y) + ", " + std::to_string(v.z) + ")";
 }
 
-template <typename T>
-void array(std::ostream& out, const std::vector<T>& values) {
+template <typename T, class A>
+void array(std::ostream& out, const std::vector<T, A>& values) {
   out << "[";
   for (size_t i = 0; i < values.size(); ++i) {
     if (i) out << (i % kPerLine ? ", " : ",\n        ");
@@ -49,8 +49,8 @@ void array(std::ostream& out, const std::vector<T>& values) {
 }
 
 // `type name = [...]`, with an interpolation when it is a primvar or widths.
-template <typename T>
-void attribute(std::ostream& out, const char* type, const std::string& name, const std::vector<T>& values,
+template <typename T, class A>
+void attribute(std::ostream& out, const char* type, const std::string& name, const std::vector<T, A>& values,
                const char* interpolation = nullptr) {
   out << "    " << type << " " << name << " = ";
   array(out, values);

@@ -35,7 +35,7 @@ double surfaceArea(const Mesh& mesh) {
   return area;
 }
 
-Bounds bounds(const std::vector<glm::vec3>& points) {
+Bounds bounds(std::span<const glm::vec3> points) {
   if (points.empty()) return {};
   Bounds b{glm::vec3(std::numeric_limits<float>::max()), glm::vec3(std::numeric_limits<float>::lowest())};
   for (const glm::vec3& p : points) {

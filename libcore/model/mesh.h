@@ -2,6 +2,7 @@
 #pragma once
 
 #include <cstdint>
+#include <span>
 #include <vector>
 
 #include <glm/glm.hpp>
@@ -31,6 +32,6 @@ struct Bounds {
   glm::vec3 min{0.0f};
   glm::vec3 max{0.0f};
 };
-Bounds bounds(const std::vector<glm::vec3>& points);  // {0,0} for no points
+Bounds bounds(std::span<const glm::vec3> points);  // {0,0} for no points
 
 }  // namespace hairgen

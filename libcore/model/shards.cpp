@@ -29,8 +29,8 @@ std::string rangeText(const ShardRange& r) {
   return std::to_string(r.first) + "-" + std::to_string(r.end);
 }
 
-template <typename T>
-void append(std::vector<T>& to, const std::vector<T>& from, bool wanted) {
+template <typename T, class A>
+void append(std::vector<T, A>& to, const std::vector<T, A>& from, bool wanted) {
   if (wanted) to.insert(to.end(), from.begin(), from.end());
 }
 

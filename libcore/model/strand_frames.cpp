@@ -18,7 +18,7 @@ glm::dvec3 transport(const glm::dvec3& a, const glm::dvec3& b, const glm::dvec3&
 }
 
 std::vector<glm::vec3> transportFrames(const Strands& s) {
-  const std::vector<glm::vec3> tangents = tangentsOf(s);
+  const PointArray tangents = tangentsOf(s);
   glm::dvec3 centroid(0.0);
   for (size_t i = 0; i < s.strandCount(); ++i) centroid += glm::dvec3(s.points[s.firstPoint[i]]);
   centroid /= double(std::max<size_t>(s.strandCount(), 1));
@@ -48,7 +48,7 @@ std::vector<glm::vec3> reposeNormals(const Strands& rest, const Strands& deforme
   if (rest.strandCount() != deformed.strandCount() || rest.firstPoint != deformed.firstPoint)
     throw InputError("the rest coupe and the coupe to re-pose differ in strands or vertex counts");
   if (rest.normals.empty()) throw InputError("the rest coupe has no normals; run hairgen shade on it first");
-  const std::vector<glm::vec3> tr = tangentsOf(rest), td = tangentsOf(deformed);
+  const PointArray tr = tangentsOf(rest), td = tangentsOf(deformed);
   const std::vector<glm::vec3> ur = transportFrames(rest), ud = transportFrames(deformed);
   std::vector<glm::vec3> out(deformed.pointCount());
   for (size_t p = 0; p < out.size(); ++p) {

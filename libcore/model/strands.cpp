@@ -21,8 +21,8 @@ bool finite(const glm::vec3& v) {
 
 // Whether any value of an array of floats or doubles is not finite (all exponent bits set), without a
 // branch per value so that it vectorises: a cache's arrays are checked at memory speed.
-template <typename T>
-bool anyNonFinite(const std::vector<T>& values) {
+template <typename T, class A>
+bool anyNonFinite(const std::vector<T, A>& values) {
   if constexpr (std::is_same_v<T, uint32_t> || std::is_same_v<T, glm::uvec3>) {
     return false;
   } else {
@@ -51,8 +51,9 @@ bool finiteEntry(const T& v) {
     return finite(v);
 }
 
-template <typename T>
-void checkArray(const std::string& source, const char* name, const std::vector<T>& values, size_t expected) {
+template <class T, class A>
+void checkArray(const std::string& source, const char* name, const std::vector<T, A>& values,
+                size_t expected) {
   if (values.empty()) return;
   if (values.size() != expected)
     throw InputError({source, 0}, std::string(name) + " has " + std::to_string(values.size()) +
@@ -85,7 +86,7 @@ Provenance madeByHairgen(std::string stage, uint64_t seed, std::string configDig
 }
 
 void Strands::assignRestKeepingBuffers(const Strands& rest) {
-  std::vector<glm::vec3> keptPoints = std::move(points), keptTangents = std::move(tangents);
+  PointArray keptPoints = std::move(points), keptTangents = std::move(tangents);
   std::vector<double> keptState = std::move(simulationState);
   *this = rest;
   points = std::move(keptPoints);
@@ -128,8 +129,8 @@ void Strands::validate(const std::string& source) const {
     throw InputError({source, 0}, "header defaults are not finite");
 }
 
-std::vector<glm::vec3> polylineTangents(const Strands& s) {
-  std::vector<glm::vec3> t(s.pointCount(), glm::vec3(0.0f, 1.0f, 0.0f));
+PointArray polylineTangents(const Strands& s) {
+  PointArray t(s.pointCount(), glm::vec3(0.0f, 1.0f, 0.0f));
   for (size_t i = 0; i < s.strandCount(); ++i) {
     const uint32_t first = s.firstPoint[i], last = s.firstPoint[i + 1];
     glm::vec3 previous(0.0f, 1.0f, 0.0f);

@@ -9,6 +9,8 @@
 
 #include <glm/glm.hpp>
 
+#include "libcore/util/uninitialised.h"
+
 namespace hairgen {
 
 // A shard of a split stage (`--shard K/N`): the range of the stage's items it holds (grow: wick vertices,
@@ -49,16 +51,20 @@ struct Provenance {
 // The provenance of what this build of hairgen makes: producer "hairgen VERSION", no frame.
 Provenance madeByHairgen(std::string stage, uint64_t seed, std::string configDigest);
 
+// A coupe's points or tangents. Sizing one leaves its new elements unset (UninitialisedAllocator): whoever
+// resizes it writes every element it adds, so hundreds of MB are written once, not zeroed first.
+using PointArray = std::vector<glm::vec3, UninitialisedAllocator<glm::vec3>>;
+
 // A set of polyline strands. Strand s owns points [firstPoint[s], firstPoint[s+1]).
 //
 // Every optional array is either empty or has exactly its documented size; validate() checks it.
 // Units: metres, unit vectors, widths as diameters in metres (DESIGN §2).
 struct Strands {
-  std::vector<glm::vec3> points;
+  PointArray points;
   std::vector<uint32_t> firstPoint{0};  // strandCount() + 1 offsets, firstPoint[0] == 0
 
   // Per point (size points.size() or empty).
-  std::vector<glm::vec3> tangents;  // unit
+  PointArray tangents;              // unit
   std::vector<glm::vec3> normals;   // unit shading normals
   std::vector<glm::vec3> colors;    // linear RGB
   std::vector<float> thickness;     // diameter, metres
@@ -89,8 +95,8 @@ struct Strands {
   uint32_t pointsOf(size_t strand) const { return firstPoint[strand + 1] - firstPoint[strand]; }
 
   // Becomes a copy of `rest` whose points, tangents and simulation state are to be filled: those arrays
-  // keep their storage (sized to rest's points), so a frame posed into the same Strands each time
-  // allocates nothing.
+  // keep their storage (sized to rest's points, their values unset: the caller writes every one), so a
+  // frame posed into the same Strands each time allocates nothing.
   void assignRestKeepingBuffers(const Strands& rest);
 
   // Appends a strand's points; the optional arrays are left to the caller.
@@ -105,10 +111,10 @@ struct Strands {
 
 // Unit tangents of every strand's polyline by forward differences (the last point looks back; a
 // repeated point keeps the previous tangent, +y before any), for caches that carry none.
-std::vector<glm::vec3> polylineTangents(const Strands& strands);
+PointArray polylineTangents(const Strands& strands);
 
 // The strands' own tangents when they carry them, else polylineTangents().
-inline std::vector<glm::vec3> tangentsOf(const Strands& strands) {
+inline PointArray tangentsOf(const Strands& strands) {
   return strands.tangents.empty() ? polylineTangents(strands) : strands.tangents;
 }
 

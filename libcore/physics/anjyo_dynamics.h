@@ -157,7 +157,7 @@ class AnjyoHair {
   std::vector<LanePoint> lanePoints_;
 
   Strands rest_;  // every attribute of the rest guides but their points and tangents
-  std::vector<glm::vec3> restPoints_;
+  PointArray restPoints_;
   std::vector<uint32_t> firstSegment_;  // per strand, + 1
   std::vector<double> state_;           // kStateValues per segment: 0 at rest but the cosines, 1
   std::vector<double> shapeReach2_;     // per shape: beyond this squared distance nothing reaches it
@@ -175,7 +175,7 @@ class AnjyoHair {
     bool mayBeWithin(const glm::dvec3& v) const { return !ellipsoid || ratio2(v) < near2; }
   };
   std::vector<ShapeTest> shapeTests_;
-  std::vector<glm::vec3> restTangents_;
+  PointArray restTangents_;
   std::vector<glm::dvec3> restForward_;         // the rest nodes as the forward recurrence computes them
   std::vector<std::vector<double>> restDepth_;  // per shape, per node: the depth it sat at in the shape
   std::vector<CollisionShape> shapes_;

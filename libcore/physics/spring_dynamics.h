@@ -186,7 +186,7 @@ class SpringHair {
   // Twist springs, indexed by their first point i (to i + 3): rest distance and compliance (m/N), 0
   // stiffness as compliance < 0.
   std::vector<double> twistLength_, twistCompliance_;
-  std::vector<glm::vec3> restTangents_;
+  PointArray restTangents_;
   std::vector<glm::dvec3> restUnit_;  // per point but each strand's last, its segment's rest direction
   // The implicit solve, per free point: 1/D and the two sub-diagonals of L in M(1 + cΔt) + Δt²K = L D Lᵀ,
   // for the step dt_.

@@ -217,7 +217,7 @@ Buffer::~Buffer() {
 
 // ------------------------------------------------------------------------------------------ geometry
 
-HairGeometry::HairGeometry(const Strands& s, const std::vector<glm::vec3>& tangentData, const Strands* before)
+HairGeometry::HairGeometry(const Strands& s, const PointArray& tangentData, const Strands* before)
     : points(s.points.data(), s.points.size() * sizeof(glm::vec3)),
       tangents(tangentData.data(), tangentData.size() * sizeof(glm::vec3)),
       colors(s.colors.data(), s.colors.size() * sizeof(glm::vec3)),

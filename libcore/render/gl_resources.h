@@ -119,8 +119,7 @@ struct LineStrips {
 // buffer 4.
 struct HairGeometry {
   // `tangents`: one per point. `previous`: null, or the same strands a frame before (as many points).
-  HairGeometry(const Strands& strands, const std::vector<glm::vec3>& tangents,
-               const Strands* previous = nullptr);
+  HairGeometry(const Strands& strands, const PointArray& tangents, const Strands* previous = nullptr);
   ~HairGeometry();
   HairGeometry(const HairGeometry&) = delete;
   HairGeometry& operator=(const HairGeometry&) = delete;

@@ -100,7 +100,7 @@ StageSource stage(const char* own, const std::optional<CustomStage>& custom = st
 // The strands' own tangents, or polylineTangents() in `computed` when they carry none: tangentsOf()
 // would copy them (115 MB at 150,000 strands of 64 points). `computed` lives to the end of the
 // expression that calls this.
-const std::vector<glm::vec3>& tangentsFor(const Strands& s, std::vector<glm::vec3>&& computed = {}) {
+const PointArray& tangentsFor(const Strands& s, PointArray&& computed = {}) {
   if (!s.tangents.empty()) return s.tangents;
   computed = polylineTangents(s);
   return computed;

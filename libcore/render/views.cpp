@@ -20,9 +20,11 @@ glm::dvec3 anyUp(const glm::dvec3& forward, const glm::dvec3& preferred) {
 
 BoundingSphere boundingSphere(const Strands& hair, const Mesh* head) {
   std::vector<glm::vec3> corners;
-  for (const std::vector<glm::vec3>* points : {&hair.points, head ? &head->positions : nullptr})
-    if (points && !points->empty()) {
-      const Bounds b = bounds(*points);
+  for (const std::span<const glm::vec3> points :
+       {std::span<const glm::vec3>(hair.points),
+        head ? std::span<const glm::vec3>(head->positions) : std::span<const glm::vec3>()})
+    if (!points.empty()) {
+      const Bounds b = bounds(points);
       corners.insert(corners.end(), {b.min, b.max});
     }
   if (corners.empty()) return {glm::dvec3(0.0), 0.1};

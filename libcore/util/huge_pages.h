@@ -27,14 +27,14 @@ inline void adviseHugePages(void* data, size_t bytes) {
 
 // v resized to n. When it grows past 8 MiB, its new storage is asked of the kernel in 2 MiB pages
 // (madvise; only advice: where transparent huge pages are off, it has 4 KiB ones) and faulted in by
-// every core at once before resize fills it. The values are resize's (zeros for new elements, the old
-// ones kept).
-template <class T>
-void resizeLarge(std::vector<T>& v, size_t n) {
+// every core at once before resize makes the elements. The values are resize's: the old ones kept,
+// new ones as the allocator makes them (zeros for std::allocator, unset for UninitialisedAllocator).
+template <class T, class A>
+void resizeLarge(std::vector<T, A>& v, size_t n) {
   static_assert(std::is_trivially_copyable_v<T>, "its storage is touched before it holds elements");
   constexpr size_t kLarge = size_t(8) << 20;
   if (n > v.capacity() && n * sizeof(T) >= kLarge) {
-    std::vector<T> fresh;
+    std::vector<T, A> fresh;
     fresh.reserve(n);
     adviseHugePages(fresh.data(), n * sizeof(T));
     // A zero byte in every 4 KiB page of the storage not yet holding elements: its faults (the kernel

@@ -115,7 +115,7 @@ ValueAndGradient sampleWithGradient(const Grid& grid, const glm::vec3* gradients
 
 }  // namespace
 
-Bounds boundsInParallel(const std::vector<glm::vec3>& points) {
+Bounds boundsInParallel(std::span<const glm::vec3> points) {
   if (points.empty()) return {};
   const Bounds none{glm::vec3(std::numeric_limits<float>::max()),
                     glm::vec3(std::numeric_limits<float>::lowest())};
@@ -136,7 +136,7 @@ Bounds boundsInParallel(const std::vector<glm::vec3>& points) {
 }
 
 template <class T>
-GridOf<T> gridAround(const std::vector<glm::vec3>& points, double voxel, int padding) {
+GridOf<T> gridAround(std::span<const glm::vec3> points, double voxel, int padding) {
   if (points.empty()) throw InputError("the coupe has no points to build a volume from");
   const Bounds box = boundsInParallel(points);
   const glm::dvec3 lo(box.min), hi(box.max);
@@ -211,7 +211,7 @@ void splatBlock(const glm::dvec3& origin, double voxel, const glm::vec3* __restr
 
 }  // namespace
 
-void splat(Grid& d, const std::vector<glm::vec3>& points) {
+void splat(Grid& d, std::span<const glm::vec3> points) {
   // Weights are added as 32.32 fixed-point integers: integer sums do not depend on the order of the
   // additions, so however the points fall to threads the grid is the same bits on every run and thread
   // count. Each point's eight weights are rounded to sum to exactly one (the rounding is given to its
@@ -413,8 +413,8 @@ double densityEnergy(const Grid& d) {
 
 template struct GridOf<float>;
 template struct GridOf<glm::dvec4>;
-template GridOf<float> gridAround<float>(const std::vector<glm::vec3>&, double, int);
-template GridOf<glm::dvec4> gridAround<glm::dvec4>(const std::vector<glm::vec3>&, double, int);
+template GridOf<float> gridAround<float>(std::span<const glm::vec3>, double, int);
+template GridOf<glm::dvec4> gridAround<glm::dvec4>(std::span<const glm::vec3>, double, int);
 template void smoothInPlace<float>(GridOf<float>&);
 template void smoothInPlace<glm::dvec4>(GridOf<glm::dvec4>&);
 template GridOf<float> smoothed<float>(const GridOf<float>&);

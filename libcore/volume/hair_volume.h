@@ -5,6 +5,7 @@
 #pragma once
 
 #include <cstdint>
+#include <span>
 #include <type_traits>
 #include <utility>
 #include <vector>
@@ -38,12 +39,12 @@ using Grid = GridOf<float>;
 
 // bounds(points) from every core, for the millions of points of a coupe: a minimum or maximum does
 // not round, and the threads' boxes join in the points' order, so it is the same box to the bit.
-Bounds boundsInParallel(const std::vector<glm::vec3>& points);
+Bounds boundsInParallel(std::span<const glm::vec3> points);
 
 // A grid around `points` with `padding` empty nodes on every side, all values zero. Throws InputError
 // beyond 4e8 nodes.
 template <class T = float>
-GridOf<T> gridAround(const std::vector<glm::vec3>& points, double voxel, int padding);
+GridOf<T> gridAround(std::span<const glm::vec3> points, double voxel, int padding);
 
 // Splats every point with the tent (trilinear) kernel of the paper's (1): each point adds weights
 // summing to exactly 1 to the 8 nodes around it, so the grid sums to the number of points inside it.
@@ -51,7 +52,7 @@ GridOf<T> gridAround(const std::vector<glm::vec3>& points, double voxel, int pad
 // many as fit in kSplatCopiesBytes (at least one): a many-core machine with a fine grid runs the
 // splat on fewer threads rather than holding a grid per core.
 constexpr double kSplatCopiesBytes = 256.0 * 1024 * 1024;
-void splat(Grid& density, const std::vector<glm::vec3>& points);
+void splat(Grid& density, std::span<const glm::vec3> points);
 
 // Adds values[i] times point i's tent weights to the 8 nodes around it (the outer corners of a point
 // at the grid's edge fall away). Sums in a fixed order, whatever the thread count: points by z-slab of
