@@ -132,6 +132,12 @@ RenderOutput render(GlContext& gl, const Strands& hair, const Mesh* head, const 
   input.domResolution =
       options.domResolution > 0 ? options.domResolution : domResolutionFor(settings.resolution);
   input.keepDom = options.keepDom;
+  input.uploaded = [&] {  // render's own copies (conformed, framing) go with the caller's hair
+    copy.reset();
+    copyBefore.reset();
+    copyFraming.reset();
+    if (options.uploaded) options.uploaded();
+  };
   const BoundingSphere scene = boundingSphere(*input.hair, head);
   const double nearest =
       std::max(glm::length(scene.centre - input.settings.cameraPosition) - scene.radius, 1e-3);

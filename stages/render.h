@@ -41,6 +41,7 @@
 // setup.txt:9)".
 #pragma once
 
+#include <functional>
 #include <optional>
 #include <string>
 
@@ -64,6 +65,9 @@ struct RenderOptions {
   // A sequence names its shot's first frame, so the camera holds still over the shot.
   const Strands* framing = nullptr;
   Progress* progress = nullptr;  // advanced once per pass (renderPassCount)
+  // Called once the hair is on the GPU and render() reads it no more (RenderInput::uploaded): a caller
+  // that has no more use for it may free it then.
+  std::function<void()> uploaded;
 };
 
 // Hair made elsewhere, to hairgen's conventions: z-up turned to y-up (x, y, z) → (x, z, −y), then

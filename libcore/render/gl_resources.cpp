@@ -9,6 +9,7 @@
 #include <glm/gtc/type_ptr.hpp>
 
 #include "libcore/render/custom_shaders.h"
+#include "libcore/render/line_decimation.h"
 #include "libcore/render/shader_interface.h"
 #include "libcore/util/error.h"
 #include "libcore/util/huge_pages.h"
@@ -215,6 +216,11 @@ Buffer::~Buffer() {
   glDeleteBuffers(1, &id);
 }
 
+void Buffer::reset() {
+  glDeleteBuffers(1, &id);
+  id = 0;
+}
+
 // ------------------------------------------------------------------------------------------ geometry
 
 HairGeometry::HairGeometry(const Strands& s, const PointArray& tangentData, const Strands* before)
@@ -277,13 +283,56 @@ void HairGeometry::drawInOrder(const Strands& s, const std::vector<uint32_t>& or
     ribbonFirsts[i] = static_cast<GLint>(2 * s.firstPoint[strand]);
     ribbonCounts[i] = static_cast<GLsizei>(2 * s.pointsOf(strand));
   }
+  // Chunks of whole strands of about kCameraChunkVertices line vertices (a ribbon's has twice as many).
+  chunkEnds.clear();
+  size_t vertices = 0;
+  for (size_t i = 0; i < order.size(); ++i)
+    if ((vertices += size_t(lineCounts[i])) >= kCameraChunkVertices || i + 1 == order.size()) {
+      chunkEnds.push_back(i + 1);
+      vertices = 0;
+    }
 }
 
 HairGeometry::~HairGeometry() {
   glDeleteVertexArrays(1, &vao);
 }
 
-LineStrips::LineStrips(const std::vector<uint32_t>& indices) : count(static_cast<GLsizei>(indices.size())) {
+void HairGeometry::release() {
+  glDeleteVertexArrays(1, &vao);  // first: a vertex array keeps the buffers it names alive
+  vao = 0;
+  for (Buffer* b : {&points, &tangents, &colors, &normals, &previous}) b->reset();
+}
+
+namespace {
+
+// Draws chunk c of `chunks` for every c, in order, with at most two chunks unfinished at once
+// (kChunkVertices).
+template <class Draw>
+void drawInChunks(size_t chunks, Draw&& draw) {
+  GLsync fences[2] = {nullptr, nullptr};
+  for (size_t c = 0; c < chunks; ++c) {
+    GLsync& oldest = fences[c % 2];
+    if (oldest) {
+      glClientWaitSync(oldest, GL_SYNC_FLUSH_COMMANDS_BIT, ~GLuint64(0));
+      glDeleteSync(oldest);
+      oldest = nullptr;
+    }
+    draw(c);
+    if (c + 1 < chunks) oldest = glFenceSync(GL_SYNC_GPU_COMMANDS_COMPLETE, 0);
+  }
+  for (GLsync fence : fences)
+    if (fence) glDeleteSync(fence);
+}
+
+}  // namespace
+
+LineStrips::LineStrips(const std::vector<uint32_t>& indices, size_t chunkVertices)
+    : count(static_cast<GLsizei>(indices.size())) {
+  size_t start = 0;
+  for (size_t i = 0; i < indices.size(); ++i)
+    if (indices[i] == kRestartIndex && i + 1 - start >= chunkVertices)
+      chunkEnds.push_back(static_cast<GLsizei>(start = i + 1));
+  if (start < indices.size()) chunkEnds.push_back(count);
   glCreateBuffers(1, &id);
   glNamedBufferStorage(id, static_cast<GLsizeiptr>(std::max<size_t>(indices.size() * sizeof(uint32_t), 4)),
                        indices.empty() ? nullptr : indices.data(), 0);
@@ -298,7 +347,11 @@ void HairGeometry::drawLines(const LineStrips* strips) const {
   draw(false, false);
   glVertexArrayElementBuffer(vao, strips->id);
   glEnable(GL_PRIMITIVE_RESTART_FIXED_INDEX);
-  glDrawElements(GL_LINE_STRIP, strips->count, GL_UNSIGNED_INT, nullptr);
+  drawInChunks(strips->chunkEnds.size(), [&](size_t c) {
+    const GLsizei first = c > 0 ? strips->chunkEnds[c - 1] : 0;
+    glDrawElements(GL_LINE_STRIP, strips->chunkEnds[c] - first, GL_UNSIGNED_INT,
+                   reinterpret_cast<const void*>(uintptr_t(first) * sizeof(uint32_t)));
+  });
   glDisable(GL_PRIMITIVE_RESTART_FIXED_INDEX);
 }
 
@@ -312,12 +365,14 @@ void HairGeometry::draw(bool ribbon, bool drawing) const {
   if (!hasColors) glVertexAttrib3f(2, 1.0f, 1.0f, 1.0f);
   if (!hasNormals) glVertexAttrib3f(3, 0.0f, 0.0f, 0.0f);
   if (lineFirsts.empty() || !drawing) return;
-  if (ribbon)
-    glMultiDrawArrays(GL_TRIANGLE_STRIP, ribbonFirsts.data(), ribbonCounts.data(),
-                      static_cast<GLsizei>(ribbonFirsts.size()));
-  else
-    glMultiDrawArrays(GL_LINE_STRIP, lineFirsts.data(), lineCounts.data(),
-                      static_cast<GLsizei>(lineFirsts.size()));
+  drawInChunks(chunkEnds.size(), [&](size_t c) {
+    const size_t first = c > 0 ? chunkEnds[c - 1] : 0;
+    const GLsizei strands = static_cast<GLsizei>(chunkEnds[c] - first);
+    if (ribbon)
+      glMultiDrawArrays(GL_TRIANGLE_STRIP, &ribbonFirsts[first], &ribbonCounts[first], strands);
+    else
+      glMultiDrawArrays(GL_LINE_STRIP, &lineFirsts[first], &lineCounts[first], strands);
+  });
 }
 
 HeadGeometry::HeadGeometry(const Mesh& m, const Mesh* before) {

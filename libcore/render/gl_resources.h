@@ -91,6 +91,7 @@ struct Buffer {
   ~Buffer();
   Buffer(const Buffer&) = delete;
   Buffer& operator=(const Buffer&) = delete;
+  void reset();  // deletes it now
 
   GLuint id = 0;
 };
@@ -100,16 +101,25 @@ struct Buffer {
 // ties of equal depth.
 std::vector<uint32_t> frontToBack(const Strands& strands, const glm::dmat4& view);
 
+// A pass draws its hair in chunks of about this many vertices, waiting for the chunk before the last
+// one drawn to finish before it draws the next (a fence): llvmpipe bins a draw into scenes and queues
+// scenes while its rasterisers lag behind, so one draw of the whole coupe held hundreds of MB of
+// binned scenes at once. Two chunks in flight keep binning and rasterising going side by side. The
+// camera's passes bin more per line (their varyings) and draw in smaller chunks. (150,000 strands at
+// 1080p, README Performance: smaller chunks than these saved little more memory and cost time.)
+constexpr size_t kChunkVertices = size_t(1) << 18, kCameraChunkVertices = size_t(1) << 17;
+
 // Line strips through some of a coupe's points (line_decimation.h: point indices, kRestartIndex
 // between strips) in an index buffer, for HairGeometry::drawLines.
 struct LineStrips {
-  explicit LineStrips(const std::vector<uint32_t>& indices);
+  explicit LineStrips(const std::vector<uint32_t>& indices, size_t chunk = kChunkVertices);
   ~LineStrips();
   LineStrips(const LineStrips&) = delete;
   LineStrips& operator=(const LineStrips&) = delete;
 
   GLuint id = 0;
   GLsizei count = 0;
+  std::vector<GLsizei> chunkEnds;  // where each of drawLines' chunks of whole strips ends (kChunkVertices)
 };
 
 // Hair on the GPU: points, tangents, colors and normals (where the strands have them) both as vertex
@@ -129,11 +139,14 @@ struct HairGeometry {
   void drawLines(const LineStrips* strips) const;
   // Draws the strands in `order` (frontToBack's: every strand of two points or more, once).
   void drawInOrder(const Strands& strands, const std::vector<uint32_t>& order);
+  // Deletes the vertex array and the buffers now (nothing may be drawn after).
+  void release();
 
   Buffer points, tangents, colors, normals, previous;
   bool hasColors, hasNormals, hasPrevious;
   std::vector<GLint> lineFirsts, ribbonFirsts;
   std::vector<GLsizei> lineCounts, ribbonCounts;
+  std::vector<size_t> chunkEnds;  // where each of draw()'s chunks of strands ends (kCameraChunkVertices)
   GLuint vao = 0;
 };
 

@@ -225,12 +225,21 @@ Scene::Scene(const RenderInput& in)
   preparing->work.wait();
   if (!preparing->order.empty()) hair.drawInOrder(*in.hair, preparing->order);
   if (preparing->lightChords) lightLines = std::make_unique<LineStrips>(preparing->light);
-  if (preparing->cameraChords) cameraLines = std::make_unique<LineStrips>(preparing->camera);
+  if (preparing->cameraChords)
+    cameraLines = std::make_unique<LineStrips>(preparing->camera, kCameraChunkVertices);
   preparing.reset();
   checkGl("setting up");
 }
 
 Scene::~Scene() = default;
+
+void Scene::releaseGeometry() {
+  glBindVertexArray(0);
+  hair.release();
+  lightLines.reset();
+  cameraLines.reset();
+  head.reset();
+}
 
 LightDepth lightDepthPass(const Scene& scene) {
   const int n = scene.light.width;

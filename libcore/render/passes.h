@@ -58,6 +58,12 @@ struct Scene {
   std::unique_ptr<LineStrips> lightLines, cameraLines;
   std::unique_ptr<HeadGeometry> head;  // null when there is no head to draw
   Programs programs;
+
+  // Frees the geometry once the passes that draw it are done, so what follows (the readback, the
+  // images' writing) does not run with the coupe still held: the light's chords after its passes, all
+  // of it after the last pass.
+  void releaseLightLines() { lightLines.reset(); }
+  void releaseGeometry();
 };
 
 // The light's depth maps, metres along its axis (kBackgroundZ where nothing was drawn).

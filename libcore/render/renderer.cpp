@@ -34,13 +34,14 @@ RenderOutput renderHair(GlContext&, const RenderInput& in) {
   RenderOutput out;
   Stopwatch clock;
   clearGlErrors();
-  const Scene scene(in);
+  Scene scene(in);
   out.samples = scene.block * scene.block;
   out.settings = in.settings;
   out.worldToCamera = scene.camera.view;
   out.worldToNdc = scene.camera.proj * scene.camera.view;
   out.worldToLight = scene.light.proj * scene.light.view;
   out.timings.upload = seconds(clock);
+  if (in.uploaded) in.uploaded();
   auto passDone = [&] {
     if (in.progress) in.progress->advance();
   };
@@ -50,6 +51,7 @@ RenderOutput renderHair(GlContext&, const RenderInput& in) {
   out.timings.lightDepth = seconds(clock);
   passDone();
   const Texture opacity = deepOpacityPass(scene, depth);
+  scene.releaseLightLines();
   out.timings.opacity = seconds(clock);
   passDone();
   const ShadedImage image = resolvePass(scene, shadingPass(scene, depth, opacity));
@@ -61,6 +63,7 @@ RenderOutput renderHair(GlContext&, const RenderInput& in) {
     out.timings.motion = seconds(clock);
     passDone();
   }
+  scene.releaseGeometry();
   readBack(image, motion ? &*motion : nullptr, in.keepDom ? &depth : nullptr, in.keepDom ? &opacity : nullptr,
            out);
   out.timings.readback = seconds(clock);

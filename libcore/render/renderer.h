@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cstdint>
+#include <functional>
 #include <optional>
 #include <string>
 #include <vector>
@@ -67,6 +68,9 @@ struct RenderInput {
   bool keepDom = false;
   std::optional<PreviousFrame> previous;  // motion vectors in the beauty image when given
   Progress* progress = nullptr;           // advanced once per pass (renderPassCount of them)
+  // Called once the hair (and the frame before's) is on the GPU and renderHair reads it no more: the
+  // caller may free it then, so the passes do not run with both copies held.
+  std::function<void()> uploaded;
 };
 
 // The passes renderHair reports to its Progress: upload, light depth, opacity, shading, (motion,)
