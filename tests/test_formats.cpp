@@ -144,6 +144,16 @@ TEST(Ply, HostileFilesAreInputErrors) {
   EXPECT_THROW(decodePlyText("ply\nformat ascii 1.0\nelement vertex 1\nproperty list uint float x\n"
                              "end_header\n4000000000 1\n"),
                InputError);  // x is a list; and the list's length is absurd
+  try {                      // a tangent component as a list: refused, not left unread
+    decodePlyText(
+        "ply\nformat ascii 1.0\nelement vertex 2\nproperty float x\nproperty float y\n"
+        "property float z\nproperty list uchar float tangent_x\nproperty float tangent_y\n"
+        "property float tangent_z\nelement strand 1\nproperty uchar nsegs\nend_header\n"
+        "0 0 0 1 1 0 0\n0 1 0 1 1 0 0\n1\n");
+    ADD_FAILURE() << "a list tangent_x was accepted";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("'tangent_x' is a list"), std::string::npos) << e.what();
+  }
   EXPECT_THROW(decodePlyText("ply\nformat ascii 2.0\nend_header\n"), InputError);
   EXPECT_THROW(decodePlyText("plyx"), InputError);
 }

@@ -388,9 +388,15 @@ Strands decodePly(const uint8_t* data, size_t size, const std::string& name, Ply
     sinks[i] = {base, nullptr, stride, scale, e.name + " property " + property};
     return true;
   };
+  // A vector attribute is read when the vertex has its three components, each a scalar (`out` is sized
+  // only then, and every element is written: tangents are a PointArray, which sizing leaves unset).
   auto sinkVec3 = [&](const char* const names[3], auto& out) {
     for (int c = 0; c < 3; ++c)
       if (vertex->find(names[c]) < 0) return;
+    for (int c = 0; c < 3; ++c)
+      if (vertex->properties[vertex->find(names[c])].list)
+        throw InputError({name, 0}, std::string("the vertex element's property '") + names[c] +
+                                        "' is a list; hairgen reads it as one number per vertex");
     out.resize(n);
     for (int c = 0; c < 3; ++c) sinkFloat(vertexSinks, *vertex, names[c], component(out, c), 3);
   };
