@@ -29,6 +29,7 @@
 #include <sys/resource.h>
 #include <sys/wait.h>
 
+#include <cerrno>
 #include <ctime>
 #include <map>
 
@@ -46,6 +47,8 @@
 #include "stages/render.h"
 #include "stages/shade.h"
 #include "stages/simulate.h"
+
+extern char** environ;  // what the child inherits (POSIX declares it nowhere)
 
 namespace hairgen {
 namespace {
@@ -441,8 +444,10 @@ void RenderCommand(benchmark::State& state) {
     }
     int status = 0;
     rusage usage{};
-    wait4(child, &status, 0, &usage);
-    if (!WIFEXITED(status) || WEXITSTATUS(status) != 0) {
+    pid_t waited;
+    while ((waited = wait4(child, &status, 0, &usage)) < 0 && errno == EINTR) {
+    }
+    if (waited != child || !WIFEXITED(status) || WEXITSTATUS(status) != 0) {
       state.SkipWithError("hairgen render failed");
       return;
     }
