@@ -495,20 +495,22 @@ void AnjyoHair::posedInto(const Pose& pose, Strands& out, Kernel kernel) const {
   tbb::parallel_for(size_t(0), rest_.strandCount(), [&](size_t s) {
     const uint32_t p0 = rest_.firstPoint[s], first = firstSegment_[s], k = firstSegment_[s + 1] - first;
     glm::dvec3 node = restForward_[p0], dir(0.0);
-    bool moved = false;  // whether the segment at hand has left its rest direction
+    Segment segment{};   // the segment the point starts (the last point takes the last segment's)
+    bool moved = false;  // whether it has left its rest direction
     for (uint32_t j = 0; j <= k; ++j) {
       const uint32_t p = p0 + j;
-      if (j > 0) node += segmentOf(s, j - 1).length * dir;
-      if (j < k) {  // the segment the point starts (the last point takes the last segment's)
+      if (j > 0) node += segment.length * dir;  // segment j − 1's
+      if (j < k) {
         const double* v = &state_[stateAt(s, j)];
-        dir = directionOf(s, j);
+        segment = segmentOf(s, j);
+        dir = directionAt(segment.frame, v[kTheta * kLanes], v[kPhi * kLanes]);
         moved = v[kTheta * kLanes] != 0.0 || v[kPhi * kLanes] != 0.0;
       }
       // The input point plus the motion: at rest exactly the input.
       out.points[p] = glm::vec3(pose.apply(glm::dvec3(restPoints_[p]) + (node - restForward_[p])));
       glm::dvec3 t(restTangents_[p]);
       // Turned with its segment: the minimal rotation from the rest direction to the current one.
-      if (k > 0 && moved) t = transportFast(segmentOf(s, std::min(j, k - 1)).frame.rest, dir, t);
+      if (k > 0 && moved) t = transportFast(segment.frame.rest, dir, t);
       out.tangents[p] = glm::vec3(still ? t : pose.rotation * t);  // a rotation keeps it unit
     }
   });
