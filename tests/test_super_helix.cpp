@@ -179,5 +179,53 @@ TEST(StrandEnergy, CollisionTermEqualsDirectSamplingOfEveryShape) {
   EXPECT_GE(touching, 15);  // the shapes are where the strands go
 }
 
+TEST(StrandEnergy, GradientMatchesCentralDifferencesAndValueIsTheEnergys) {
+  // The forward-mode gradient of every term (elastic, closed-form gravity, penalties of the three
+  // kinds of shape, the series and closed-form branches, a straight element at W = 0) against
+  // central differences; 11 coordinates, so the last of two walks is partly seeded.
+  Hairstyle style;
+  style.hairLengths = {0.03, 0.05, 0.04, 0.006};
+  style.collisionStep = 0.004;
+  style.helixRadius = 0.01;
+  style.helixStep = 0.05;
+  Collision collision;
+  glm::dmat3 tilted = glm::dmat3(glm::rotate(glm::dmat4(1.0), 0.4, glm::dvec3(1, 2, 0.5)));
+  collision.shapes = {
+      {ShapeKind::kEllipsoid, 0.03, 10.0, glm::dvec3(0, 0.12, 0), glm::dvec3(0.08, 0.1, 0.11), tilted, {}},
+      {ShapeKind::kSphere, 0.01, 3.0, glm::dvec3(0.05, 0.2, 0.08), glm::dvec3(0.06), glm::dmat3(1.0), {}},
+      {ShapeKind::kCuboid,
+       0.0,
+       20.0,
+       glm::dvec3(-0.04, 0.15, 0.0),
+       glm::dvec3(0.05, 0.02, 0.04),
+       tilted,
+       {}}};
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> k(-60.0, 60.0);
+  int touching = 0;
+  for (int trial = 0; trial < 20; ++trial) {
+    RodFrame root = follicleFrame(glm::dvec3(0.0, 0.2, 0.0), glm::dvec3(0.3 * k(rng) / 60.0, 1.0, 0.2));
+    StrandEnergy energy(style, collision, root, 0.6);
+    std::vector<double> q;
+    for (int i = 0; i < 12; ++i) q.push_back(k(rng));
+    if (trial == 0) std::fill(q.begin(), q.end(), 0.0);  // straight: W = 0 in every element
+    if (trial == 1) q[9] = 0.5, q[10] = q[11] = 0.0;     // Ω ℓ = 0.003: the series
+    std::vector<double> gradient(q.size());
+    const double value = energy.valueAndGradient(q, gradient);
+    EXPECT_EQ(value, energy(q)) << "trial " << trial;
+    touching += energy.terms(q).collision > 0.0;
+    for (size_t i = 0; i < q.size(); ++i) {
+      const double h = 1e-4;
+      std::vector<double> up = q, down = q;
+      up[i] += h;
+      down[i] -= h;
+      const double central = (energy(up) - energy(down)) / (2.0 * h);
+      EXPECT_NEAR(gradient[i], central, 1e-5 * std::abs(central) + 1e-14)
+          << "trial " << trial << ", coordinate " << i;
+    }
+  }
+  EXPECT_GE(touching, 10);
+}
+
 }  // namespace
 }  // namespace hairgen

@@ -6,27 +6,31 @@
 
 namespace hairgen {
 
-double penetration(const CollisionShape& shape, const glm::dvec3& p) {
-  glm::dvec3 v = p - shape.centre;
-  glm::dvec3 local(glm::dot(v, shape.axes[0]), glm::dot(v, shape.axes[1]), glm::dot(v, shape.axes[2]));
+template <class T>
+T penetrationOf(const CollisionShape& shape, const Vec3<T>& p) {
+  const Vec3<T> v = p - Vec3<T>(shape.centre);
+  const Vec3<T> local(dotOf(v, shape.axes[0]), dotOf(v, shape.axes[1]), dotOf(v, shape.axes[2]));
+  const glm::dvec3& half = shape.halfExtents;
   switch (shape.kind) {
     case ShapeKind::kSphere:
-      return shape.halfExtents.x - glm::length(v);
+      return half.x - lengthOf(v);
     case ShapeKind::kEllipsoid: {
       // Along the ray from the centre through p: the surface lies at dist / ratio (§4.1.2.1.1).
-      double dist = glm::length(local);
-      double ratio = glm::length(local / shape.halfExtents);
-      if (!(ratio > 0.0))
-        return std::min(shape.halfExtents.x, std::min(shape.halfExtents.y, shape.halfExtents.z));
+      const T dist = lengthOf(local);
+      const T ratio = lengthOf(Vec3<T>(local.x / half.x, local.y / half.y, local.z / half.z));
+      if (!(ratio > 0.0)) return T(std::min(half.x, std::min(half.y, half.z)));
       return dist / ratio - dist;
     }
     case ShapeKind::kCuboid: {
-      glm::dvec3 dent = shape.halfExtents - glm::abs(local);
-      return std::min(dent.x, std::min(dent.y, dent.z));
+      // |local| per axis; a face's dent has the derivative of the coordinate it is measured along.
+      auto dent = [&](int k) { return valueOf(local[k]) < 0.0 ? half[k] + local[k] : half[k] - local[k]; };
+      return minOf(dent(0), minOf(dent(1), dent(2)));
     }
   }
-  return 0.0;
+  return T(0.0);
 }
+template double penetrationOf(const CollisionShape&, const Vec3<double>&);
+template EnergyGradient penetrationOf(const CollisionShape&, const Vec3<EnergyGradient>&);
 
 namespace {
 
@@ -116,6 +120,13 @@ std::vector<double> StrandEnergy::initialSteps() const {
   return steps;
 }
 
+std::vector<double> StrandEnergy::inverseStiffness() const {
+  std::vector<double> out;
+  for (double l : lengths_)
+    out.insert(out.end(), {0.5 / (l * twist_), 0.5 / (l * bend1_), 0.5 / (l * bend2_)});
+  return out;
+}
+
 bool StrandEnergy::mayTouch(const glm::dvec3& p, double radius) const {
   for (const Shape& shape : shapes_) {
     const glm::dvec3 v = p - shape.shape.centre;
@@ -125,59 +136,95 @@ bool StrandEnergy::mayTouch(const glm::dvec3& p, double radius) const {
   return false;
 }
 
-double StrandEnergy::penalty(const glm::dvec3& p) const {
+template <class T>
+T StrandEnergy::penalty(const Vec3<T>& p) const {
   // penetration() per kind (equal to it within rounding), with the cheap rejections first.
-  double sum = 0.0;
+  using std::sqrt;
+  T sum(0.0);
   for (const Shape& shape : shapes_) {
-    const glm::dvec3 v = p - shape.shape.centre;
-    const double dist2 = glm::dot(v, v);
+    const Vec3<T> v = p - Vec3<T>(shape.shape.centre);
+    const T dist2 = dotOf(v, v);
     if (dist2 >= shape.reach2) continue;
-    double dent;
+    T dent;
     if (shape.shape.kind == ShapeKind::kEllipsoid) {
-      glm::dvec3 scaled(glm::dot(v, shape.scaledAxes[0]), glm::dot(v, shape.scaledAxes[1]),
-                        glm::dot(v, shape.scaledAxes[2]));
-      const double ratio2 = glm::dot(scaled, scaled);
+      const Vec3<T> scaled(dotOf(v, shape.scaledAxes[0]), dotOf(v, shape.scaledAxes[1]),
+                           dotOf(v, shape.scaledAxes[2]));
+      const T ratio2 = dotOf(scaled, scaled);
       if (ratio2 >= shape.ratio2Outside) continue;
       if (!(ratio2 > 0.0)) {
-        dent = penetration(shape.shape, p);
+        dent = penetrationOf(shape.shape, p);
       } else {
-        const double dist = std::sqrt(dist2);  // |local| = |v|: the axes are orthonormal
-        dent = dist / std::sqrt(ratio2) - dist;
+        const T dist = sqrt(dist2);  // |local| = |v|: the axes are orthonormal
+        dent = dist / sqrt(ratio2) - dist;
       }
     } else if (shape.shape.kind == ShapeKind::kSphere) {
-      dent = shape.shape.halfExtents.x - std::sqrt(dist2);
+      dent = shape.shape.halfExtents.x - sqrt(dist2);
     } else {
-      dent = penetration(shape.shape, p);
+      dent = penetrationOf(shape.shape, p);
     }
-    double d = dent + shape.extra;
+    const T d = dent + shape.extra;
     if (d > 0.0) sum += 0.5 * shape.shape.penalty * d * d;
   }
   return sum;
 }
 
-EnergyTerms StrandEnergy::terms(std::span<const double> q) const {
-  EnergyTerms e;
-  for (size_t k = 0; k < lengths_.size(); ++k) {
-    double dt = q[3 * k] - rest_.tau, d1 = q[3 * k + 1] - rest_.kappa1, d2 = q[3 * k + 2] - rest_.kappa2;
-    e.elastic += lengths_[k] * (bend1_ * d1 * d1 + bend2_ * d2 * d2 + twist_ * dt * dt);
+template <class T>
+void StrandEnergy::accumulate(std::span<const T> q, size_t first, const RodFrame& start, T& elastic,
+                              T& height, T& penalty) const {
+  for (size_t k = first; k < lengths_.size(); ++k) {
+    const T dt = q[3 * k] - rest_.tau, d1 = q[3 * k + 1] - rest_.kappa1, d2 = q[3 * k + 2] - rest_.kappa2;
+    elastic += lengths_[k] * (bend1_ * d1 * d1 + bend2_ * d2 * d2 + twist_ * dt * dt);
   }
   // One walk along the rod gives both the height integral (§4.1.1.3.2, closed form per element) and
   // the collision samples (two sin/cos pairs per element, whatever the number of samples).
-  double height = 0.0, penalty = 0.0;
-  forEachElement(root_, lengths_, q, [&](const HelixElement& element, double, size_t k) {
-    height +=
-        element.length() * (element.start().position.y - root_.position.y) + element.displacementIntegral().y;
-    // An element's samples lie within its length of its start (the arc is at least the chord): where no
-    // shape reaches that far, each would add exactly 0, so none is placed.
-    if (shapes_.empty() || !mayTouch(element.start().position, element.length())) return;
-    const ElementSamples& samples = samples_[k];
-    element.visitGrid(samples.first, collisionStep_, samples.gridCount,
-                      [&](size_t, const glm::dvec3& p) { penalty += this->penalty(p); });
-    for (double u : samples.offGrid) penalty += this->penalty(element.position(u));
-  });
-  e.gravity = weight_ * height;
-  e.collision = penalty * collisionStep_;
-  return e;
+  const auto lengths = std::span(lengths_).subspan(first);
+  forEachElement(BasicRodFrame<T>(start), lengths, q.subspan(3 * first),
+                 [&](const BasicHelixElement<T>& element, double, size_t i) {
+                   const size_t k = first + i;
+                   height += element.length() * (element.start().position.y - root_.position.y) +
+                             element.displacementIntegral().y;
+                   // An element's samples lie within its length of its start (the arc is at least the chord):
+                   // where no shape reaches that far, each would add exactly 0, so none is placed.
+                   if (shapes_.empty() || !mayTouch(valueOf(element.start().position), element.length()))
+                     return;
+                   const ElementSamples& samples = samples_[k];
+                   element.visitGrid(samples.first, collisionStep_, samples.gridCount,
+                                     [&](size_t, const Vec3<T>& p) { penalty += this->penalty(p); });
+                   for (double u : samples.offGrid) penalty += this->penalty(element.position(u));
+                 });
+}
+
+EnergyTerms StrandEnergy::terms(std::span<const double> q) const {
+  double elastic = 0.0, height = 0.0, penalty = 0.0;
+  accumulate(q, 0, root_, elastic, height, penalty);
+  return {elastic, weight_ * height, penalty * collisionStep_};
+}
+
+double StrandEnergy::valueAndGradient(std::span<const double> q, std::span<double> gradient) const {
+  // Forward mode: each walk seeds kGradientWidth coordinates and carries their derivatives. The
+  // elements before the first seeded coordinate's do not depend on it, so a walk starts there,
+  // from that element's start frame (found in doubles); the first walk, from the root, gives the value.
+  std::vector<EnergyGradient> dual(q.begin(), q.end());
+  double value = 0.0;
+  RodFrame start = root_;
+  size_t startElement = 0;
+  for (size_t first = 0; first < q.size(); first += kGradientWidth) {
+    const size_t end = std::min(q.size(), first + kGradientWidth), element = first / 3;
+    for (size_t i = 0; i < q.size(); ++i)
+      dual[i] = i >= first && i < end ? EnergyGradient::variable(q[i], int(i - first)) : EnergyGradient(q[i]);
+    for (; startElement < element; ++startElement)
+      start = HelixElement(
+                  start,
+                  darbouxVector(start, q[3 * startElement], q[3 * startElement + 1], q[3 * startElement + 2]),
+                  lengths_[startElement])
+                  .end();
+    EnergyGradient elastic(0.0), height(0.0), penalty(0.0);
+    accumulate(std::span<const EnergyGradient>(dual), element, start, elastic, height, penalty);
+    const EnergyGradient total = elastic + weight_ * height + penalty * collisionStep_;
+    for (size_t i = first; i < end; ++i) gradient[i] = total.d[i - first];
+    if (first == 0) value = total.v;
+  }
+  return value;
 }
 
 }  // namespace hairgen

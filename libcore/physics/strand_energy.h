@@ -17,7 +17,11 @@
 namespace hairgen {
 
 // Penetration depth (metres, positive inside) of `p` into a shape, as the thesis defines it per kind.
-double penetration(const CollisionShape& shape, const glm::dvec3& p);
+template <class T>
+T penetrationOf(const CollisionShape& shape, const Vec3<T>& p);
+inline double penetration(const CollisionShape& shape, const glm::dvec3& p) {
+  return penetrationOf(shape, p);
+}
 
 struct EnergyTerms {
   double elastic = 0.0, gravity = 0.0, collision = 0.0;
@@ -31,6 +35,9 @@ class StrandEnergy {
 
   double operator()(std::span<const double> q) const { return terms(q).total(); }
   EnergyTerms terms(std::span<const double> q) const;
+  // The energy and its gradient ∂E/∂q, `gradient` sized like q: the derivatives of the same closed
+  // forms (dual.h), kGradientWidth coordinates per walk along the rod. The value is operator()'s.
+  double valueAndGradient(std::span<const double> q, std::span<double> gradient) const;
 
   // The rest shape's coordinates (the minimiser's start) and the energy scale used for Epsilon:
   // ρ S g L²/2 (the strand's weight times half its length) + E I1 / L (bending it by one radian).
@@ -38,6 +45,9 @@ class StrandEnergy {
   double energyScale() const;
   // Initial Rosenbrock steps: a quarter radian of bend or twist over each element.
   std::vector<double> initialSteps() const;
+  // The inverse of the elastic energy's curvature along each coordinate, 1/(2 ℓ · E I/2 or μ J/2):
+  // the quasi-Newton minimiser's first inverse-Hessian estimate (exact without gravity and contact).
+  std::vector<double> inverseStiffness() const;
 
  private:
   struct Shape {
@@ -57,7 +67,14 @@ class StrandEnergy {
     size_t gridCount = 0;
     std::vector<double> offGrid;
   };
-  double penalty(const glm::dvec3& p) const;
+  // The three sums of terms() for q of any scalar type, over the elements from `first` on, whose
+  // start frame is `start`: the elastic term itself, height (metres², × weight_ for gravity) and
+  // penalty (× collisionStep_ for the collision term).
+  template <class T>
+  void accumulate(std::span<const T> q, size_t first, const RodFrame& start, T& elastic, T& height,
+                  T& penalty) const;
+  template <class T>
+  T penalty(const Vec3<T>& p) const;
   // Whether any point within `radius` of p may touch a shape (else its penalty is exactly 0).
   bool mayTouch(const glm::dvec3& p, double radius) const;
 
