@@ -55,7 +55,7 @@ GrowResult growStage(const CommonOptions& common, const Config& config, const Me
   stats.counts()["energyEvaluations"] = result.evaluations;
   int onEpsilon = 0;
   for (const GuideReport& r : result.reports)
-    onEpsilon += r.stop == RosenbrockStop::kEpsilon || r.stop == RosenbrockStop::kStalled;
+    onEpsilon += r.stop == MinimiserStop::kEpsilon || r.stop == MinimiserStop::kStalled;
   stats.counts()["convergedOnEpsilon"] = onEpsilon;
   stats.counts()["stoppedOnMaxIter"] = static_cast<int>(result.reports.size()) - onEpsilon;
   note(common, "grow: " + std::to_string(result.guides.strandCount()) + " guides, " +

@@ -16,7 +16,7 @@ if [ "$group" = farm ]; then
 fi
 cmake --build build --target hairgen_bench hairgen
 case "$group" in
-  grow) filter='EnergyEvaluation|GrowCoupe3|GrowDefault' ;;
+  grow) filter='EnergyEvaluation|GrowCoupe3|GrowDefault' ;;  # and their Bfgs forms
   cantilever) filter='CantileverStyling' ;;
   interpolate) filter='InterpolateCoupe3' ;;
   shade) filter='ShadeCoupe3' ;;

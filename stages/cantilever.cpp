@@ -171,7 +171,7 @@ GrowResult growCantilever(const Mesh& wick, const Hairstyle& style, const Collis
     guides.firstPoint.push_back(static_cast<uint32_t>(guides.points.size()));
     guides.strandId.push_back(static_cast<uint32_t>(i));
     result.reports[i - first].follicle = static_cast<uint32_t>(i);
-    result.reports[i - first].stop = RosenbrockStop::kEpsilon;
+    result.reports[i - first].stop = MinimiserStop::kEpsilon;
   }
   guides.defaultThickness = static_cast<float>(style.hairRadius1 + style.hairRadius2);
   guides.provenance = madeByHairgen("grow", style.seed, options.configDigest);

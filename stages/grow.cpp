@@ -16,21 +16,36 @@ namespace hairgen {
 GuideReport growGuide(const RodFrame& root, double envelope, const Hairstyle& style,
                       const Collision& collision) {
   StrandEnergy energy(style, collision, root, envelope);
-  RosenbrockOptions options;
-  options.maxStages = style.maxIter;
-  options.epsilon = style.epsilon;
-  options.energyScale = energy.energyScale();
-  std::vector<double> q0 = energy.restCoordinates(), steps = energy.initialSteps();
+  const std::vector<double> q0 = energy.restCoordinates();
   bool finite = true;
-  auto f = [&](std::span<const double> q) {
-    double e = energy(q);
-    if (!std::isfinite(e)) {
-      finite = false;
-      return HUGE_VAL;
-    }
-    return e;
+  auto checked = [&](double e) {
+    if (std::isfinite(e)) return e;
+    finite = false;
+    return HUGE_VAL;
   };
-  RosenbrockResult result = minimizeRosenbrock(f, q0, steps, options);
+  MinimiserResult result;
+  if (style.minimiser == Minimiser::kBfgs) {
+    QuasiNewtonOptions options;
+    options.maxIterations = style.maxIter * static_cast<int>(q0.size());
+    // The penalties' second derivatives jump wherever a sample crosses a shape's envelope, so BFGS's
+    // model predicts far less decrease than is left while samples still cross: stopping at Epsilon's
+    // bar left 2/3 of coupe 3's guides above Rosenbrock's minima by more than 1% of the energy
+    // scale; a thousandth of it reaches them (README, Minimiser).
+    options.tolerance = 1e-3 * style.epsilon * energy.energyScale();
+    auto f = [&](std::span<const double> q, std::span<double> gradient) {
+      return checked(energy.valueAndGradient(q, gradient));
+    };
+    std::vector<double> maxStep = energy.initialSteps();
+    for (double& step : maxStep) step *= 4.0;  // a radian of bend or twist over an element
+    result = minimizeQuasiNewton(f, q0, energy.inverseStiffness(), maxStep, options);
+  } else {
+    RosenbrockOptions options;
+    options.maxStages = style.maxIter;
+    options.epsilon = style.epsilon;
+    options.energyScale = energy.energyScale();
+    auto f = [&](std::span<const double> q) { return checked(energy(q)); };
+    result = minimizeRosenbrock(f, q0, energy.initialSteps(), options);
+  }
   GuideReport report;
   report.coordinates = result.x;
   report.start = energy.terms(q0);

@@ -9,6 +9,7 @@
 #include "libcore/config/params.h"
 #include "libcore/model/mesh.h"
 #include "libcore/model/strands.h"
+#include "libcore/physics/quasi_newton.h"
 #include "libcore/physics/rosenbrock.h"
 #include "libcore/physics/strand_energy.h"
 #include "libcore/util/progress.h"
@@ -31,7 +32,7 @@ struct GuideReport {
   EnergyTerms start, end;           // joules
   int stages = 0;
   int evaluations = 0;
-  RosenbrockStop stop = RosenbrockStop::kMaxStages;
+  MinimiserStop stop = MinimiserStop::kMaxStages;
 };
 
 struct GrowResult {

@@ -195,5 +195,36 @@ TEST(Grow, ZeroNormalIsAnInputError) {
   EXPECT_THROW(grow(wick, style({0.01}), Collision{}, {}), InputError);
 }
 
+TEST(Grow, BfgsReachesRosenbrocksMinimaOnTheBundledCoupes) {
+  // Every 8th guide of each bundled Super-Helix coupe, grown by both minimisers from the same rest
+  // shape. The energy is not convex (a strand may settle on either side of a shape), so the two may
+  // end in different valleys; where Rosenbrock stops on MaxIter, BFGS goes lower. What must hold:
+  // most guides end within 1% of the energy scale of each other, and few end higher with BFGS.
+  for (const char* setup : {"default", "thesis/coupe1", "thesis/coupe2", "thesis/coupe3", "thesis/coupe4"}) {
+    const Config config = loadConfig(
+        std::filesystem::path(HAIRGEN_SOURCE_DIR) / "configs" / setup / "setup.txt", {}, SetupUse::kGrow);
+    const Mesh wick = readObj(config.setup.wickModel.path);
+    const std::vector<double> envelopes = follicleEnvelopes(wick);
+    Hairstyle rosenbrock = config.hairstyle, bfgs = config.hairstyle;
+    rosenbrock.minimiser = Minimiser::kRosenbrock;
+    bfgs.minimiser = Minimiser::kBfgs;
+    int guides = 0, same = 0, higher = 0;
+    for (size_t i = 0; i < wick.vertexCount(); i += 8) {
+      const glm::dvec3 p(wick.positions[i]);
+      const RodFrame root = follicleFrame(p, config.hairstyle.growDirection(p, glm::dvec3(wick.normals[i])));
+      const double scale = StrandEnergy(config.hairstyle, config.collision, root, envelopes[i]).energyScale();
+      const GuideReport a = growGuide(root, envelopes[i], rosenbrock, config.collision);
+      const GuideReport b = growGuide(root, envelopes[i], bfgs, config.collision);
+      const double difference = (b.end.total() - a.end.total()) / scale;
+      ++guides;
+      same += std::abs(difference) <= 0.01;
+      higher += difference > 0.01;
+    }
+    SCOPED_TRACE(setup);
+    EXPECT_GE(same, guides / 2);
+    EXPECT_LE(higher, guides / 20);
+  }
+}
+
 }  // namespace
 }  // namespace hairgen

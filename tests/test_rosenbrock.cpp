@@ -1,8 +1,9 @@
-// Rosenbrock's method with Palmer's orthogonalisation, on problems with known minima.
+// Rosenbrock's method with Palmer's orthogonalisation, and BFGS, on problems with known minima.
 #include <gtest/gtest.h>
 
 #include <cmath>
 
+#include "libcore/physics/quasi_newton.h"
 #include "libcore/physics/rosenbrock.h"
 
 namespace hairgen {
@@ -16,7 +17,7 @@ TEST(Rosenbrock, FindsTheBananaMinimum) {
   RosenbrockOptions options;
   options.maxStages = 1000;
   options.epsilon = 1e-16;
-  RosenbrockResult r = minimizeRosenbrock(banana, x0, steps, options);
+  MinimiserResult r = minimizeRosenbrock(banana, x0, steps, options);
   EXPECT_NEAR(r.x[0], 1.0, 1e-4);
   EXPECT_NEAR(r.x[1], 1.0, 1e-4);
   EXPECT_LT(r.value, 1e-8);
@@ -41,8 +42,81 @@ TEST(Rosenbrock, SolvesAnIllConditionedQuadraticIn15Dimensions) {
   options.maxStages = 5000;
   options.epsilon = 1e-18;
   options.energyScale = f(x0);
-  RosenbrockResult r = minimizeRosenbrock(f, x0, steps, options);
+  MinimiserResult r = minimizeRosenbrock(f, x0, steps, options);
   EXPECT_LT(r.value, 1e-6 * f(x0));
+}
+
+TEST(QuasiNewton, FindsTheBananaMinimumInFewEvaluations) {
+  auto banana = [](std::span<const double> x, std::span<double> g) {
+    const double a = 1 - x[0], b = x[1] - x[0] * x[0];
+    g[0] = -2 * a - 400 * x[0] * b;
+    g[1] = 200 * b;
+    return a * a + 100 * b * b;
+  };
+  std::vector<double> x0 = {-1.2, 1.0}, scale = {1.0, 1.0}, maxStep = {0.5, 0.5};
+  QuasiNewtonOptions options;
+  options.tolerance = 1e-20;
+  MinimiserResult r = minimizeQuasiNewton(banana, x0, scale, maxStep, options);
+  EXPECT_EQ(r.stop, MinimiserStop::kEpsilon);
+  EXPECT_NEAR(r.x[0], 1.0, 1e-8);
+  EXPECT_NEAR(r.x[1], 1.0, 1e-8);
+  EXPECT_LT(r.evaluations, 100);  // Rosenbrock's search takes thousands here
+}
+
+TEST(QuasiNewton, SolvesAnIllConditionedQuadraticExactlyAndStepsBackFromNonFiniteValues) {
+  // f = Σ c_i y_i², y = R(x − t), condition number 1e6; outside |x_0| < 5 f is NaN, where the
+  // start's first full step lands.
+  const int n = 12;
+  std::vector<double> target(n);
+  for (int i = 0; i < n; ++i) target[i] = std::sin(1.0 + i);
+  // R = I − 2vvᵀ/|v|², a reflection: orthogonal, and it mixes every coordinate.
+  std::vector<double> v(n);
+  double vv = 0.0;
+  for (int i = 0; i < n; ++i) vv += (v[i] = std::cos(2.0 + 0.7 * i)) * v[i];
+  auto mix = [&](int i, int j) { return (i == j ? 1.0 : 0.0) - 2.0 * v[i] * v[j] / vv; };
+  auto f = [&](std::span<const double> x, std::span<double> g) {
+    if (std::abs(x[0]) >= 5.0) return std::nan("");
+    std::fill(g.begin(), g.end(), 0.0);
+    double sum = 0.0;
+    for (int i = 0; i < n; ++i) {
+      double y = 0.0;
+      for (int j = 0; j < n; ++j) y += mix(i, j) * (x[j] - target[j]);
+      const double c = std::pow(10.0, 6.0 * i / (n - 1));
+      sum += c * y * y;
+      for (int j = 0; j < n; ++j) g[j] += 2 * c * y * mix(i, j);
+    }
+    return sum;
+  };
+  std::vector<double> x0(n, 0.0), scale(n, 1.0), maxStep(n, 100.0), g(n);
+  x0[0] = 4.9;
+  QuasiNewtonOptions options;
+  options.tolerance = 1e-12 * f(x0, g);
+  MinimiserResult r = minimizeQuasiNewton(f, x0, scale, maxStep, options);
+  EXPECT_EQ(r.stop, MinimiserStop::kEpsilon);
+  EXPECT_LT(r.value, 1e-10 * f(x0, g)) << r.stages << " iterations, " << r.evaluations << " evaluations";
+  for (int i = 0; i < n; ++i) EXPECT_NEAR(r.x[i], target[i], 1e-3);
+  // The same bits again: no state outside the call.
+  MinimiserResult again = minimizeQuasiNewton(f, x0, scale, maxStep, options);
+  EXPECT_EQ(again.x, r.x);
+  EXPECT_EQ(again.evaluations, r.evaluations);
+}
+
+TEST(QuasiNewton, NeverStepsAnyCoordinateFurtherThanItsBound) {
+  // A linear f has no minimum: every step is a line search along −H g, each bounded by maxStep.
+  std::vector<double> previous = {0.0, 0.0};
+  double largest = 0.0;
+  auto f = [&](std::span<const double> x, std::span<double> g) {
+    largest = std::max({largest, std::abs(x[0] - previous[0]) / 0.1, std::abs(x[1] - previous[1]) / 0.2});
+    g[0] = -1.0;
+    g[1] = -3.0;
+    return -x[0] - 3.0 * x[1];
+  };
+  std::vector<double> x0 = {0.0, 0.0}, scale = {1.0, 1.0}, maxStep = {0.1, 0.2};
+  QuasiNewtonOptions options;
+  options.maxIterations = 1;
+  MinimiserResult r = minimizeQuasiNewton(f, x0, scale, maxStep, options);
+  EXPECT_LE(largest, 1.0 + 1e-12);
+  EXPECT_LT(r.value, 0.0);
 }
 
 TEST(Rosenbrock, PalmerDirectionsStayOrthonormalWhenAnAdvanceIsZero) {
@@ -66,9 +140,9 @@ TEST(Rosenbrock, PalmerDirectionsStayOrthonormalWhenAnAdvanceIsZero) {
 TEST(Rosenbrock, StopsAtAMinimumItStartsOn) {
   auto bowl = [](std::span<const double> x) { return x[0] * x[0] + x[1] * x[1]; };
   std::vector<double> x0 = {0.0, 0.0}, steps = {1.0, 1.0};
-  RosenbrockResult r = minimizeRosenbrock(bowl, x0, steps, RosenbrockOptions{});
+  MinimiserResult r = minimizeRosenbrock(bowl, x0, steps, RosenbrockOptions{});
   EXPECT_EQ(r.value, 0.0);
-  EXPECT_EQ(r.stop, RosenbrockStop::kStalled);
+  EXPECT_EQ(r.stop, MinimiserStop::kStalled);
   EXPECT_LT(r.evaluations, 200);
 }
 

@@ -13,6 +13,10 @@ const char* name(StylingModel model) {
   return model == StylingModel::kCantilever ? "cantilever" : "superhelix";
 }
 
+const char* name(Minimiser minimiser) {
+  return minimiser == Minimiser::kBfgs ? "bfgs" : "rosenbrock";
+}
+
 const char* name(ShadingModel model) {
   switch (model) {
     case ShadingModel::kThesis:

@@ -16,12 +16,16 @@
 namespace hairgen {
 
 enum class StylingModel { kSuperHelix, kCantilever };
+// How grow minimises a Super-Helix guide's energy: Rosenbrock's direct search (the thesis, the
+// default) or BFGS on the energy's analytic gradient (README, Minimiser).
+enum class Minimiser { kRosenbrock, kBfgs };
 enum class ShadingModel { kKajiyaKay, kThesis, kAnjyo, kVolumetric };
 // Every shading model, in the enum's order: the config's choices and the renderer's GLSL constants.
 inline constexpr ShadingModel kShadingModels[] = {ShadingModel::kKajiyaKay, ShadingModel::kThesis,
                                                   ShadingModel::kAnjyo, ShadingModel::kVolumetric};
 
 const char* name(StylingModel model);
+const char* name(Minimiser minimiser);
 const char* name(ShadingModel model);
 
 // Anjyo's styling extras (Hairstyle Info, repeatable lines). A force field adds an acceleration
@@ -58,7 +62,7 @@ struct RootFlow {
 struct Hairstyle {
   double visualityStep = 0.0025;    // metres of arc length between output vertices
   double collisionStep = 0.005;     // metres of arc length between collision samples
-  int maxIter = 20;                 // Rosenbrock stages at most
+  int maxIter = 20;                 // Rosenbrock stages at most (bfgs: iterations per coordinate)
   double epsilon = 1.0e-4;          // stop when a stage lowers the energy by less (relative)
   std::vector<double> hairLengths;  // metres, one per Super-Helix element; required
   double hairDensity = 100.0;       // strands per square centimetre of wick
@@ -71,6 +75,7 @@ struct Hairstyle {
   double massDensity = 1300.0;      // ρ, kilograms per cubic metre (Table 3), key Density
   double gravity = 9.81;            // g, newtons per kilogram (Table 3)
   StylingModel model = StylingModel::kSuperHelix;
+  Minimiser minimiser = Minimiser::kRosenbrock;
   double clump = 0.25;     // tip weights v1, v2 drawn in [0, Clump): 0 gathers tips at the nearest guide
   bool strayHairs = true;  // true = the thesis' barycentric assignment (§4.1.4.4)
   uint64_t seed = 0;       // keys every random number; --seed overrides it

@@ -21,15 +21,15 @@ double dot(const std::vector<double>& a, const std::vector<double>& b) {
 
 }  // namespace
 
-const char* name(RosenbrockStop stop) {
+const char* name(MinimiserStop stop) {
   switch (stop) {
-    case RosenbrockStop::kEpsilon:
+    case MinimiserStop::kEpsilon:
       return "epsilon";
-    case RosenbrockStop::kStalled:
+    case MinimiserStop::kStalled:
       return "stalled";
-    case RosenbrockStop::kMaxEvaluations:
+    case MinimiserStop::kMaxEvaluations:
       return "maxEvaluations";
-    case RosenbrockStop::kMaxStages:
+    case MinimiserStop::kMaxStages:
       break;
   }
   return "maxIter";
@@ -66,11 +66,11 @@ std::vector<std::vector<double>> palmerDirections(const std::vector<std::vector<
   return out;
 }
 
-RosenbrockResult minimizeRosenbrock(const std::function<double(std::span<const double>)>& f,
-                                    std::span<const double> x0, std::span<const double> steps,
-                                    const RosenbrockOptions& options) {
+MinimiserResult minimizeRosenbrock(const std::function<double(std::span<const double>)>& f,
+                                   std::span<const double> x0, std::span<const double> steps,
+                                   const RosenbrockOptions& options) {
   const size_t n = x0.size();
-  RosenbrockResult result;
+  MinimiserResult result;
   result.x.assign(x0.begin(), x0.end());
   std::vector<double> trial(n);
   auto evaluate = [&](const std::vector<double>& x) {
@@ -79,7 +79,7 @@ RosenbrockResult minimizeRosenbrock(const std::function<double(std::span<const d
   };
   result.value = evaluate(result.x);
   if (n == 0) {
-    result.stop = RosenbrockStop::kEpsilon;
+    result.stop = MinimiserStop::kEpsilon;
     return result;
   }
 
@@ -88,7 +88,7 @@ RosenbrockResult minimizeRosenbrock(const std::function<double(std::span<const d
   std::vector<double> step(n), advance(n);
   std::vector<char> succeeded(n), done(n);
 
-  result.stop = RosenbrockStop::kMaxStages;
+  result.stop = MinimiserStop::kMaxStages;
   for (int stage = 0; stage < options.maxStages; ++stage) {
     const double stageStart = result.value;
     // A stage starts from the step lengths the last one ended with, expanded once: near the minimum
@@ -107,7 +107,7 @@ RosenbrockResult minimizeRosenbrock(const std::function<double(std::span<const d
     size_t remaining = n;
     while (remaining > 0) {
       if (result.evaluations >= options.maxEvaluations) {
-        result.stop = RosenbrockStop::kMaxEvaluations;
+        result.stop = MinimiserStop::kMaxEvaluations;
         result.stages = stage + 1;
         return result;
       }
@@ -138,11 +138,11 @@ RosenbrockResult minimizeRosenbrock(const std::function<double(std::span<const d
     bool moved = false;
     for (double a : advance) moved = moved || a != 0.0;
     if (!moved) {
-      result.stop = RosenbrockStop::kStalled;
+      result.stop = MinimiserStop::kStalled;
       return result;
     }
     if (stageStart - result.value < options.epsilon * options.energyScale) {
-      result.stop = RosenbrockStop::kEpsilon;
+      result.stop = MinimiserStop::kEpsilon;
       return result;
     }
     xi = palmerDirections(xi, advance);

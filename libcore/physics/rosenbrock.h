@@ -6,6 +6,8 @@
 #include <span>
 #include <vector>
 
+#include "libcore/physics/minimiser.h"
+
 namespace hairgen {
 
 struct RosenbrockOptions {
@@ -20,22 +22,11 @@ struct RosenbrockOptions {
   int maxEvaluations = 1000000;      // hard bound, so a pathological f cannot loop forever
 };
 
-enum class RosenbrockStop { kEpsilon, kMaxStages, kStalled, kMaxEvaluations };
-const char* name(RosenbrockStop stop);
-
-struct RosenbrockResult {
-  std::vector<double> x;
-  double value = 0.0;
-  int stages = 0;
-  int evaluations = 0;
-  RosenbrockStop stop = RosenbrockStop::kMaxStages;
-};
-
 // Minimises f from x0 with initial step sizes `steps` (one per coordinate, non-zero).
 // f is called with a span it must not keep. Deterministic: no randomness, fixed evaluation order.
-RosenbrockResult minimizeRosenbrock(const std::function<double(std::span<const double>)>& f,
-                                    std::span<const double> x0, std::span<const double> steps,
-                                    const RosenbrockOptions& options);
+MinimiserResult minimizeRosenbrock(const std::function<double(std::span<const double>)>& f,
+                                   std::span<const double> x0, std::span<const double> steps,
+                                   const RosenbrockOptions& options);
 
 // Palmer's orthonormal directions for the next stage from the old directions `xi` (rows) and the
 // total advance `d` along each; well defined when some advances are zero.

@@ -4,6 +4,8 @@
 //   GrowCoupe3:         the whole grow stage on every core, counters guides/s and evaluations/s.
 //   GrowDefault:        the same on the default coupe (configs/default), what the README's first
 //                       command grows.
+//   GrowCoupe3Bfgs, GrowDefaultBfgs: the same with `Minimiser bfgs` (an evaluation is the energy with
+//                       its gradient).
 //   InterpolateCoupe3:  ~150,000 strands of 64 vertices from coupe 3's guides, every core, into a fresh
 //                       coupe each time, as `hairgen interpolate` makes a still: the kernel's faulting
 //                       in and clearing of ~230 MB of new pages is part of the figure.
@@ -111,11 +113,14 @@ void EnergyEvaluation(benchmark::State& state) {
 }
 BENCHMARK(EnergyEvaluation);
 
-void growBundled(benchmark::State& state, const Bundled& c, double target) {
+void growBundled(benchmark::State& state, const Bundled& c, double target,
+                 Minimiser minimiser = Minimiser::kRosenbrock) {
   uint64_t evaluations = 0, guides = 0;
+  Hairstyle style = c.config.hairstyle;
+  style.minimiser = minimiser;
   Stopwatch clock;
   for (auto _ : state) {
-    GrowResult g = grow(c.wick, c.config.hairstyle, c.config.collision, {});
+    GrowResult g = grow(c.wick, style, c.config.collision, {});
     evaluations += g.evaluations;
     guides += g.reports.size();
   }
@@ -135,6 +140,14 @@ void GrowDefault(benchmark::State& state) {
   growBundled(state, defaultCoupe(), kGrowDefaultGuidesPerSecond);
 }
 BENCHMARK(GrowDefault)->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(3.0);
+void GrowCoupe3Bfgs(benchmark::State& state) {
+  growBundled(state, coupe3(), kGrowCoupe3GuidesPerSecond, Minimiser::kBfgs);
+}
+BENCHMARK(GrowCoupe3Bfgs)->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(3.0);
+void GrowDefaultBfgs(benchmark::State& state) {
+  growBundled(state, defaultCoupe(), kGrowDefaultGuidesPerSecond, Minimiser::kBfgs);
+}
+BENCHMARK(GrowDefaultBfgs)->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(3.0);
 
 // Coupe 3's guides at 64 vertices and the style that gives ~150,000 strands from them.
 struct Coupe3At150k {

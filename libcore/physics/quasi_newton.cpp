@@ -1,0 +1,151 @@
+// BFGS with a backtracking (Armijo) line search. The inverse Hessian estimate H is kept dense: the
+// Super-Helix guides have 3 coordinates per element, a few dozen at most, so H·g and the rank-two
+// update cost far less than one evaluation of the energy.
+#include "libcore/physics/quasi_newton.h"
+
+#include <algorithm>
+#include <cmath>
+#include <vector>
+
+namespace hairgen {
+namespace {
+
+double dot(std::span<const double> a, std::span<const double> b) {
+  double s = 0.0;
+  for (size_t i = 0; i < a.size(); ++i) s += a[i] * b[i];
+  return s;
+}
+
+// H = diag(scale).
+void resetInverse(std::vector<double>& h, std::span<const double> scale) {
+  const size_t n = scale.size();
+  std::fill(h.begin(), h.end(), 0.0);
+  for (size_t i = 0; i < n; ++i) h[i * n + i] = scale[i];
+}
+
+}  // namespace
+
+MinimiserResult minimizeQuasiNewton(const ValueAndGradient& f, std::span<const double> x0,
+                                    std::span<const double> inverseScale, std::span<const double> maxStep,
+                                    const QuasiNewtonOptions& options) {
+  constexpr double kArmijo = 1e-4;    // sufficient decrease: f(x + αp) ≤ f(x) + kArmijo α gᵀp
+  constexpr double kCurvature = 0.9;  // |f'(x + αp)| ≤ kCurvature |f'(x)| along p
+  constexpr int kMaxTrials = 40;
+  const size_t n = x0.size();
+  MinimiserResult result;
+  result.x.assign(x0.begin(), x0.end());
+  std::vector<double> g(n), trial(n), trialGradient(n), loPoint(n), loGradient(n), p(n), s(n), y(n), hy(n),
+      h(n * n);
+  auto evaluate = [&](std::span<const double> x, std::span<double> gradient) {
+    ++result.evaluations;
+    const double value = f(x, gradient);
+    return std::isfinite(value) ? value : HUGE_VAL;
+  };
+  result.value = evaluate(result.x, g);
+  resetInverse(h, inverseScale);
+  bool fresh = true;
+  double lastDecrease = HUGE_VAL;  // H is still the given diagonal: scale it by the first step's curvature
+  result.stop = MinimiserStop::kMaxStages;
+  for (int iteration = 0; iteration < options.maxIterations; ++iteration) {
+    result.stages = iteration;
+    // p = −H g; a direction that does not descend (H lost its positivity to rounding) restarts H.
+    for (int attempt = 0; attempt < 2; ++attempt) {
+      for (size_t i = 0; i < n; ++i) p[i] = -dot(std::span(h).subspan(i * n, n), g);
+      if (dot(p, g) < 0.0) break;
+      resetInverse(h, inverseScale);
+      fresh = true;
+    }
+    const double slope = dot(p, g);
+    if (!(slope < 0.0) || (-0.5 * slope < options.tolerance && lastDecrease < options.tolerance)) {
+      result.stop = slope < 0.0 || dot(g, g) == 0.0 ? MinimiserStop::kEpsilon : MinimiserStop::kStalled;
+      return result;
+    }
+    // A step satisfying the strong Wolfe conditions (sufficient decrease, and a slope along p that
+    // has flattened to kCurvature of the first), bracketed and zoomed by safeguarded quadratic
+    // interpolation (Nocedal & Wright Algorithms 3.5-3.6): it keeps yᵀs > 0, so every update is made.
+    double lo = 0.0, loValue = result.value, loSlope = slope, hi = HUGE_VAL, hiValue = HUGE_VAL;
+    double longest = HUGE_VAL;  // the step at which some coordinate moves by its bound
+    for (size_t i = 0; i < n; ++i)
+      if (std::abs(p[i]) > 0.0) longest = std::min(longest, maxStep[i] / std::abs(p[i]));
+    double alpha = std::min(1.0, longest);
+    bool accepted = false;
+    for (int k = 0; k < kMaxTrials; ++k) {
+      if (result.evaluations >= options.maxEvaluations) {
+        result.stop = MinimiserStop::kMaxEvaluations;
+        return result;
+      }
+      for (size_t i = 0; i < n; ++i) trial[i] = result.x[i] + alpha * p[i];
+      const double value = evaluate(trial, trialGradient);
+      const double trialSlope = dot(trialGradient, p);
+      if (value > result.value + kArmijo * alpha * slope || value >= loValue) {
+        hi = alpha;
+        hiValue = value;
+      } else {
+        loGradient.swap(trialGradient);
+        std::copy(trial.begin(), trial.end(), loPoint.begin());
+        if (std::abs(trialSlope) <= -kCurvature * slope || (hi == HUGE_VAL && alpha == longest)) {
+          lo = alpha;
+          loValue = value;
+          accepted = true;
+          break;
+        }
+        if (trialSlope * (hi - lo) >= 0.0) {
+          hi = lo;
+          hiValue = loValue;
+        }
+        lo = alpha;
+        loValue = value;
+        loSlope = trialSlope;
+      }
+      if (hi == HUGE_VAL) {
+        alpha = std::min(4.0 * alpha, longest);  // still descending: expand, within the bound
+        continue;
+      }
+      const double width = hi - lo;
+      double next = lo + 0.5 * width;
+      if (hiValue < HUGE_VAL) {
+        const double curvature = hiValue - loValue - loSlope * width;
+        if (curvature > 0.0) next = lo - loSlope * width * width / (2.0 * curvature);
+      }
+      const double a = std::min(lo, hi), b = std::max(lo, hi), margin = 0.1 * (b - a);
+      alpha = std::clamp(next, a + margin, b - margin);
+    }
+    if (!accepted && lo == 0.0) {
+      result.stop = MinimiserStop::kStalled;
+      return result;
+    }
+    std::copy(loPoint.begin(), loPoint.end(), trial.begin());
+    trialGradient.swap(loGradient);
+    const double value = loValue;
+    for (size_t i = 0; i < n; ++i) {
+      s[i] = trial[i] - result.x[i];
+      y[i] = trialGradient[i] - g[i];
+    }
+    result.x.swap(trial);
+    g.swap(trialGradient);
+    lastDecrease = result.value - value;
+    result.value = value;
+    // H ← (I − ρ s yᵀ) H (I − ρ y sᵀ) + ρ s sᵀ, ρ = 1/(yᵀs), skipped where yᵀs ≤ 0 (no curvature
+    // information the update could keep positive definite).
+    const double sy = dot(s, y);
+    if (sy > 1e-14 * std::sqrt(dot(s, s) * dot(y, y))) {
+      const double rho = 1.0 / sy;
+      for (size_t i = 0; i < n; ++i) hy[i] = dot(std::span(h).subspan(i * n, n), y);
+      double yhy = dot(y, hy);
+      if (fresh) {
+        const double gamma = sy / yhy;
+        for (double& v : h) v *= gamma;
+        for (double& v : hy) v *= gamma;
+        yhy *= gamma;
+        fresh = false;
+      }
+      for (size_t i = 0; i < n; ++i)
+        for (size_t j = 0; j < n; ++j)
+          h[i * n + j] += rho * ((1.0 + rho * yhy) * s[i] * s[j] - hy[i] * s[j] - s[i] * hy[j]);
+    }
+  }
+  result.stages = options.maxIterations;
+  return result;
+}
+
+}  // namespace hairgen
