@@ -13,6 +13,10 @@
 
 namespace hairgen {
 
+// Every operation is forced inline: each is a short loop over N doubles, and a call per operation
+// (GCC inlines few of them by itself) costs more than the loop.
+#define HAIRGEN_DUAL [[gnu::always_inline]] inline
+
 template <int N>
 struct Dual {
   double v = 0.0;
@@ -31,72 +35,72 @@ struct Dual {
   Dual& operator*=(const Dual& b) { return *this = *this * b; }
 
   // d(a·b) = a·db + b·da and friends, with the derivative part scaled once per operand.
-  friend Dual operator+(const Dual& a, const Dual& b) {
+  HAIRGEN_DUAL friend Dual operator+(const Dual& a, const Dual& b) {
     Dual r(a.v + b.v);
     for (int k = 0; k < N; ++k) r.d[k] = a.d[k] + b.d[k];
     return r;
   }
-  friend Dual operator-(const Dual& a, const Dual& b) {
+  HAIRGEN_DUAL friend Dual operator-(const Dual& a, const Dual& b) {
     Dual r(a.v - b.v);
     for (int k = 0; k < N; ++k) r.d[k] = a.d[k] - b.d[k];
     return r;
   }
-  friend Dual operator-(const Dual& a) { return a * -1.0; }
-  friend Dual operator*(const Dual& a, const Dual& b) {
+  HAIRGEN_DUAL friend Dual operator-(const Dual& a) { return a * -1.0; }
+  HAIRGEN_DUAL friend Dual operator*(const Dual& a, const Dual& b) {
     Dual r(a.v * b.v);
     for (int k = 0; k < N; ++k) r.d[k] = a.d[k] * b.v + a.v * b.d[k];
     return r;
   }
-  friend Dual operator/(const Dual& a, const Dual& b) {
+  HAIRGEN_DUAL friend Dual operator/(const Dual& a, const Dual& b) {
     const double inv = 1.0 / b.v, q = a.v * inv;
     Dual r(a.v / b.v);
     for (int k = 0; k < N; ++k) r.d[k] = (a.d[k] - q * b.d[k]) * inv;
     return r;
   }
-  friend Dual operator+(const Dual& a, double b) {
+  HAIRGEN_DUAL friend Dual operator+(const Dual& a, double b) {
     Dual r = a;
     r.v += b;
     return r;
   }
-  friend Dual operator+(double a, const Dual& b) { return b + a; }
-  friend Dual operator-(const Dual& a, double b) { return a + -b; }
-  friend Dual operator-(double a, const Dual& b) {
+  HAIRGEN_DUAL friend Dual operator+(double a, const Dual& b) { return b + a; }
+  HAIRGEN_DUAL friend Dual operator-(const Dual& a, double b) { return a + -b; }
+  HAIRGEN_DUAL friend Dual operator-(double a, const Dual& b) {
     Dual r(a - b.v);
     for (int k = 0; k < N; ++k) r.d[k] = -b.d[k];
     return r;
   }
-  friend Dual operator*(const Dual& a, double b) {
+  HAIRGEN_DUAL friend Dual operator*(const Dual& a, double b) {
     Dual r(a.v * b);
     for (int k = 0; k < N; ++k) r.d[k] = a.d[k] * b;
     return r;
   }
-  friend Dual operator*(double a, const Dual& b) { return b * a; }
-  friend Dual operator/(const Dual& a, double b) {
+  HAIRGEN_DUAL friend Dual operator*(double a, const Dual& b) { return b * a; }
+  HAIRGEN_DUAL friend Dual operator/(const Dual& a, double b) {
     Dual r(a.v / b);
     const double inv = 1.0 / b;
     for (int k = 0; k < N; ++k) r.d[k] = a.d[k] * inv;
     return r;
   }
-  friend Dual operator/(double a, const Dual& b) { return Dual(a) / b; }
+  HAIRGEN_DUAL friend Dual operator/(double a, const Dual& b) { return Dual(a) / b; }
 
   // Comparisons compare values: a branch on them picks the same closed form as the double code.
-  friend bool operator<(const Dual& a, const Dual& b) { return a.v < b.v; }
-  friend bool operator<(const Dual& a, double b) { return a.v < b; }
-  friend bool operator>(const Dual& a, double b) { return a.v > b; }
-  friend bool operator>=(const Dual& a, double b) { return a.v >= b; }
+  HAIRGEN_DUAL friend bool operator<(const Dual& a, const Dual& b) { return a.v < b.v; }
+  HAIRGEN_DUAL friend bool operator<(const Dual& a, double b) { return a.v < b; }
+  HAIRGEN_DUAL friend bool operator>(const Dual& a, double b) { return a.v > b; }
+  HAIRGEN_DUAL friend bool operator>=(const Dual& a, double b) { return a.v >= b; }
 
-  friend Dual sqrt(const Dual& a) {
+  HAIRGEN_DUAL friend Dual sqrt(const Dual& a) {
     // At 0 the derivative is taken as 0: hairgen takes √ of |W|², whose gradient vanishes there,
     // and every closed form that uses |W| is smooth in |W|² (see super_helix.h).
     const double s = std::sqrt(a.v);
     return chain(a, s, s > 0.0 ? 0.5 / s : 0.0);
   }
-  friend Dual sin(const Dual& a) { return chain(a, std::sin(a.v), std::cos(a.v)); }
-  friend Dual cos(const Dual& a) { return chain(a, std::cos(a.v), -std::sin(a.v)); }
+  HAIRGEN_DUAL friend Dual sin(const Dual& a) { return chain(a, std::sin(a.v), std::cos(a.v)); }
+  HAIRGEN_DUAL friend Dual cos(const Dual& a) { return chain(a, std::cos(a.v), -std::sin(a.v)); }
 
  private:
   // f(a) given f(a.v) and f'(a.v).
-  static Dual chain(const Dual& a, double value, double slope) {
+  HAIRGEN_DUAL static Dual chain(const Dual& a, double value, double slope) {
     Dual r(value);
     for (int k = 0; k < N; ++k) r.d[k] = a.d[k] * slope;
     return r;
@@ -122,22 +126,22 @@ glm::dvec3 valueOf(const Vec3<T>& v) {
 // glm's vector-by-scalar operators want both of one type; a double times a vector of Duals scales
 // only the derivatives' parts it must.
 template <int N>
-Vec3<Dual<N>> operator*(double s, const Vec3<Dual<N>>& v) {
+HAIRGEN_DUAL Vec3<Dual<N>> operator*(double s, const Vec3<Dual<N>>& v) {
   return {v.x * s, v.y * s, v.z * s};
 }
 
 template <class T>
-Vec3<T> crossOf(const Vec3<T>& x, const Vec3<T>& y) {
+HAIRGEN_DUAL Vec3<T> crossOf(const Vec3<T>& x, const Vec3<T>& y) {
   return {x.y * y.z - y.y * x.z, x.z * y.x - y.z * x.x, x.x * y.y - y.x * x.y};
 }
 
 template <class T, class U>
-T dotOf(const Vec3<T>& a, const Vec3<U>& b) {
+HAIRGEN_DUAL T dotOf(const Vec3<T>& a, const Vec3<U>& b) {
   return a.x * b.x + a.y * b.y + a.z * b.z;
 }
 
 template <class T>
-T lengthOf(const Vec3<T>& v) {
+HAIRGEN_DUAL T lengthOf(const Vec3<T>& v) {
   using std::sqrt;
   return sqrt(dotOf(v, v));
 }

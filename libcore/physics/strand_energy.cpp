@@ -3,6 +3,7 @@
 
 #include <cmath>
 #include <numeric>
+#include <type_traits>
 
 namespace hairgen {
 
@@ -188,9 +189,18 @@ void StrandEnergy::accumulate(std::span<const T> q, size_t first, const RodFrame
                    if (shapes_.empty() || !mayTouch(valueOf(element.start().position), element.length()))
                      return;
                    const ElementSamples& samples = samples_[k];
-                   element.visitGrid(samples.first, collisionStep_, samples.gridCount,
-                                     [&](size_t, const Vec3<T>& p) { penalty += this->penalty(p); });
-                   for (double u : samples.offGrid) penalty += this->penalty(element.position(u));
+                   // With derivatives, a sample that touches no shape (penalty and derivatives 0) is
+                   // found from its position's value alone.
+                   constexpr bool kValues = std::is_same_v<T, double>;
+                   element.visitGrid(
+                       samples.first, collisionStep_, samples.gridCount,
+                       [&](size_t, double u, const T& c, const T& s) {
+                         if (kValues || this->penalty(element.valueAt(u, valueOf(c), valueOf(s))) > 0.0)
+                           penalty += this->penalty(element.at(u, c, s));
+                       });
+                   for (double u : samples.offGrid)
+                     if (kValues || this->penalty(element.valuePosition(u)) > 0.0)
+                       penalty += this->penalty(element.position(u));
                  });
 }
 

@@ -67,6 +67,12 @@ Vec3<T> BasicHelixElement<T>::position(double u) const {
 }
 
 template <class T>
+glm::dvec3 BasicHelixElement<T>::valuePosition(double u) const {
+  HelixCoefficients k = coefficients(valueOf(omega_), valueOf(invOmega_), u);
+  return valueOf(start_.position) + u * valueOf(start_.n0) + k.b * valueOf(wn0_) + k.c * valueOf(wwn0_);
+}
+
+template <class T>
 BasicRodFrame<T> BasicHelixElement<T>::frame(double u) const {
   BasicHelixCoefficients<T> k = coefficients(omega_, invOmega_, u);
   BasicRodFrame<T> f;

@@ -74,14 +74,17 @@ class BasicHelixElement {
   // ∫0^ℓ (r(u) − r(0)) du, metres².
   Vec3<T> displacementIntegral() const;
 
-  // Calls visit(j, position) for u_j = first + j·step, j < count, with two sin/cos pairs in all:
-  // the angles advance by a rotation recurrence instead of a library call per point.
+  // Calls visit(j, u_j, cos Ωu_j, sin Ωu_j) for u_j = first + j·step, j < count, with two sin/cos
+  // pairs in all: the angles advance by a rotation recurrence instead of a library call per point.
+  // at(u, cos, sin) is the position there.
   template <class Visit>
   void visitGrid(double first, double step, size_t count, Visit&& visit) const;
+  Vec3<T> at(double u, const T& cosX, const T& sinX) const;
+  // The values alone (no derivatives) of at() and position().
+  glm::dvec3 valueAt(double u, double cosX, double sinX) const;
+  glm::dvec3 valuePosition(double u) const;
 
  private:
-  Vec3<T> at(double u, const T& cosX, const T& sinX) const;
-
   BasicRodFrame<T> start_, end_;
   Vec3<T> w_, wn0_, wwn0_;  // W, W×n0, W×(W×n0)
   T omega_, invOmega_;      // invOmega_ is 0 for a straight element
@@ -144,6 +147,12 @@ Vec3<T> BasicHelixElement<T>::at(double u, const T& cosX, const T& sinX) const {
 }
 
 template <class T>
+glm::dvec3 BasicHelixElement<T>::valueAt(double u, double cosX, double sinX) const {
+  HelixCoefficients k = helixCoefficients(valueOf(omega_), valueOf(invOmega_), u, cosX, sinX);
+  return valueOf(start_.position) + u * valueOf(start_.n0) + k.b * valueOf(wn0_) + k.c * valueOf(wwn0_);
+}
+
+template <class T>
 template <class Visit>
 void BasicHelixElement<T>::visitGrid(double first, double step, size_t count, Visit&& visit) const {
   using std::cos, std::sin;
@@ -156,7 +165,7 @@ void BasicHelixElement<T>::visitGrid(double first, double step, size_t count, Vi
     s = sin(omega_ * first);
   }
   for (size_t j = 0; j < count; ++j) {
-    visit(j, at(first + static_cast<double>(j) * step, c, s));
+    visit(j, first + static_cast<double>(j) * step, c, s);
     T next = c * cd - s * sd;
     s = s * cd + c * sd;
     c = next;
