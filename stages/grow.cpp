@@ -2,7 +2,9 @@
 // (§4.1.3), then sampling of the Super-Helix every VisualityStep (§4.1.4.2).
 #include "stages/grow.h"
 
+#include <climits>
 #include <cmath>
+#include <cstdint>
 
 #include <tbb/parallel_for.h>
 #include <tbb/task_arena.h>
@@ -26,7 +28,10 @@ GuideReport growGuide(const RodFrame& root, double envelope, const Hairstyle& st
   MinimiserResult result;
   if (style.minimiser == Minimiser::kBfgs) {
     QuasiNewtonOptions options;
-    options.maxIterations = style.maxIter * static_cast<int>(q0.size());
+    // MaxIter per coordinate; a search takes 1-2 evaluations, so twice the iterations bounds them.
+    const int64_t iterations = std::min<int64_t>(int64_t(style.maxIter) * int64_t(q0.size()), INT_MAX / 4);
+    options.maxIterations = static_cast<int>(iterations);
+    options.maxEvaluations = static_cast<int>(2 * iterations + 40);
     // The penalties' second derivatives jump wherever a sample crosses a shape's envelope, so BFGS's
     // model predicts far less decrease than is left while samples still cross: stopping at Epsilon's
     // bar left 2/3 of coupe 3's guides above Rosenbrock's minima by more than 1% of the energy

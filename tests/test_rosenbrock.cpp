@@ -102,21 +102,49 @@ TEST(QuasiNewton, SolvesAnIllConditionedQuadraticExactlyAndStepsBackFromNonFinit
 }
 
 TEST(QuasiNewton, NeverStepsAnyCoordinateFurtherThanItsBound) {
-  // A linear f has no minimum: every step is a line search along −H g, each bounded by maxStep.
-  std::vector<double> previous = {0.0, 0.0};
-  double largest = 0.0;
+  // f = (x − 10)² from 0 with H = 0.01: the full step reaches 0.2 and the slope has hardly flattened,
+  // so the search expands (0.2, 0.8, 3.2, …); the bound of 3 per step must stop it at 3.
+  double farthest = 0.0;
   auto f = [&](std::span<const double> x, std::span<double> g) {
-    largest = std::max({largest, std::abs(x[0] - previous[0]) / 0.1, std::abs(x[1] - previous[1]) / 0.2});
-    g[0] = -1.0;
-    g[1] = -3.0;
-    return -x[0] - 3.0 * x[1];
+    farthest = std::max(farthest, std::abs(x[0]));
+    g[0] = 2.0 * (x[0] - 10.0);
+    return (x[0] - 10.0) * (x[0] - 10.0);
   };
-  std::vector<double> x0 = {0.0, 0.0}, scale = {1.0, 1.0}, maxStep = {0.1, 0.2};
+  std::vector<double> x0 = {0.0}, scale = {0.01}, maxStep = {3.0};
   QuasiNewtonOptions options;
   options.maxIterations = 1;
   MinimiserResult r = minimizeQuasiNewton(f, x0, scale, maxStep, options);
-  EXPECT_LE(largest, 1.0 + 1e-12);
-  EXPECT_LT(r.value, 0.0);
+  EXPECT_LE(farthest, 3.0);
+  EXPECT_EQ(r.x[0], 3.0);
+  // Unbounded, the same search goes past it.
+  farthest = 0.0;
+  maxStep[0] = 1e9;
+  minimizeQuasiNewton(f, x0, scale, maxStep, options);
+  EXPECT_GT(farthest, 3.0);
+}
+
+TEST(QuasiNewton, AnUnderflowedScaleOrAnEvaluationBoundStillEndsAtTheLowestPointFound) {
+  // A zero or infinite first inverse-Hessian entry (a stiffness that underflowed) must not poison the
+  // direction with 0·∞; and when the evaluations run out mid-search, the lowest point found is kept.
+  auto f = [](std::span<const double> x, std::span<double> g) {
+    g[0] = 2.0 * (x[0] - 1.0);
+    g[1] = 20.0 * (x[1] + 2.0);
+    return (x[0] - 1.0) * (x[0] - 1.0) + 10.0 * (x[1] + 2.0) * (x[1] + 2.0);
+  };
+  std::vector<double> x0 = {0.0, 0.0}, scale = {HUGE_VAL, 0.0}, maxStep = {10.0, 10.0}, g(2);
+  QuasiNewtonOptions options;
+  options.tolerance = 1e-20;
+  MinimiserResult r = minimizeQuasiNewton(f, x0, scale, maxStep, options);
+  EXPECT_EQ(r.stop, MinimiserStop::kEpsilon);
+  EXPECT_NEAR(r.x[0], 1.0, 1e-8);
+  EXPECT_NEAR(r.x[1], -2.0, 1e-8);
+  for (int bound = 1; bound < 12; ++bound) {
+    options.maxEvaluations = bound;
+    MinimiserResult cut = minimizeQuasiNewton(f, x0, scale, maxStep, options);
+    EXPECT_LE(cut.evaluations, bound);
+    EXPECT_EQ(cut.value, f(cut.x, g)) << bound;  // the value of the point returned
+    EXPECT_LE(cut.value, f(x0, g));
+  }
 }
 
 TEST(Rosenbrock, PalmerDirectionsStayOrthonormalWhenAnAdvanceIsZero) {

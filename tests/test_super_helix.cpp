@@ -182,7 +182,8 @@ TEST(StrandEnergy, CollisionTermEqualsDirectSamplingOfEveryShape) {
 TEST(StrandEnergy, GradientMatchesCentralDifferencesAndValueIsTheEnergys) {
   // The forward-mode gradient of every term (elastic, closed-form gravity, penalties of the three
   // kinds of shape, the series and closed-form branches, a straight element at W = 0) against
-  // central differences; 11 coordinates, so the last of two walks is partly seeded.
+  // central differences; 12 coordinates, so the second of two walks starts mid-element and is
+  // partly seeded.
   Hairstyle style;
   style.hairLengths = {0.03, 0.05, 0.04, 0.006};
   style.collisionStep = 0.004;

@@ -1,6 +1,7 @@
-// BFGS with a backtracking (Armijo) line search. The inverse Hessian estimate H is kept dense: the
-// Super-Helix guides have 3 coordinates per element, a few dozen at most, so H·g and the rank-two
-// update cost far less than one evaluation of the energy.
+// BFGS with a strong-Wolfe line search. The inverse Hessian estimate H is kept dense: a Super-Helix
+// guide has 3 coordinates per element (24 for the default coupe, 768 at HairLengths' limit), and H·g
+// and the rank-two update cost less than one evaluation of the energy's gradient, whose cost grows
+// with the coordinates too.
 #include "libcore/physics/quasi_newton.h"
 
 #include <algorithm>
@@ -16,11 +17,12 @@ double dot(std::span<const double> a, std::span<const double> b) {
   return s;
 }
 
-// H = diag(scale).
+// H = diag(scale); an entry that is not a positive finite number (a stiffness that underflowed) is 1,
+// which the first step's curvature then rescales.
 void resetInverse(std::vector<double>& h, std::span<const double> scale) {
   const size_t n = scale.size();
   std::fill(h.begin(), h.end(), 0.0);
-  for (size_t i = 0; i < n; ++i) h[i * n + i] = scale[i];
+  for (size_t i = 0; i < n; ++i) h[i * n + i] = std::isfinite(scale[i]) && scale[i] > 0.0 ? scale[i] : 1.0;
 }
 
 }  // namespace
@@ -43,8 +45,8 @@ MinimiserResult minimizeQuasiNewton(const ValueAndGradient& f, std::span<const d
   };
   result.value = evaluate(result.x, g);
   resetInverse(h, inverseScale);
-  bool fresh = true;
-  double lastDecrease = HUGE_VAL;  // H is still the given diagonal: scale it by the first step's curvature
+  bool fresh = true;  // H is still the given diagonal: scale it by the first step's curvature
+  double lastDecrease = HUGE_VAL;
   result.stop = MinimiserStop::kMaxStages;
   for (int iteration = 0; iteration < options.maxIterations; ++iteration) {
     result.stages = iteration;
@@ -62,17 +64,19 @@ MinimiserResult minimizeQuasiNewton(const ValueAndGradient& f, std::span<const d
     }
     // A step satisfying the strong Wolfe conditions (sufficient decrease, and a slope along p that
     // has flattened to kCurvature of the first), bracketed and zoomed by safeguarded quadratic
-    // interpolation (Nocedal & Wright Algorithms 3.5-3.6): it keeps yᵀs > 0, so every update is made.
+    // interpolation (Nocedal & Wright Algorithms 3.5-3.6): it keeps yᵀs > 0, so the update is made,
+    // except after a step that ends on the bound or a search that runs out of trials (then the
+    // lowest point found is taken, and the update only where yᵀs > 0).
     double lo = 0.0, loValue = result.value, loSlope = slope, hi = HUGE_VAL, hiValue = HUGE_VAL;
     double longest = HUGE_VAL;  // the step at which some coordinate moves by its bound
     for (size_t i = 0; i < n; ++i)
       if (std::abs(p[i]) > 0.0) longest = std::min(longest, maxStep[i] / std::abs(p[i]));
     double alpha = std::min(1.0, longest);
-    bool accepted = false;
+    bool accepted = false, outOfEvaluations = false;
     for (int k = 0; k < kMaxTrials; ++k) {
       if (result.evaluations >= options.maxEvaluations) {
-        result.stop = MinimiserStop::kMaxEvaluations;
-        return result;
+        outOfEvaluations = true;
+        break;
       }
       for (size_t i = 0; i < n; ++i) trial[i] = result.x[i] + alpha * p[i];
       const double value = evaluate(trial, trialGradient);
@@ -111,7 +115,7 @@ MinimiserResult minimizeQuasiNewton(const ValueAndGradient& f, std::span<const d
       alpha = std::clamp(next, a + margin, b - margin);
     }
     if (!accepted && lo == 0.0) {
-      result.stop = MinimiserStop::kStalled;
+      result.stop = outOfEvaluations ? MinimiserStop::kMaxEvaluations : MinimiserStop::kStalled;
       return result;
     }
     std::copy(loPoint.begin(), loPoint.end(), trial.begin());
@@ -139,9 +143,16 @@ MinimiserResult minimizeQuasiNewton(const ValueAndGradient& f, std::span<const d
         yhy *= gamma;
         fresh = false;
       }
+      // The upper triangle, mirrored: H stays exactly symmetric.
       for (size_t i = 0; i < n; ++i)
-        for (size_t j = 0; j < n; ++j)
+        for (size_t j = i; j < n; ++j) {
           h[i * n + j] += rho * ((1.0 + rho * yhy) * s[i] * s[j] - hy[i] * s[j] - s[i] * hy[j]);
+          h[j * n + i] = h[i * n + j];
+        }
+    }
+    if (outOfEvaluations) {
+      result.stop = MinimiserStop::kMaxEvaluations;
+      return result;
     }
   }
   result.stages = options.maxIterations;

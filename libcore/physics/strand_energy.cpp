@@ -3,6 +3,7 @@
 
 #include <cmath>
 #include <numeric>
+#include <stdexcept>
 #include <type_traits>
 
 namespace hairgen {
@@ -211,6 +212,8 @@ EnergyTerms StrandEnergy::terms(std::span<const double> q) const {
 }
 
 double StrandEnergy::valueAndGradient(std::span<const double> q, std::span<double> gradient) const {
+  if (q.size() != 3 * lengths_.size() || gradient.size() != q.size())
+    throw std::invalid_argument("valueAndGradient: q and gradient need 3 coordinates per element");
   // Forward mode: each walk seeds kGradientWidth coordinates and carries their derivatives. The
   // elements before the first seeded coordinate's do not depend on it, so a walk starts there,
   // from that element's start frame (found in doubles); the first walk, from the root, gives the value.
