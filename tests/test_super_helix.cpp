@@ -136,12 +136,8 @@ TEST(StrandEnergy, PenetrationFollowsEachShapesDefinition) {
   EXPECT_NEAR(penetration(cuboid, {0.15, 0.02, 0}), 0.05, 1e-15);
 }
 
-TEST(StrandEnergy, CollisionTermEqualsDirectSamplingOfEveryShape) {
-  // The energy walks samples by a trigonometric recurrence and rejects far shapes early; it must
-  // equal Δs Σ ½k max(penetration + extra, 0)² evaluated point by point from sampleRod.
-  Hairstyle style;
-  style.hairLengths = {0.035, 0.05, 0.04};  // 0.125 m: the last sample is off the 4 mm grid
-  style.collisionStep = 0.004;
+// An ellipsoid, a sphere and a tilted box where the test strands go, each with an envelope or none.
+Collision threeShapes() {
   Collision collision;
   glm::dmat3 tilted = glm::dmat3(glm::rotate(glm::dmat4(1.0), 0.4, glm::dvec3(1, 2, 0.5)));
   collision.shapes = {
@@ -154,6 +150,16 @@ TEST(StrandEnergy, CollisionTermEqualsDirectSamplingOfEveryShape) {
        glm::dvec3(0.05, 0.02, 0.04),
        tilted,
        {}}};
+  return collision;
+}
+
+TEST(StrandEnergy, CollisionTermEqualsDirectSamplingOfEveryShape) {
+  // The energy walks samples by a trigonometric recurrence and rejects far shapes early; it must
+  // equal Δs Σ ½k max(penetration + extra, 0)² evaluated point by point from sampleRod.
+  Hairstyle style;
+  style.hairLengths = {0.035, 0.05, 0.04};  // 0.125 m: the last sample is off the 4 mm grid
+  style.collisionStep = 0.004;
+  const Collision collision = threeShapes();
   const double envelope = 0.7;
   std::mt19937 rng(5);
   std::uniform_real_distribution<double> k(-60.0, 60.0);
@@ -189,18 +195,7 @@ TEST(StrandEnergy, GradientMatchesCentralDifferencesAndValueIsTheEnergys) {
   style.collisionStep = 0.004;
   style.helixRadius = 0.01;
   style.helixStep = 0.05;
-  Collision collision;
-  glm::dmat3 tilted = glm::dmat3(glm::rotate(glm::dmat4(1.0), 0.4, glm::dvec3(1, 2, 0.5)));
-  collision.shapes = {
-      {ShapeKind::kEllipsoid, 0.03, 10.0, glm::dvec3(0, 0.12, 0), glm::dvec3(0.08, 0.1, 0.11), tilted, {}},
-      {ShapeKind::kSphere, 0.01, 3.0, glm::dvec3(0.05, 0.2, 0.08), glm::dvec3(0.06), glm::dmat3(1.0), {}},
-      {ShapeKind::kCuboid,
-       0.0,
-       20.0,
-       glm::dvec3(-0.04, 0.15, 0.0),
-       glm::dvec3(0.05, 0.02, 0.04),
-       tilted,
-       {}}};
+  const Collision collision = threeShapes();
   std::mt19937 rng(11);
   std::uniform_real_distribution<double> k(-60.0, 60.0);
   int touching = 0;
