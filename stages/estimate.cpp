@@ -99,11 +99,13 @@ WorkEstimate estimateGrow(const Hairstyle& style, const Collision& collision, si
   e.memoryKey = output >= scratch ? "Hairstyle.VisualityStep" : "Hairstyle.CollisionStep";
   const double perEvaluation =
       kSecondsPerElement * elements + kSecondsPerSample * samples * double(shapes) + 1e-9 * coordinates;
-  // Rosenbrock: MaxIter stages of sweeps over every coordinate. BFGS: at most MaxIter iterations per
-  // coordinate, about 1.2 values with gradients each, and a gradient costs ~coordinates/3 values more.
-  const double evaluations = style.minimiser == Minimiser::kBfgs
-                                 ? double(style.maxIter) * coordinates * 1.2 * (1.0 + coordinates / 3.0)
-                                 : double(style.maxIter) * sweepsPerStage(elements) * coordinates;
+  // Rosenbrock: MaxIter stages of sweeps over every coordinate. BFGS: what it takes in practice, 1.4-12
+  // values with gradients per coordinate on the bundled coupes (5, or MaxIter if fewer), a gradient
+  // costing 4 + coordinates/3 values (GrowCoupe3Bfgs: 9 at 12 coordinates; 62 at 192, 251 at 768).
+  const double evaluations =
+      style.minimiser == Minimiser::kBfgs
+          ? std::min(double(style.maxIter), 5.0) * coordinates * (4.0 + coordinates / 3.0)
+          : double(style.maxIter) * sweepsPerStage(elements) * coordinates;
   e.seconds = guides * evaluations * perEvaluation / cores(threads);
   e.timeKey = kSecondsPerSample * samples * double(shapes) > kSecondsPerElement * elements
                   ? "Hairstyle.CollisionStep"

@@ -1,7 +1,9 @@
-// grow: follicle frames (§4.1.4.1), Rosenbrock minimisation of each guide's energy from its rest shape
-// (§4.1.3), then sampling of the Super-Helix every VisualityStep (§4.1.4.2).
+// grow: follicle frames (§4.1.4.1), minimisation of each guide's energy from its rest shape by
+// Rosenbrock's search (§4.1.3) or BFGS on its gradient (Minimiser bfgs), then sampling of the
+// Super-Helix every VisualityStep (§4.1.4.2).
 #include "stages/grow.h"
 
+#include <algorithm>
 #include <climits>
 #include <cmath>
 #include <cstdint>

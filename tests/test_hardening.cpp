@@ -239,6 +239,11 @@ TEST(Hardening, AbsurdConfigsAreRefusedBeforeTheWork) {
   EXPECT_NE(inputError([&] { requireFits(estimateGrow(fine, head, 759, 2), false); }).find("--force"),
             std::string::npos);
   EXPECT_NO_THROW(requireFits(estimateGrow(fine, head, 759, 2), true));  // --force runs it
+  fine.minimiser = Minimiser::kBfgs;  // each guide's gradient walks all 256 elements 96 times
+  EXPECT_NE(inputError([&] { requireFits(estimateGrow(fine, head, 759, 2), false); }).find("--force"),
+            std::string::npos);
+  fine.hairLengths.assign(8, 0.02);  // the default coupe's: well within
+  EXPECT_NO_THROW(requireFits(estimateGrow(fine, head, 759, 2), false));
   fine = style;
   fine.hairDensity = 1e20;
   EXPECT_NE(

@@ -142,8 +142,26 @@ TEST(QuasiNewton, AnUnderflowedScaleOrAnEvaluationBoundStillEndsAtTheLowestPoint
     options.maxEvaluations = bound;
     MinimiserResult cut = minimizeQuasiNewton(f, x0, scale, maxStep, options);
     EXPECT_LE(cut.evaluations, bound);
+    EXPECT_LE(cut.stages, cut.evaluations - 1);  // an iteration takes at least one evaluation after x0's
+    if (cut.x != x0) {
+      EXPECT_GE(cut.stages, 1) << bound;  // a step taken is an iteration counted
+    }
     EXPECT_EQ(cut.value, f(cut.x, g)) << bound;  // the value of the point returned
     EXPECT_LE(cut.value, f(x0, g));
+  }
+  // Cut mid-search while it expands toward the minimum of (x − 10)² (from 0, H = 0.01: trials at
+  // 0.2, 0.8, 3.2): the point reached is a step taken, and an iteration counted.
+  auto far = [](std::span<const double> x, std::span<double> gradient) {
+    gradient[0] = 2.0 * (x[0] - 10.0);
+    return (x[0] - 10.0) * (x[0] - 10.0);
+  };
+  std::vector<double> origin = {0.0}, small = {0.01}, unbounded = {1e9};
+  for (int bound = 2; bound <= 3; ++bound) {
+    options.maxEvaluations = bound;
+    MinimiserResult cut = minimizeQuasiNewton(far, origin, small, unbounded, options);
+    EXPECT_EQ(cut.stop, MinimiserStop::kMaxEvaluations);
+    EXPECT_GT(cut.x[0], 0.0) << bound;
+    EXPECT_EQ(cut.stages, 1) << bound;
   }
 }
 

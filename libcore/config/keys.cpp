@@ -383,7 +383,8 @@ Section<Hairstyle> makeHairstyle() {
        integerKey<H>({"MaxIter", "", "Rosenbrock stages at most; bfgs: iterations at most, per coordinate"},
                      &H::maxIter, 1, 1000000),
        realKey<H>({"Epsilon", "",
-                   "relative energy change between stages (bfgs: still predicted) that ends minimisation"},
+                   "relative energy change between stages that ends minimisation (bfgs: the predicted and "
+                   "the last decrease both below Epsilon/100)"},
                   &H::epsilon, Range::positive()),
        hairLengthsKey(),
        realKey<H>({"HairDensity", "strands/cm²", "strands per square centimetre of wick"}, &H::hairDensity,

@@ -5,8 +5,9 @@
 
 namespace hairgen {
 
-// kEpsilon: the energy's change fell below Epsilon of its scale (Rosenbrock: over a stage;
-// quasi-Newton: the decrease its model still predicts); kStalled: no trial lowered it any more;
+// kEpsilon: the energy's change fell below its bar (Rosenbrock: over a stage, Epsilon × the energy
+// scale; quasi-Newton: the decrease its model still predicts and the last one, both below the
+// tolerance it is given); kStalled: no trial lowered it any more;
 // kMaxStages: MaxIter's bound; kMaxEvaluations: the hard bound on evaluations.
 enum class MinimiserStop { kEpsilon, kMaxStages, kStalled, kMaxEvaluations };
 const char* name(MinimiserStop stop);

@@ -66,7 +66,8 @@ MinimiserResult minimizeQuasiNewton(const ValueAndGradient& f, std::span<const d
     // has flattened to kCurvature of the first), bracketed and zoomed by safeguarded quadratic
     // interpolation (Nocedal & Wright Algorithms 3.5-3.6): it keeps yᵀs > 0, so the update is made,
     // except after a step that ends on the bound or a search that runs out of trials (then the
-    // lowest point found is taken, and the update only where yᵀs > 0).
+    // lowest point that passed the sufficient-decrease test is taken, and the update made only
+    // where yᵀs > 0).
     double lo = 0.0, loValue = result.value, loSlope = slope, hi = HUGE_VAL, hiValue = HUGE_VAL;
     double longest = HUGE_VAL;  // the step at which some coordinate moves by its bound
     for (size_t i = 0; i < n; ++i)
@@ -151,6 +152,7 @@ MinimiserResult minimizeQuasiNewton(const ValueAndGradient& f, std::span<const d
         }
     }
     if (outOfEvaluations) {
+      result.stages = iteration + 1;  // this iteration's step was taken
       result.stop = MinimiserStop::kMaxEvaluations;
       return result;
     }
