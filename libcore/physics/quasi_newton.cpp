@@ -11,12 +11,6 @@
 namespace hairgen {
 namespace {
 
-double dot(std::span<const double> a, std::span<const double> b) {
-  double s = 0.0;
-  for (size_t i = 0; i < a.size(); ++i) s += a[i] * b[i];
-  return s;
-}
-
 // H = diag(scale); an entry that is not a positive finite number (a stiffness that underflowed) is 1,
 // which the first step's curvature then rescales.
 void resetInverse(std::vector<double>& h, std::span<const double> scale) {
@@ -52,14 +46,15 @@ MinimiserResult minimizeQuasiNewton(const ValueAndGradient& f, std::span<const d
     result.stages = iteration;
     // p = −H g; a direction that does not descend (H lost its positivity to rounding) restarts H.
     for (int attempt = 0; attempt < 2; ++attempt) {
-      for (size_t i = 0; i < n; ++i) p[i] = -dot(std::span(h).subspan(i * n, n), g);
-      if (dot(p, g) < 0.0) break;
+      for (size_t i = 0; i < n; ++i) p[i] = -innerProduct(std::span(h).subspan(i * n, n), g);
+      if (innerProduct(p, g) < 0.0) break;
       resetInverse(h, inverseScale);
       fresh = true;
     }
-    const double slope = dot(p, g);
+    const double slope = innerProduct(p, g);
     if (!(slope < 0.0) || (-0.5 * slope < options.tolerance && lastDecrease < options.tolerance)) {
-      result.stop = slope < 0.0 || dot(g, g) == 0.0 ? MinimiserStop::kEpsilon : MinimiserStop::kStalled;
+      result.stop =
+          slope < 0.0 || innerProduct(g, g) == 0.0 ? MinimiserStop::kEpsilon : MinimiserStop::kStalled;
       return result;
     }
     // A step satisfying the strong Wolfe conditions (sufficient decrease, and a slope along p that
@@ -81,7 +76,7 @@ MinimiserResult minimizeQuasiNewton(const ValueAndGradient& f, std::span<const d
       }
       for (size_t i = 0; i < n; ++i) trial[i] = result.x[i] + alpha * p[i];
       const double value = evaluate(trial, trialGradient);
-      const double trialSlope = dot(trialGradient, p);
+      const double trialSlope = innerProduct(trialGradient, p);
       if (value > result.value + kArmijo * alpha * slope || value >= loValue) {
         hi = alpha;
         hiValue = value;
@@ -132,11 +127,11 @@ MinimiserResult minimizeQuasiNewton(const ValueAndGradient& f, std::span<const d
     result.value = value;
     // H ← (I − ρ s yᵀ) H (I − ρ y sᵀ) + ρ s sᵀ, ρ = 1/(yᵀs), skipped where yᵀs ≤ 0 (no curvature
     // information the update could keep positive definite).
-    const double sy = dot(s, y);
-    if (sy > 1e-14 * std::sqrt(dot(s, s) * dot(y, y))) {
+    const double sy = innerProduct(s, y);
+    if (sy > 1e-14 * std::sqrt(innerProduct(s, s) * innerProduct(y, y))) {
       const double rho = 1.0 / sy;
-      for (size_t i = 0; i < n; ++i) hy[i] = dot(std::span(h).subspan(i * n, n), y);
-      double yhy = dot(y, hy);
+      for (size_t i = 0; i < n; ++i) hy[i] = innerProduct(std::span(h).subspan(i * n, n), y);
+      double yhy = innerProduct(y, hy);
       if (fresh) {
         const double gamma = sy / yhy;
         for (double& v : h) v *= gamma;

@@ -11,29 +11,6 @@
 #include <cmath>
 
 namespace hairgen {
-namespace {
-
-double dot(const std::vector<double>& a, const std::vector<double>& b) {
-  double s = 0.0;
-  for (size_t i = 0; i < a.size(); ++i) s += a[i] * b[i];
-  return s;
-}
-
-}  // namespace
-
-const char* name(MinimiserStop stop) {
-  switch (stop) {
-    case MinimiserStop::kEpsilon:
-      return "epsilon";
-    case MinimiserStop::kStalled:
-      return "stalled";
-    case MinimiserStop::kMaxEvaluations:
-      return "maxEvaluations";
-    case MinimiserStop::kMaxStages:
-      break;
-  }
-  return "maxIter";
-}
 
 std::vector<std::vector<double>> palmerDirections(const std::vector<std::vector<double>>& xi,
                                                   std::span<const double> d) {
@@ -60,7 +37,7 @@ std::vector<std::vector<double>> palmerDirections(const std::vector<std::vector<
     double sign = dk < 0.0 ? -1.0 : 1.0;
     double scale = sign / (std::sqrt(norm2[k - 1]) * std::sqrt(norm2[k]));
     for (size_t j = 0; j < n; ++j) out[k][j] = scale * (dk * a[k][j] - norm2[k] * xi[k - 1][j]);
-    double len = std::sqrt(dot(out[k], out[k]));  // 1 in exact arithmetic; renormalise rounding away
+    double len = std::sqrt(innerProduct(out[k], out[k]));  // 1 in exact arithmetic; renormalise rounding away
     for (double& v : out[k]) v /= len;
   }
   return out;

@@ -179,30 +179,24 @@ void StrandEnergy::accumulate(std::span<const T> q, size_t first, const RodFrame
   }
   // One walk along the rod gives both the height integral (§4.1.1.3.2, closed form per element) and
   // the collision samples (two sin/cos pairs per element, whatever the number of samples).
-  const auto lengths = std::span(lengths_).subspan(first);
-  forEachElement(BasicRodFrame<T>(start), lengths, q.subspan(3 * first),
-                 [&](const BasicHelixElement<T>& element, double, size_t i) {
-                   const size_t k = first + i;
-                   height += element.length() * (element.start().position.y - root_.position.y) +
-                             element.displacementIntegral().y;
-                   // An element's samples lie within its length of its start (the arc is at least the chord):
-                   // where no shape reaches that far, each would add exactly 0, so none is placed.
-                   if (shapes_.empty() || !mayTouch(valueOf(element.start().position), element.length()))
-                     return;
-                   const ElementSamples& samples = samples_[k];
-                   // With derivatives, a sample that touches no shape (penalty and derivatives 0) is
-                   // found from its position's value alone.
-                   constexpr bool kValues = std::is_same_v<T, double>;
-                   element.visitGrid(
-                       samples.first, collisionStep_, samples.gridCount,
-                       [&](size_t, double u, const T& c, const T& s) {
-                         if (kValues || this->penalty(element.valueAt(u, valueOf(c), valueOf(s))) > 0.0)
-                           penalty += this->penalty(element.at(u, c, s));
-                       });
-                   for (double u : samples.offGrid)
-                     if (kValues || this->penalty(element.valuePosition(u)) > 0.0)
-                       penalty += this->penalty(element.position(u));
-                 });
+  // With derivatives, a sample that touches no shape (penalty and derivatives 0) is found from its
+  // position's value alone.
+  constexpr bool kValues = std::is_same_v<T, double>;
+  auto element = [&](const BasicHelixElement<T>& e, double, size_t i) {
+    height += e.length() * (e.start().position.y - root_.position.y) + e.displacementIntegral().y;
+    // An element's samples lie within its length of its start (the arc is at least the chord): where no
+    // shape reaches that far, each would add exactly 0, so none is placed.
+    if (shapes_.empty() || !mayTouch(valueOf(e.start().position), e.length())) return;
+    const ElementSamples& samples = samples_[first + i];
+    e.visitGrid(samples.first, collisionStep_, samples.gridCount,
+                [&](size_t, double u, const T& c, const T& s) {
+                  if (kValues || this->penalty(e.valueAt(u, valueOf(c), valueOf(s))) > 0.0)
+                    penalty += this->penalty(e.at(u, c, s));
+                });
+    for (double u : samples.offGrid)
+      if (kValues || this->penalty(e.valuePosition(u)) > 0.0) penalty += this->penalty(e.position(u));
+  };
+  forEachElement(BasicRodFrame<T>(start), std::span(lengths_).subspan(first), q.subspan(3 * first), element);
 }
 
 EnergyTerms StrandEnergy::terms(std::span<const double> q) const {
@@ -225,12 +219,10 @@ double StrandEnergy::valueAndGradient(std::span<const double> q, std::span<doubl
     const size_t end = std::min(q.size(), first + kGradientWidth), element = first / 3;
     for (size_t i = 0; i < q.size(); ++i)
       dual[i] = i >= first && i < end ? EnergyGradient::variable(q[i], int(i - first)) : EnergyGradient(q[i]);
-    for (; startElement < element; ++startElement)
-      start = HelixElement(
-                  start,
-                  darbouxVector(start, q[3 * startElement], q[3 * startElement + 1], q[3 * startElement + 2]),
-                  lengths_[startElement])
-                  .end();
+    for (; startElement < element; ++startElement) {
+      const double* e = &q[3 * startElement];
+      start = advance(start, darbouxVector(start, e[0], e[1], e[2]), lengths_[startElement]);
+    }
     EnergyGradient elastic(0.0), height(0.0), penalty(0.0);
     accumulate(std::span<const EnergyGradient>(dual), element, start, elastic, height, penalty);
     const EnergyGradient total = elastic + weight_ * height + penalty * collisionStep_;

@@ -54,7 +54,7 @@ BasicHelixElement<T>::BasicHelixElement(const BasicRodFrame<T>& start, const Vec
   sinL_ = series ? T(0.0) : sin(x);
   cosL_ = series ? T(1.0) : cos(x);
   BasicHelixCoefficients<T> k = helixCoefficients(omega_, invOmega_, length, cosL_, sinL_);
-  end_.position = start.position + length * start.n0 + k.b * wn0_ + k.c * wwn0_;
+  end_.position = along(length, k);
   end_.n0 = rotate(start.n0, w_, k);
   end_.n1 = rotate(start.n1, w_, k);
   end_.n2 = crossOf(end_.n0, end_.n1);  // the frame stays right-handed; one rotation fewer
@@ -62,21 +62,19 @@ BasicHelixElement<T>::BasicHelixElement(const BasicRodFrame<T>& start, const Vec
 
 template <class T>
 Vec3<T> BasicHelixElement<T>::position(double u) const {
-  BasicHelixCoefficients<T> k = coefficients(omega_, invOmega_, u);
-  return start_.position + u * start_.n0 + k.b * wn0_ + k.c * wwn0_;
+  return along(u, coefficients(omega_, invOmega_, u));
 }
 
 template <class T>
 glm::dvec3 BasicHelixElement<T>::valuePosition(double u) const {
-  HelixCoefficients k = coefficients(valueOf(omega_), valueOf(invOmega_), u);
-  return valueOf(start_.position) + u * valueOf(start_.n0) + k.b * valueOf(wn0_) + k.c * valueOf(wwn0_);
+  return valueAlong(u, coefficients(valueOf(omega_), valueOf(invOmega_), u));
 }
 
 template <class T>
 BasicRodFrame<T> BasicHelixElement<T>::frame(double u) const {
   BasicHelixCoefficients<T> k = coefficients(omega_, invOmega_, u);
   BasicRodFrame<T> f;
-  f.position = start_.position + u * start_.n0 + k.b * wn0_ + k.c * wwn0_;
+  f.position = along(u, k);
   f.n0 = rotate(start_.n0, w_, k);
   f.n1 = rotate(start_.n1, w_, k);
   f.n2 = rotate(start_.n2, w_, k);

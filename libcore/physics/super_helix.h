@@ -59,6 +59,30 @@ struct RestShape {
 };
 RestShape restShape(double helixRadius, double helixStep);
 
+// Below this |Ω u| the closed forms switch to their Taylor series (truncation error < 1e-17).
+inline constexpr double kHelixSeriesBelow = 0.05;
+
+// a = sin x/Ω, b = (1 − cos x)/Ω², c = (x − sin x)/Ω³ at u (x = Ω u), given cos x, sin x and 1/Ω;
+// Taylor series below kHelixSeriesBelow, where cos x, sin x and 1/Ω are not read.
+template <class T>
+struct BasicHelixCoefficients {
+  T a, b, c;
+};
+using HelixCoefficients = BasicHelixCoefficients<double>;
+template <class T>
+BasicHelixCoefficients<T> helixCoefficients(const T& omega, const T& invOmega, double u, const T& cosX,
+                                            const T& sinX) {
+  const T x = omega * u;
+  if (std::abs(valueOf(x)) < kHelixSeriesBelow) {
+    const T x2 = x * x;
+    return {u * (1.0 - x2 / 6.0 * (1.0 - x2 / 20.0 * (1.0 - x2 / 42.0))),
+            u * u * (0.5 - x2 / 24.0 * (1.0 - x2 / 30.0 * (1.0 - x2 / 56.0))),
+            u * u * u * (1.0 / 6.0 - x2 / 120.0 * (1.0 - x2 / 42.0 * (1.0 - x2 / 72.0)))};
+  }
+  const T inv2 = invOmega * invOmega;
+  return {sinX * invOmega, (1.0 - cosX) * inv2, (x - sinX) * inv2 * invOmega};
+}
+
 // One element of the rod: its start frame, constant Darboux vector W, and the closed forms over
 // u ∈ [0, ℓ]. Building one costs one sin/cos pair (for its end frame); everything else is algebra.
 template <class T>
@@ -85,6 +109,15 @@ class BasicHelixElement {
   glm::dvec3 valuePosition(double u) const;
 
  private:
+  // The centreline at u from its coefficients there (the file comment of super_helix.cpp), with
+  // derivatives and as values alone.
+  Vec3<T> along(double u, const BasicHelixCoefficients<T>& k) const {
+    return start_.position + u * start_.n0 + k.b * wn0_ + k.c * wwn0_;
+  }
+  glm::dvec3 valueAlong(double u, const HelixCoefficients& k) const {
+    return valueOf(start_.position) + u * valueOf(start_.n0) + k.b * valueOf(wn0_) + k.c * valueOf(wwn0_);
+  }
+
   BasicRodFrame<T> start_, end_;
   Vec3<T> w_, wn0_, wwn0_;  // W, W×n0, W×(W×n0)
   T omega_, invOmega_;      // invOmega_ is 0 for a straight element
@@ -116,40 +149,14 @@ void sampleRod(const RodFrame& root, std::span<const double> lengths, std::span<
 // Output arc lengths: every `step` from 0, the last exactly at `total`.
 std::vector<double> sampleArcLengths(double total, double step, bool includeRoot);
 
-// Below this |Ω u| the closed forms switch to their Taylor series (truncation error < 1e-17).
-inline constexpr double kHelixSeriesBelow = 0.05;
-
-// a = sin x/Ω, b = (1 − cos x)/Ω², c = (x − sin x)/Ω³ at u (x = Ω u), given cos x, sin x and 1/Ω;
-// Taylor series below kHelixSeriesBelow, where cos x, sin x and 1/Ω are not read.
-template <class T>
-struct BasicHelixCoefficients {
-  T a, b, c;
-};
-using HelixCoefficients = BasicHelixCoefficients<double>;
-template <class T>
-BasicHelixCoefficients<T> helixCoefficients(const T& omega, const T& invOmega, double u, const T& cosX,
-                                            const T& sinX) {
-  const T x = omega * u;
-  if (std::abs(valueOf(x)) < kHelixSeriesBelow) {
-    const T x2 = x * x;
-    return {u * (1.0 - x2 / 6.0 * (1.0 - x2 / 20.0 * (1.0 - x2 / 42.0))),
-            u * u * (0.5 - x2 / 24.0 * (1.0 - x2 / 30.0 * (1.0 - x2 / 56.0))),
-            u * u * u * (1.0 / 6.0 - x2 / 120.0 * (1.0 - x2 / 42.0 * (1.0 - x2 / 72.0)))};
-  }
-  const T inv2 = invOmega * invOmega;
-  return {sinX * invOmega, (1.0 - cosX) * inv2, (x - sinX) * inv2 * invOmega};
-}
-
 template <class T>
 Vec3<T> BasicHelixElement<T>::at(double u, const T& cosX, const T& sinX) const {
-  BasicHelixCoefficients<T> k = helixCoefficients(omega_, invOmega_, u, cosX, sinX);
-  return start_.position + u * start_.n0 + k.b * wn0_ + k.c * wwn0_;
+  return along(u, helixCoefficients(omega_, invOmega_, u, cosX, sinX));
 }
 
 template <class T>
 glm::dvec3 BasicHelixElement<T>::valueAt(double u, double cosX, double sinX) const {
-  HelixCoefficients k = helixCoefficients(valueOf(omega_), valueOf(invOmega_), u, cosX, sinX);
-  return valueOf(start_.position) + u * valueOf(start_.n0) + k.b * valueOf(wn0_) + k.c * valueOf(wwn0_);
+  return valueAlong(u, helixCoefficients(valueOf(omega_), valueOf(invOmega_), u, cosX, sinX));
 }
 
 template <class T>
