@@ -114,17 +114,14 @@ MinimiserResult minimizeQuasiNewton(const ValueAndGradient& f, std::span<const d
       result.stop = outOfEvaluations ? MinimiserStop::kMaxEvaluations : MinimiserStop::kStalled;
       return result;
     }
-    std::copy(loPoint.begin(), loPoint.end(), trial.begin());
-    trialGradient.swap(loGradient);
-    const double value = loValue;
     for (size_t i = 0; i < n; ++i) {
-      s[i] = trial[i] - result.x[i];
-      y[i] = trialGradient[i] - g[i];
+      s[i] = loPoint[i] - result.x[i];
+      y[i] = loGradient[i] - g[i];
     }
-    result.x.swap(trial);
-    g.swap(trialGradient);
-    lastDecrease = result.value - value;
-    result.value = value;
+    result.x.swap(loPoint);
+    g.swap(loGradient);
+    lastDecrease = result.value - loValue;
+    result.value = loValue;
     // H ← (I − ρ s yᵀ) H (I − ρ y sᵀ) + ρ s sᵀ, ρ = 1/(yᵀs), skipped where yᵀs ≤ 0 (no curvature
     // information the update could keep positive definite).
     const double sy = innerProduct(s, y);
