@@ -77,10 +77,9 @@ void registerGrow(CLI::App& app, int& exitCode) {
   cmd->add_option("-o,--output", options->output,
                   "Guides to write: .hair, .gltf or .glb (written atomically)")
       ->required();
-  cmd->add_option(
-         "--diagnostics", options->diagnostics,
-         "Write per guide: follicle, generalised coordinates, energy terms at start and end, stages, "
-         "evaluations, why it stopped")
+  cmd->add_option("--diagnostics", options->diagnostics,
+                  "Write per guide: follicle, generalised coordinates, energy terms at start and end, stages "
+                  "(Minimiser bfgs: iterations), evaluations, why it stopped")
       ->type_name("FILE.json");
   cmd->add_option(
          "--shard", options->shard,
