@@ -2,7 +2,8 @@
 # Benchmarks, one group or all: scripts/bench.sh [grow|cantilever|interpolate|shade|render|simulate|cache|all] [Google Benchmark flags]
 # scripts/bench.sh farm: a shot in one process and through a local Slurm (scripts/bench-farm.sh).
 # Builds Release first. Speed targets are checked here, never by timed unit tests: each benchmark with a
-# target (issues 15, 16 and 20) prints `of_target`, its figure over the target (1 or more meets it).
+# target (issues 15, 16 and 20) prints `of_target`, its figure over the target (1 or more meets it), and
+# the run ends with a table of them: figure, target, ratio, met or not (medians with repetitions).
 # Medians: add --benchmark_repetitions=5 --benchmark_report_aggregates_only=true.
 set -euo pipefail
 cd "$(dirname "$0")/.."

@@ -25,15 +25,24 @@
 //                       through whatever EGL opens (llvmpipe here); counters give each pass's seconds.
 //   RenderCommand:      the whole `hairgen render` of that coupe's cache at 1920×1080, a child process:
 //                       wall time against 4 s, peak memory (peak_MB) against 3× the cache (peak_of_target).
+// Every benchmark with a target gives `of_target` (its figure over the target: 1 or more meets it) and
+// the target; after the runs, a table lists them all (TargetTable, at the end).
 #include <benchmark/benchmark.h>
 
 #include <spawn.h>
 #include <sys/resource.h>
 #include <sys/wait.h>
 
+#include <unistd.h>
+
 #include <cerrno>
+#include <cmath>
+#include <cstdio>
 #include <ctime>
 #include <map>
+#include <ostream>
+#include <string>
+#include <vector>
 
 #include <tbb/global_control.h>
 #include <tbb/info.h>
@@ -63,13 +72,17 @@ constexpr double kRender1080pSeconds = 4.0;   // 150,000 strands at 1920×1080 (
 constexpr double kRenderPeakOverCache = 3.0;  // its peak memory over the cache's size
 constexpr double kAnjyoFramesPerSecond = 200.0, kSpringsFramesPerSecond = 24.0;
 
-// `done` things in `seconds` against a target of `perSecond` a second.
-void rateTarget(benchmark::State& state, double done, double seconds, double perSecond) {
+// `done` things in `seconds` against a target of `perSecond` a second, `unit` naming them ("guides/s").
+// Beside `of_target` the target itself is a counter, `target_` and its unit, which TargetTable reads.
+void rateTarget(benchmark::State& state, double done, double seconds, double perSecond,
+                const std::string& unit) {
   state.counters["of_target"] = done / seconds / perSecond;
+  state.counters["target_" + unit] = perSecond;
 }
 // The iterations' `seconds` against a target of `target` seconds each.
 void timeTarget(benchmark::State& state, double seconds, double target) {
   state.counters["of_target"] = target / (seconds / double(state.iterations()));
+  state.counters["target_s"] = target;
 }
 
 // A bundled coupe's config and wick.
@@ -130,7 +143,7 @@ void growBundled(benchmark::State& state, const Bundled& c, double target,
       benchmark::Counter(double(evaluations) / tbb::info::default_concurrency(), benchmark::Counter::kIsRate);
   state.counters["follicles"] = double(c.wick.vertexCount());
   state.counters["elements"] = double(c.config.hairstyle.hairLengths.size());
-  rateTarget(state, double(guides), clock.lap(), target);
+  rateTarget(state, double(guides), clock.lap(), target, "guides/s");
 }
 void GrowCoupe3(benchmark::State& state) {
   growBundled(state, coupe3(), kGrowCoupe3GuidesPerSecond);
@@ -306,7 +319,7 @@ void SimulateAnjyo(benchmark::State& state) {
   state.counters["segments"] = double(guides.pointCount() - guides.strandCount());
   // As for SimulateSprings: CPU seconds of every thread per frame, what a shared machine's load leaves out.
   state.counters["cpu_s_per_frame"] = double(std::clock() - start) / CLOCKS_PER_SEC / double(frames);
-  rateTarget(state, double(frames), clock.lap(), kAnjyoFramesPerSecond);
+  rateTarget(state, double(frames), clock.lap(), kAnjyoFramesPerSecond, "frames/s");
 }
 BENCHMARK(SimulateAnjyo)->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(3.0);
 
@@ -348,7 +361,7 @@ void SimulateSprings(benchmark::State& state) {
   // CPU seconds of every thread per frame: on a shared machine the wall clock also counts the other
   // jobs' time, this does not (2 / cpu_s_per_frame is what 2 free cores would give at best).
   state.counters["cpu_s_per_frame"] = double(std::clock() - start) / CLOCKS_PER_SEC / double(frames);
-  rateTarget(state, double(frames), clock.lap(), kSpringsFramesPerSecond);
+  rateTarget(state, double(frames), clock.lap(), kSpringsFramesPerSecond, "frames/s");
 }
 BENCHMARK(SimulateSprings)->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(3.0);
 
@@ -472,6 +485,7 @@ void RenderCommand(benchmark::State& state) {
   state.counters["peak_MB"] = peak / 1e6;
   state.counters["cache_MB"] = cacheBytes / 1e6;
   state.counters["peak_of_target"] = kRenderPeakOverCache * cacheBytes / peak;
+  state.counters["peak_target_MB"] = kRenderPeakOverCache * cacheBytes / 1e6;
 }
 // One command an iteration; --benchmark_repetitions=5 gives the medians of five.
 BENCHMARK(RenderCommand)->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(1);
@@ -486,7 +500,98 @@ BENCHMARK(Render)
     ->UseRealTime()
     ->Iterations(3);
 
+// After the benchmarks' own lines, every figure that has a target in one table: the figure, the target,
+// the figure over the target and whether it is met (the README's Performance table gives the same
+// figures with their history). A target is a pair of counters, `of_target` and `target_UNIT` (or
+// `peak_of_target` and `peak_target_MB` for a second target of the same benchmark); with
+// --benchmark_repetitions the medians are taken.
+class TargetTable : public benchmark::ConsoleReporter {
+ public:
+  // As the library's own console (colour on a terminal; counters after the times, not as columns).
+  TargetTable() : ConsoleReporter(isatty(STDOUT_FILENO) ? OO_Color : OO_None) {}
+  void ReportRuns(const std::vector<Run>& runs) override {
+    ConsoleReporter::ReportRuns(runs);
+    for (const Run& run : runs) {
+      if (run.error_occurred) continue;
+      const bool aggregate = run.run_type == Run::RT_Aggregate;
+      if (aggregate ? run.aggregate_name != "median" : run.repetitions > 1) continue;
+      for (const auto& [key, ratio] : run.counters) {
+        const size_t at = key.rfind("of_target");
+        if (at == std::string::npos || at + 9 != key.size()) continue;
+        const std::string prefix = key.substr(0, at) + "target_";
+        const auto target = run.counters.lower_bound(prefix);
+        if (target == run.counters.end() || target->first.compare(0, prefix.size(), prefix) != 0) continue;
+        Row row;
+        row.name = run.run_name.function_name + (run.run_name.args.empty() ? "" : "/" + run.run_name.args) +
+                   (at > 0 ? " (" + key.substr(0, at - 1) + ")" : "");
+        row.unit = target->first.substr(prefix.size());
+        row.target = target->second.value;
+        row.ratio = ratio.value;
+        row.median = aggregate;
+        rows_.push_back(row);
+      }
+    }
+  }
+  void Finalize() override {
+    ConsoleReporter::Finalize();
+    if (rows_.empty()) return;
+    std::ostream& out = GetOutputStream();
+    out << "\ntargets (issues 15, 16, 20):\n";
+    out << "| benchmark | figure | target | of target | |\n|---|---|---|---|---|\n";
+    for (const Row& r : rows_) {
+      // A rate's figure is its target times the ratio; a time's or a size's, the target over it.
+      const bool rate = r.unit.size() > 2 && r.unit.compare(r.unit.size() - 2, 2, "/s") == 0;
+      // Seconds under a second are written in milliseconds.
+      const double scale = r.unit == "s" && r.target < 1.0 ? 1000.0 : 1.0;
+      const std::string unit = scale > 1.0 ? "ms" : r.unit;
+      const double figure = rate ? r.ratio * r.target : r.target / r.ratio;
+      out << "| " << r.name << " | " << number(figure * scale) << " " << unit << (r.median ? " (median)" : "")
+          << " | " << number(r.target * scale) << " " << unit << " | " << number(r.ratio) << " | "
+          << (r.ratio >= 1.0 ? "met" : "not met") << " |\n";
+    }
+  }
+
+ private:
+  struct Row {
+    std::string name, unit;
+    double target = 0.0, ratio = 0.0;
+    bool median = false;
+  };
+  // Three significant figures, thousands apart with commas: 1,715, 0.427, 84.9.
+  static std::string number(double v) {
+    if (!std::isfinite(v)) return std::to_string(v);
+    if (std::abs(v) >= 1000.0) {
+      std::string digits = std::to_string(static_cast<long long>(std::llround(v)));
+      for (int i = int(digits.size()) - 3; i > (digits[0] == '-' ? 1 : 0); i -= 3)
+        digits.insert(size_t(i), ",");
+      return digits;
+    }
+    char text[32];
+    std::snprintf(text, sizeof text, "%.3g", v);
+    return text;
+  }
+  std::vector<Row> rows_;
+};
+
 }  // namespace
 }  // namespace hairgen
 
-BENCHMARK_MAIN();
+// BENCHMARK_MAIN's, with the table of targets after the console's lines (another --benchmark_format
+// gets the library's own reporter and no table).
+int main(int argc, char** argv) {
+  bool console = true;
+  for (int i = 1; i < argc; ++i) {
+    const std::string arg = argv[i];
+    if (arg.rfind("--benchmark_format=", 0) == 0 && arg != "--benchmark_format=console") console = false;
+  }
+  benchmark::Initialize(&argc, argv);
+  if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 1;
+  if (console) {
+    hairgen::TargetTable table;
+    benchmark::RunSpecifiedBenchmarks(&table);
+  } else {
+    benchmark::RunSpecifiedBenchmarks();
+  }
+  benchmark::Shutdown();
+  return 0;
+}
