@@ -159,7 +159,7 @@ class AnjyoHair {
   Strands rest_;  // every attribute of the rest guides but their points and tangents
   PointArray restPoints_;
   std::vector<uint32_t> firstSegment_;  // per strand, + 1
-  std::vector<double> state_;           // kStateValues per segment: 0 at rest but the cosines, 1
+  std::vector<double> state_;           // kStateValues per segment (the restart layout): all 0 at rest
   std::vector<double> shapeReach2_;     // per shape: beyond this squared distance nothing reaches it
   // Per shape, a test cheaper than penetration() that rules out most points (exact for ellipsoids,
   // always "maybe" for the other shapes). `v` is the point less the shape's centre.
