@@ -1,6 +1,7 @@
 // The attacks of the hardening review, each kept as a test of the class of bug it found: wrapped
 // extents, files read from outside a glTF's folder, images sized by their header, outputs that replaced
 // devices and links, stale temporaries, runaway estimates, text as editors write it, non-UTF-8 JSON.
+#include <fcntl.h>
 #include <gtest/gtest.h>
 #include <sys/stat.h>
 #include <unistd.h>
@@ -145,6 +146,31 @@ TEST(Hardening, AWriteToAFifoGoesIntoItAndLeavesItAFifo) {
   struct stat st {};
   ASSERT_EQ(::lstat(fifo.c_str(), &st), 0);
   EXPECT_TRUE(S_ISFIFO(st.st_mode));
+}
+
+// --stats /dev/stdout with stdout appended to a farm log: the log keeps what was before and gets what
+// comes after, and stays the same file (reopening it by name, or replacing it, would lose both).
+TEST(Hardening, AWriteToAnOpenDescriptorGoesThroughItAtItsOffset) {
+  test::TempDir dir("hardening");
+  const fs::path log = dir.path() / "farm.log";
+  const int fd = ::open(log.c_str(), O_WRONLY | O_CREAT | O_APPEND | O_CLOEXEC, 0644);
+  ASSERT_GE(fd, 0);
+  struct stat before {};
+  ASSERT_EQ(::fstat(fd, &before), 0);
+  auto append = [&](const std::string& text) {
+    ASSERT_EQ(::write(fd, text.data(), text.size()), ssize_t(text.size()));
+  };
+  append("earlier\n");
+  writeFileAtomic("/dev/fd/" + std::to_string(fd), std::string("{\"a\": 1}\n"));
+  writeThroughTemporary("/proc/self/fd/" + std::to_string(fd),
+                        [](const fs::path& file) { spit(file, std::string("{\"b\": 2}\n")); });
+  append("later\n");
+  ::close(fd);
+  EXPECT_EQ(slurp(log), "earlier\n{\"a\": 1}\n{\"b\": 2}\nlater\n");
+  struct stat after {};
+  ASSERT_EQ(::stat(log.c_str(), &after), 0);
+  EXPECT_EQ(after.st_ino, before.st_ino);
+  for (const fs::path& left : fs::directory_iterator(dir.path())) EXPECT_EQ(left.filename(), "farm.log");
 }
 
 TEST(Hardening, AWriteErrorIsAnIoError) {

@@ -86,10 +86,45 @@ std::string hostName() {
 struct Destination {
   fs::path path;
   bool direct = false;  // a device, FIFO or socket: written in place
+  int descriptor = -1;  // a descriptor this process has open (/dev/stdout, /dev/fd/N): written through it
 };
+
+// The descriptor N of this process that `path` names, or that a link on the way to it names:
+// /dev/stdout, /dev/stderr, /dev/fd/N, /proc/self/fd/N or /proc/PID/fd/N for this PID; −1 for any
+// other path or a descriptor that is not open. Opening such a path again would open the file behind
+// it anew (truncating a log that stdout is appended to); writing through the descriptor writes where
+// the shell's redirection points, at its offset, appending where it appends.
+int descriptorNamed(const fs::path& requested) {
+  std::error_code ec;
+  fs::path path = requested.lexically_normal();
+  const std::string self = "/proc/" + std::to_string(::getpid()) + "/fd/";
+  for (int depth = 0; depth < 40; ++depth) {
+    const std::string text = path.string();
+    int fd = -1;
+    if (text == "/dev/stdout") fd = 1;
+    if (text == "/dev/stderr") fd = 2;
+    for (const std::string& prefix : {std::string("/dev/fd/"), std::string("/proc/self/fd/"), self})
+      if (text.size() > prefix.size() && text.compare(0, prefix.size(), prefix) == 0 &&
+          text.find_first_not_of("0123456789", prefix.size()) == std::string::npos &&
+          text.size() - prefix.size() <= 9)
+        fd = std::stoi(text.substr(prefix.size()));
+    if (fd >= 0) return ::fcntl(fd, F_GETFD) != -1 ? fd : -1;
+    if (!fs::is_symlink(fs::symlink_status(path, ec))) return -1;
+    const fs::path to = fs::read_symlink(path, ec);
+    if (ec) return -1;
+    path = (to.is_absolute() ? to : path.parent_path() / to).lexically_normal();
+  }
+  return -1;
+}
 
 Destination destinationOf(const fs::path& requested) {
   std::error_code ec;
+  if (const int fd = descriptorNamed(requested); fd >= 0) {
+    struct stat st {};
+    if (::fstat(fd, &st) == 0 && S_ISDIR(st.st_mode))
+      throw InputError({requested.string(), 0}, "is a directory; name a file to write");
+    return {requested, true, fd};
+  }
   const fs::file_status status = fs::status(requested, ec);  // through any links
   if (fs::is_directory(status))
     throw InputError({requested.string(), 0}, "is a directory; name a file to write");
@@ -148,6 +183,22 @@ void renameInto(const fs::path& temporary, const fs::path& target) {
   std::error_code ec;
   fs::rename(temporary, target, ec);
   if (ec) throw IoError({target.string(), 0}, "cannot rename into place: " + ec.message());
+}
+
+// Copies a finished file to an open descriptor, at its offset.
+void copyToDescriptor(const fs::path& from, int fd, const fs::path& name) {
+  std::ifstream in(from, std::ios::binary);
+  std::vector<char> buffer(1 << 16);
+  while (in) {
+    in.read(buffer.data(), std::streamsize(buffer.size()));
+    for (size_t done = 0, n = size_t(in.gcount()); done < n;) {
+      const ssize_t wrote = ::write(fd, buffer.data() + done, n - done);
+      if (wrote < 0 && errno == EINTR) continue;
+      if (wrote <= 0) throw IoError({name.string(), 0}, std::string("write failed: ") + std::strerror(errno));
+      done += size_t(wrote);
+    }
+  }
+  if (in.bad()) throw IoError({name.string(), 0}, "write failed: cannot read back what was written");
 }
 
 // Copies a finished file into a device or FIFO.
@@ -223,8 +274,13 @@ std::vector<uint8_t> readFileBytes(const fs::path& path) {
 AtomicFile::AtomicFile(fs::path target) {
   const Destination destination = destinationOf(target);
   target_ = destination.path;
-  if (!destination.direct) temporary_ = temporaryBeside(target_, slot_);
-  const fs::path& path = destination.direct ? target_ : temporary_;
+  descriptor_ = destination.descriptor;
+  // A descriptor's file is written whole at the end, from a temporary in the system's folder.
+  if (descriptor_ >= 0)
+    temporary_ = temporaryBeside(fs::temp_directory_path() / target_.filename(), slot_);
+  else if (!destination.direct)
+    temporary_ = temporaryBeside(target_, slot_);
+  const fs::path& path = destination.direct && descriptor_ < 0 ? target_ : temporary_;
   stream_.open(path, std::ios::binary | std::ios::trunc);
   if (!stream_) {
     const std::string reason = std::strerror(errno);
@@ -249,7 +305,11 @@ void AtomicFile::commit() {
   stream_.close();
   if (!ok || stream_.fail())
     throw IoError({target_.string(), 0}, "write failed (no space left on the device?)");
-  if (!temporary_.empty()) {
+  if (descriptor_ >= 0) {
+    copyToDescriptor(temporary_, descriptor_, target_);
+    std::error_code ec;
+    fs::remove(temporary_, ec);
+  } else if (!temporary_.empty()) {
     renameInto(temporary_, target_);
     recordCommitted(target_);
   }
@@ -266,7 +326,10 @@ void writeThroughTemporary(const fs::path& target, const std::function<void(cons
                                  : temporaryBeside(destination.path, slot);
   try {
     write(temporary);
-    if (destination.direct) {
+    if (destination.descriptor >= 0) {
+      copyToDescriptor(temporary, destination.descriptor, destination.path);
+      fs::remove(temporary);
+    } else if (destination.direct) {
       copyInto(temporary, destination.path);
       fs::remove(temporary);
     } else {

@@ -66,7 +66,8 @@ class AtomicFile {
  private:
   std::filesystem::path target_;     // the file written: a symbolic link's destination
   std::filesystem::path temporary_;  // empty when writing a device or FIFO directly
-  int slot_ = -1;                    // the temporary's entry in the interrupt cleanup table
+  int descriptor_ = -1;  // an open descriptor of this process the file goes to (/dev/stdout), or -1
+  int slot_ = -1;        // the temporary's entry in the interrupt cleanup table
   std::ofstream stream_;
   bool committed_ = false;
 };
