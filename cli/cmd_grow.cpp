@@ -101,6 +101,7 @@ void registerGrow(CLI::App& app, int& exitCode) {
       std::optional<ShardRange> range;
       if (shard) range = shardRange(shard->index, shard->count, scene.wick->vertexCount());
       GrowResult result = growStage(options->common, config, *scene.wick, stats, range);
+      clock.lap();  // growStage timed the growing itself
       if (!options->diagnostics.empty())
         writeDiagnostics(options->diagnostics, options->setup, config, result);
       writeStrands(options->output, result.guides);

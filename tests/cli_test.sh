@@ -92,7 +92,12 @@ run_equals_stages)
   setup="$src/configs/thesis/coupe2/setup.txt"
   set_density=(--set Hairstyle.HairDensity=15 --set "Render.Resolution=64 64")
   expect_rc 0 "$hairgen" run "$setup" -o "$tmp/run" --quiet "${set_density[@]}"
-  expect_rc 0 "$hairgen" grow "$setup" -o "$tmp/g.hair" --quiet --threads 1 "${set_density[@]}"
+  expect_rc 0 "$hairgen" grow "$setup" -o "$tmp/g.hair" --quiet --threads 1 "${set_density[@]}" \
+    --stats "$tmp/grow.json"
+  # The parts are laps of one clock: together no more than the whole (write once held the grow too).
+  awk -F'[:,]' '/"(read|grow|write)":/ { parts += $2 } /"total":/ { total = $2 }
+    END { exit !(total > 0 && parts <= total * 1.01 + 0.002) }' "$tmp/grow.json" ||
+    fail "grow --stats parts exceed the total: $(cat "$tmp/grow.json")"
   expect_rc 0 "$hairgen" interpolate "$setup" --guides "$tmp/g.hair" -o "$tmp/c.hair" --threads 2 "${set_density[@]}" \
     --stats "$tmp/stats.json"
   cmp "$tmp/run/guides.hair" "$tmp/g.hair" || fail "run's guides differ from grow's"
