@@ -160,6 +160,9 @@ void registerRender(CLI::App& app, int& exitCode) {
           std::cout << d.platform << ": " << (d.opened ? "opens, " + d.name : "does not open: " + d.error)
                     << (d.platform == "device" ? "  [" + d.name + "]" : "") << "\n";
         if (devices.empty()) std::cout << "no EGL platform found\n";
+        // A farm's health check reads the exit code: 3 when nothing here can render.
+        if (std::none_of(devices.begin(), devices.end(), [](const GlDeviceInfo& d) { return d.opened; }))
+          throw DeviceError("no EGL platform opens an OpenGL 4.5 core context (the list above)");
         return;
       }
       const bool fromGuides = !options->guides.empty();
@@ -215,8 +218,9 @@ void registerRender(CLI::App& app, int& exitCode) {
         for (glm::vec3& n : head->normals) n = headConversion.direction(n);
       }
       renderOptions.keepDom = !options->dom.empty();
-      const std::unique_ptr<GlContext> gl =
-          openDevice(options->common, config, stats);  // one for every frame
+      // One context for every frame, opened once the first frame's hair has been read: bad input is
+      // exit 2 on a machine without a device too, not 3.
+      std::unique_ptr<GlContext> gl;
       // Motion vectors of frame f are the movement from frame f - 1 whenever that frame is in the shot
       // (Dynamics Info's Frames; without one, the frames rendered), so a range split across jobs gives
       // the same vectors as one job; the shot's first frame has nothing before it and moves by 0.
@@ -306,6 +310,7 @@ void registerRender(CLI::App& app, int& exitCode) {
         FrameBefore before{hairBefore ? &*hairBefore : nullptr, headBefore ? &*headBefore
                                                                 : head     ? &*head
                                                                            : nullptr};
+        if (!gl) gl = openDevice(options->common, config, stats);
         RenderOutput out = renderStage(options->common, config, *gl, hair,
                                        posedHead ? &*posedHead
                                        : head    ? &*head

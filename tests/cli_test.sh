@@ -141,6 +141,16 @@ render_errors)
   [ ! -e "$tmp/i.exr" ] && [ ! -e "$tmp/i.png" ] || fail "output written after an error"
   expect_rc 0 "$hairgen" render --list-devices
   grep -q "opens" "$tmp/out" || fail "no device opens: $(cat "$tmp/out")"
+  # Without any EGL vendor (glvnd finds none): bad input is still bad input (2), a good coupe cannot be
+  # rendered (3, one line), and --list-devices says so with 3 too.
+  expect_rc 0 "$hairgen" run "$src/configs/thesis/coupe1/setup.txt" -o "$tmp/c1" --no-render -q \
+    --set Hairstyle.HairDensity=5
+  export __EGL_VENDOR_LIBRARY_FILENAMES=/nonexistent/vendor.json
+  expect_rc 2 "$hairgen" render "$src/configs/default/setup.txt" --hair "$tmp/missing.hair" -o "$tmp/i.exr"
+  expect_rc 3 "$hairgen" render "$src/configs/default/setup.txt" --hair "$tmp/c1/coupe.hair" -o "$tmp/i.exr"
+  [ "$(wc -l < "$tmp/err")" -eq 1 ] || fail "the no-device error is not one line: $(cat "$tmp/err")"
+  expect_rc 3 "$hairgen" render --list-devices
+  unset __EGL_VENDOR_LIBRARY_FILENAMES
   ;;
 render_shader_errors)
   # A Setup's HairFrag that does not compile: exit 2 at the file's line, naming the Setup line, and no

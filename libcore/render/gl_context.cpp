@@ -160,7 +160,7 @@ GlContext::GlContext() : state_(std::make_unique<State>()) {
       state_->platform = "device";
       return;
     }
-    tried += "  EGL device (" + ext + "): " + error + "\n";
+    tried += (tried.empty() ? "" : "; ") + ("EGL device (" + ext + "): " + error);
   }
   // 2. Mesa's surfaceless platform.
   {
@@ -171,12 +171,13 @@ GlContext::GlContext() : state_(std::make_unique<State>()) {
       state_->platform = "surfaceless";
       return;
     }
-    tried += "  Mesa surfaceless: " + error + "\n";
+    tried += (tried.empty() ? "" : "; ") + ("Mesa surfaceless: " + error);
   }
-  if (tried.empty()) tried = "  no EGL device and no surfaceless platform\n";
-  throw DeviceError(
-      "no OpenGL 4.5 core context through EGL:\n" + tried +
-      "install Mesa (libegl-mesa0 libgl1-mesa-dri) for software rendering, or a GPU driver with EGL");
+  if (tried.empty()) tried = "no EGL device and no surfaceless platform";
+  // One line, as every error is printed: what each platform answered, then what to install.
+  throw DeviceError("no OpenGL 4.5 core context through EGL (" + tried +
+                    "); install Mesa (libegl-mesa0 libgl1-mesa-dri) for software rendering, or a GPU "
+                    "driver with EGL");
 }
 
 GlContext::~GlContext() {
