@@ -283,6 +283,24 @@ TEST(Config, DigestFollowsValuesNotFormatting) {
   EXPECT_NE(a.digest(), b.digest());
 }
 
+// The farm takes an output for done by its config digest: another wick at the same path must change
+// it, the same wick at another path must not.
+TEST(Config, DigestFollowsTheMeshesContentNotTheirPaths) {
+  test::TempDir dir("config");
+  std::ofstream(dir / "hair.txt") << "HairLengths 0.1\n";
+  std::ofstream(dir / "setup.txt") << "HairstyleInfo hair.txt\nWickModel wick.obj\n";
+  std::ofstream(dir / "moved.txt") << "HairstyleInfo hair.txt\nWickModel elsewhere/wick.obj\n";
+  const std::string triangle = "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n";
+  std::ofstream(dir / "wick.obj") << triangle;
+  std::filesystem::create_directories(dir / "elsewhere");
+  std::ofstream(dir / "elsewhere/wick.obj") << triangle;
+  const Config first = loadConfig(dir / "setup.txt", {}, SetupUse::kGrow);
+  EXPECT_NE(first.canonicalText().find("Input.WickModel "), std::string::npos) << first.canonicalText();
+  EXPECT_EQ(loadConfig(dir / "moved.txt", {}, SetupUse::kGrow).digest(), first.digest());
+  std::ofstream(dir / "wick.obj") << "v 0 0 0\nv 2 0 0\nv 0 1 0\nf 1 2 3\n";
+  EXPECT_NE(loadConfig(dir / "setup.txt", {}, SetupUse::kGrow).digest(), first.digest());
+}
+
 // A key declared once, in a section of its own that only this test knows: the reader, the canonical
 // text behind the digest, --set and the key reference all find it with no other edit.
 struct ProbeSettings {

@@ -952,9 +952,13 @@ Dynamics readDynamics(const ConfigText& text, const std::vector<Override>& overr
 std::string Config::canonicalText() const {
   // Dynamics only when the Setup names a Dynamics Info, so that a still coupe's digest is the one it
   // had before hairgen could simulate.
+  // Then the inputs whose bytes shape the output, by content (inputContent): a line each.
+  std::string inputs;
+  for (const auto& [key, content] : inputContent) inputs += "Input." + key + " " + content + "\n";
   return setupKeys().canonicalText(setup) + hairstyleKeys().canonicalText(hairstyle) +
          collisionKeys().canonicalText(collision) + visualityKeys().canonicalText(visuality) +
-         renderKeys().canonicalText(render) + (dynamics.given ? dynamicsKeys().canonicalText(dynamics) : "");
+         renderKeys().canonicalText(render) + (dynamics.given ? dynamicsKeys().canonicalText(dynamics) : "") +
+         inputs;
 }
 
 }  // namespace hairgen

@@ -268,8 +268,15 @@ struct Config {
   RenderSettings render;
   Dynamics dynamics;
 
+  // The inputs whose bytes shape the output (the meshes, the shaders, a coupe to load, a density
+  // target), each named by its key with a digest of its content (contentDigest), set by loadConfig;
+  // one that could not be read is absent. They enter the digest and the paths do not: the same mesh
+  // moved is the same configuration, another mesh at the same path is not.
+  std::vector<std::pair<std::string, std::string>> inputContent;
+
   // Canonical text of every value that shapes the output (not the paths), one `Section.Key value` a
-  // line; and its 64-bit FNV-1a digest in hex. Two configs with equal digests give equal output.
+  // line, then `Input.Key digest` per input; and its 64-bit FNV-1a digest in hex. Two configs with
+  // equal digests give equal output.
   std::string canonicalText() const;
   std::string digest() const;
 };

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "libcore/util/file_util.h"
 #include "libcore/util/text.h"
 
 namespace hairgen {
@@ -65,6 +66,20 @@ Config loadConfig(const std::filesystem::path& setupFile, const std::vector<Over
   config.render = readRender(text(s.renderInfo, "Render Info"), overrides);
   config.dynamics = readDynamics(text(s.dynamicsInfo, "Dynamics Info"), overrides);
   config.dynamics.given = s.dynamicsInfo.given();
+  // The inputs whose bytes shape the output, each by its content (Config::canonicalText). One that
+  // cannot be read is left out here: the stage that reads it says why.
+  const bool densityTarget = config.dynamics.given && config.dynamics.densityTarget.given();
+  for (auto [ref, key] : {std::pair{&s.wickModel, "WickModel"},
+                          {&s.headModel, "HeadModel"},
+                          {s.load ? &s.loadFile : nullptr, "LoadFile"},
+                          {&s.hairVert, "HairVert"},
+                          {&s.hairFrag, "HairFrag"},
+                          {&s.headVert, "HeadVert"},
+                          {&s.headFrag, "HeadFrag"},
+                          {densityTarget ? &config.dynamics.densityTarget : nullptr, "DensityTarget"}})
+    if (ref && ref->given())
+      if (std::string content = contentDigest(ref->path); !content.empty())
+        config.inputContent.emplace_back(key, std::move(content));
   return config;
 }
 

@@ -5,12 +5,15 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <array>
 #include <atomic>
 #include <cerrno>
+#include <cstdio>
 #include <cstring>
 #include <mutex>
 #include <system_error>
+#include <vector>
 
 #include "libcore/util/error.h"
 #include "libcore/util/resources.h"
@@ -261,6 +264,32 @@ void InputFile::read(void* out, size_t bytes) {
     done += size_t(n);
   }
   position_ += bytes;
+}
+
+std::string contentDigest(const fs::path& path) {
+  constexpr uint64_t kPrime = 0x100000001b3ull;
+  uint64_t lanes[4] = {0xcbf29ce484222325ull, 0x84222325cbf29ce4ull, 0x9ce484222325cbf2ull,
+                       0x2325cbf29ce48422ull};
+  uint64_t size = 0;
+  try {
+    InputFile file(path);
+    size = file.size();
+    std::vector<uint64_t> words(1 << 17);  // 1 MiB a read
+    while (file.remaining() > 0) {
+      const size_t bytes = size_t(std::min<uint64_t>(file.remaining(), words.size() * 8));
+      if (bytes % 8 != 0) words[bytes / 8] = 0;  // the last word's missing bytes are zeros (size mixed in)
+      file.read(words.data(), bytes);
+      const size_t count = (bytes + 7) / 8;
+      for (size_t i = 0; i < count; ++i) lanes[i & 3] = (lanes[i & 3] ^ words[i]) * kPrime;
+    }
+  } catch (const Error&) {
+    return "";
+  }
+  uint64_t hash = size * kPrime;
+  for (uint64_t lane : lanes) hash = (hash ^ lane) * kPrime ^ (hash >> 29);
+  char hex[17];
+  std::snprintf(hex, sizeof hex, "%016llx", static_cast<unsigned long long>(hash));
+  return hex;
 }
 
 std::string readFileText(const fs::path& path) {
