@@ -317,9 +317,11 @@ void registerRender(CLI::App& app, int& exitCode) {
                                                  : nullptr,
                                        frameOptions, stats, options->motion ? &before : nullptr);
         clock.lap();
-        // The image's config digest is that of the camera and light it was rendered with (--frame aims them).
+        // The image's config digest is the Setup's, as `run` and a farm plan write and expect it (an auto
+        // camera is part of the Setup: the same inputs aim it the same way). --frame, which is not,
+        // aims the camera and light itself: then the digest is that of the ones it rendered with.
         Config rendered = config;
-        rendered.render = out.settings;
+        if (options->frame) rendered.render = out.settings;
         writeRenderOutputs(rendered, out, frameFile(options->output, f), frameFile(options->dom, f),
                            frameFile(options->preview, f));
         stats.add("write", clock.lap());

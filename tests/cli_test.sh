@@ -105,6 +105,12 @@ run_equals_stages)
   grep -q '"strands"' "$tmp/stats.json" || fail "no strand count in --stats"
   expect_rc 0 "$hairgen" render "$setup" --hair "$tmp/c.hair" -o "$tmp/beauty.exr" --quiet "${set_density[@]}"
   cmp "$tmp/run/beauty.exr" "$tmp/beauty.exr" || fail "run's image differs from render's"
+  # With the camera aimed by the stage (auto, as a real head's Setup leaves it), the same bytes too: the
+  # EXR carries the Setup's digest, which a farm plan checks to take the render task for done.
+  expect_rc 0 "$hairgen" run "$setup" -o "$tmp/auto" --quiet "${set_density[@]}" --set Render.CameraPosition=auto
+  expect_rc 0 "$hairgen" render "$setup" --hair "$tmp/auto/coupe.hair" -o "$tmp/auto.exr" --quiet \
+    "${set_density[@]}" --set Render.CameraPosition=auto
+  cmp "$tmp/auto/beauty.exr" "$tmp/auto.exr" || fail "with an auto camera, run's image differs from render's"
   # Load and Save: render a saved coupe without growing it.
   printf 'Load true\nLoadFile %s\nSave true\nSaveFile saved.hair\nHeadModel %s\n' "$tmp/c.hair" \
     "$src/configs/assets/head.obj" > "$tmp/load.txt"
