@@ -16,7 +16,9 @@ void registerInfo(CLI::App& app, int& exitCode) {
   };
   auto options = std::make_shared<Options>();
   CLI::App* cmd = app.add_subcommand(
-      "info", "Describe a .hair, .gltf, .glb or .obj file: counts, bounds, attributes, provenance");
+      "info",
+      "Describe a .hair, .gltf, .glb, .ply, .data, .usda, .obj or .exr file: counts, bounds, "
+      "attributes, provenance");
   cmd->add_option("FILE", options->file, "The file to describe")->required();
   cmd->add_flag("--json", options->json, "Print the description as JSON");
   addCommonFlags(*cmd, options->common, false);

@@ -1,11 +1,15 @@
 // hairgen: grows, styles, caches and renders hair. This file only parses the command line and hands
 // over to one command; everything else lives in libcore/ and stages/.
+#include <algorithm>
 #include <iostream>
+#include <string>
+#include <vector>
 
 #include <CLI/CLI.hpp>
 
 #include "cli/commands.h"
 #include "cli/common.h"
+#include "libcore/util/text.h"
 
 int main(int argc, char** argv) {
   using namespace hairgen::cli;
@@ -35,6 +39,22 @@ int main(int argc, char** argv) {
   registerCheck(app, exitCode);
   registerAssets(app, exitCode);
 
+  // A first word that is no command (a typo): named, with the nearest command, rather than CLI11's
+  // "A subcommand is required".
+  if (argc > 1 && argv[1][0] != '-') {
+    std::vector<std::string> names;
+    for (const CLI::App* sub : app.get_subcommands([](const CLI::App*) { return true; }))
+      names.push_back(sub->get_name());
+    if (std::find(names.begin(), names.end(), argv[1]) == names.end()) {
+      const std::string close = hairgen::closestMatch(argv[1], names);
+      std::string all;
+      for (const std::string& n : names) all += (all.empty() ? "" : ", ") + n;
+      std::cerr << "hairgen: error: unknown command '" << argv[1] << "'"
+                << (close.empty() ? "; the commands are " + all : "; did you mean '" + close + "'?") << "\n"
+                << "Run 'hairgen --help' for usage.\n";
+      return 2;
+    }
+  }
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {

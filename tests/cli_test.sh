@@ -35,6 +35,11 @@ help)
 usage)
   expect_rc 2 "$hairgen"
   expect_rc 2 "$hairgen" frobnicate
+  expect_err "unknown command 'frobnicate'; the commands are run, grow,"
+  expect_rc 2 "$hairgen" gorw setup.txt -o g.hair
+  expect_err "unknown command 'gorw'; did you mean 'grow'?"
+  expect_rc 2 "$hairgen" info "$tmp/x.foo"
+  expect_err "info reads .hair, .gltf, .glb, .ply, .data, .usda, .obj and .exr"
   expect_rc 2 "$hairgen" info
   expect_rc 2 "$hairgen" convert a.hair
   expect_rc 2 "$hairgen" info "$tmp/missing.hair"

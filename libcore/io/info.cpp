@@ -136,7 +136,14 @@ nlohmann::ordered_json describeFile(const std::filesystem::path& file) {
     for (const auto& [name, value] : header.attributes) j["metadata"][name] = value;
     return j;
   }
-  const HairFormat format = hairFormatOf(file);
+  HairFormat format;
+  try {
+    format = hairFormatOf(file);
+  } catch (const InputError&) {  // info reads meshes and images too: name them with the hair formats
+    throw InputError({file.string(), 0}, "unknown file extension '" + file.extension().string() +
+                                             "'; info reads .hair, .gltf, .glb, .ply, .data, .usda, .obj "
+                                             "and .exr");
+  }
   Strands s;
   nlohmann::ordered_json details = nlohmann::ordered_json::object();
   switch (format) {
