@@ -334,9 +334,14 @@ void registerRender(CLI::App& app, int& exitCode) {
       }
       progress.finish();
       passes.finish();
-      note(options->common,
-           "render: wrote " + frameFile(options->output, frames.last) +
-               (options->preview.empty() ? "" : " and " + frameFile(options->preview, frames.last)));
+      // A sequence names its first and last frames' files, as run does.
+      auto written = [&](const std::string& files) {
+        return sequence && frames.last > frames.first
+                   ? frameFile(files, frames.first) + " to " + frameFile(files, frames.last)
+                   : frameFile(files, frames.last);
+      };
+      note(options->common, "render: wrote " + written(options->output) +
+                                (options->preview.empty() ? "" : " and " + written(options->preview)));
       stats.write(options->common);
     });
   });

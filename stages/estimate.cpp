@@ -175,6 +175,11 @@ WorkEstimate estimateRender(const RenderSettings& r, size_t strands, size_t poin
   const double fragments = double(strands) * lengthPx * widthPx + fine;
   e.seconds = 3.0 * double(points) * kSecondsPerVertex + fragments * kSecondsPerFragment;
   e.timeKey = widthPx > 4.0 * block ? "Render.StrandWidth" : "Render.Resolution or Render.Samples";
+  // Strands metres long are a file in other units (a groom in centimetres read as metres): say so, since
+  // no render setting is what is wrong.
+  if (hairLength > 3.0)
+    e.timeKey = "the hair's units: its strands are " + formatReal(std::round(hairLength * 10.0) / 10.0) +
+                " m long (render --units cm or mm, or --frame to fit it in the view)";
   e.detail = std::to_string(r.resolution.x) + "x" + std::to_string(r.resolution.y) + " pixels at " +
              std::to_string(block * block) + " samples, " + std::to_string(strands) + " strands";
   return e;

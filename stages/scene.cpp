@@ -87,12 +87,13 @@ std::vector<SceneFinding> checkScene(const Config& config, const Mesh& wick, con
     if (a > kMaxWickArea) {
       std::string why = suggestion(a, 0.015, kMaxWickArea, 2);
       out.push_back({true, "the wick " + wickName + " has " + area(a) + " of surface: " +
-                               (why.empty() ? "it is not a scalp (a scalp has 200-600 cm²); check MeshUnits, "
-                                              "or lower HairDensity"
+                               (why.empty() ? "more than a whole head (a scalp has 200-600 cm², a head "
+                                              "up to 0.6 m²); check MeshUnits"
                                             : why)});
     } else if (a < kMinWickArea) {
       out.push_back({false, "the wick " + wickName + " has only " + area(a) +
-                                " of surface, less than a scalp (200-600 cm²); check MeshUnits"});
+                                " of surface, less than the 20 cm² of a small patch of scalp (a whole "
+                                "scalp has 200-600 cm²); check MeshUnits"});
     }
   } else if (diagonal > kMaxWickSpan) {
     std::string why = suggestion(diagonal, kMinWickSpan * 2, kMaxWickSpan, 1);

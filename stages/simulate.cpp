@@ -105,8 +105,9 @@ void run(Hair& hair, double gravity, const Strands& restGuides, const Config& co
     if (!before)
       throw InputError("frame " + std::to_string(frames.first) + " follows the shot's first frame " +
                        std::to_string(d.firstFrame) + ": simulate resumes from frame " +
-                       std::to_string(frames.first - 1) +
-                       "'s cache, which is not there; simulate that frame first");
+                       std::to_string(frames.first - 1) + "'s cache" +
+                       (options.restartName.empty() ? "" : " (" + options.restartName + ")") +
+                       ", which is not there; simulate that frame first");
     if (before->provenance.stage != "simulate" || !before->provenance.frame ||
         *before->provenance.frame != frames.first - 1 || before->simulationState.empty())
       throw InputError(where, "is not frame " + std::to_string(frames.first - 1) +

@@ -267,7 +267,11 @@ nlohmann::ordered_json describeSetup(const std::string& setupName, const Config&
   report["digest"] = config.digest();
   report["load"] = config.setup.load;
   report["collisionShapes"] = config.collision.shapes.size();
-  report["superHelixElements"] = config.hairstyle.hairLengths.size();
+  report["model"] = name(config.hairstyle.model);
+  if (config.hairstyle.model == StylingModel::kCantilever)
+    report["cantileverSegments"] = config.hairstyle.segments;
+  else
+    report["superHelixElements"] = config.hairstyle.hairLengths.size();
   report["hairLength"] = config.hairstyle.totalLength();
   for (auto [ref, key, given] : {std::tuple{&config.setup.wickModel, "wick", wick},
                                  std::tuple{&config.setup.headModel, "head", head}}) {
@@ -287,8 +291,12 @@ std::string formatSetupReport(const nlohmann::ordered_json& report) {
   std::ostringstream out;
   out << report["setup"].get<std::string>() << ": ok, config digest " << report["digest"].get<std::string>()
       << "\n";
-  out << "  " << report["superHelixElements"] << " Super-Helix elements, hair length "
-      << report["hairLength"].get<double>() << " m, " << report["collisionShapes"] << " collision shapes\n";
+  if (report.contains("cantileverSegments"))
+    out << "  Anjyo's cantilever (Model cantilever), " << report["cantileverSegments"] << " segments";
+  else
+    out << "  " << report["superHelixElements"] << " Super-Helix elements";
+  out << ", hair length " << report["hairLength"].get<double>() << " m, " << report["collisionShapes"]
+      << " collision shapes\n";
   for (const char* key : {"wick", "head"})
     if (report.contains(key))
       out << "  " << key << " " << report[key]["file"].get<std::string>() << ": " << report[key]["vertices"]
