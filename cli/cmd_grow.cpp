@@ -93,6 +93,8 @@ void registerGrow(CLI::App& app, int& exitCode) {
     exitCode = runCommand("grow", options->common, [&] {
       Stats stats("grow");
       const HairFormat format = hairFormatOf(options->output);
+      requireWritableOutput(options->output);
+      if (!options->diagnostics.empty()) requireWritableOutput(options->diagnostics);
       const std::optional<ShardSpec> shard = shardOption(options->shard, options->output, format);
       Stopwatch clock;
       Config config = loadStageConfig(options->setup, options->common, SetupUse::kGrow, stats);

@@ -5,6 +5,7 @@
 #include "libcore/io/hair_cache.h"
 #include "libcore/io/obj_io.h"
 #include "libcore/model/shards.h"
+#include "libcore/util/file_util.h"
 #include "libcore/util/frames.h"
 #include "libcore/util/text.h"
 #include "stages/interpolate.h"
@@ -49,6 +50,7 @@ void registerInterpolate(CLI::App& app, int& exitCode) {
     exitCode = runCommand("interpolate", options->common, [&] {
       Stats stats("interpolate");
       const HairFormat format = hairFormatOf(options->output);
+      if (!isFramePattern(options->output)) requireWritableOutput(options->output);
       const std::optional<ShardSpec> shard = shardOption(options->shard, options->output, format);
       Stopwatch clock;
       Config config = loadStageConfig(options->setup, options->common, SetupUse::kInterpolate, stats);

@@ -10,6 +10,7 @@
 #include "libcore/io/obj_io.h"
 #include "libcore/render/gl_context.h"
 #include "libcore/util/error.h"
+#include "libcore/util/file_util.h"
 #include "libcore/util/frames.h"
 #include "libcore/util/progress.h"
 #include "libcore/util/text.h"
@@ -169,6 +170,8 @@ void registerRender(CLI::App& app, int& exitCode) {
       if (options->setup.empty() || (options->hair.empty() && !fromGuides) || options->output.empty())
         throw InputError("render needs SETUP, --hair FILE and -o IMAGE.exr (or --list-devices)");
       requireExtension(options->output, ".exr", "-o");
+      for (const std::string* file : {&options->output, &options->dom, &options->preview})
+        if (!file->empty() && !isFramePattern(*file)) requireWritableOutput(*file);
       if (!options->dom.empty()) requireExtension(options->dom, ".exr", "--dom");
       if (!options->preview.empty()) requireExtension(options->preview, ".png", "--preview");
       Stats stats("render");

@@ -15,6 +15,7 @@
 #include "libcore/io/obj_io.h"
 #include "libcore/physics/head_motion.h"
 #include "libcore/util/error.h"
+#include "libcore/util/file_util.h"
 #include "libcore/util/frames.h"
 #include "libcore/util/progress.h"
 #include "libcore/util/text.h"
@@ -166,6 +167,8 @@ void registerRun(CLI::App& app, int& exitCode) {
         if (fs::exists(out) && !fs::is_directory(out)) throw InputError(why);
         throw IoError(why);
       }
+      // The first file it writes, before minutes of growing: a folder it cannot write in is found now.
+      requireWritableOutput(out / "guides.hair");
 
       Strands coupe;
       Mesh wick;

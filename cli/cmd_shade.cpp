@@ -10,6 +10,7 @@
 #include "libcore/config/setup.h"
 #include "libcore/io/hair_cache.h"
 #include "libcore/io/vdb_io.h"
+#include "libcore/util/file_util.h"
 #include "libcore/util/frames.h"
 #include "libcore/util/progress.h"
 #include "libcore/util/text.h"
@@ -80,6 +81,7 @@ void registerShade(CLI::App& app, int& exitCode) {
     exitCode = runCommand("shade", options->common, [&] {
       Stats stats("shade");
       hairFormatOf(options->output);
+      if (!isFramePattern(options->output)) requireWritableOutput(options->output);
       Stopwatch clock;
       if (!options->rest.empty()) {
         if (!options->vdb.empty()) throw InputError("--vdb needs a volume, which --rest does not build");

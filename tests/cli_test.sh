@@ -398,11 +398,22 @@ hardening_outputs)
   grep -q "/dev/full: write failed" "$tmp/err" || fail "full: $(cat "$tmp/err")"
   expect_rc 0 "$hairgen" check "$src/configs/default/setup.txt" -q --stats /dev/stdout
   grep -q '"command": "check"' "$tmp/out" || fail "--stats /dev/stdout wrote nothing"
+  # With stdout appended to a farm log, the log keeps its lines before and after the stats.
+  { echo "before"; "$hairgen" check "$src/configs/default/setup.txt" -q --stats /dev/stdout; echo "after"; } >> "$tmp/farm.log"
+  [ "$(head -1 "$tmp/farm.log")" = before ] && [ "$(tail -1 "$tmp/farm.log")" = after ] &&
+    grep -q '"command": "check"' "$tmp/farm.log" || fail "--stats /dev/stdout >> log: $(cat "$tmp/farm.log")"
   # A command that fails removes what it wrote: grow's diagnostics when the guides cannot be written,
   # render's EXR when its preview cannot.
   mkdir "$tmp/taken.hair" "$tmp/taken.png"
   expect_rc 2 "$hairgen" grow "$src/configs/thesis/coupe1/setup.txt" -o "$tmp/taken.hair" --diagnostics "$tmp/d.json" -q
   [ ! -e "$tmp/d.json" ] || fail "a failed grow left its diagnostics"
+  # Found before the work: a directory named as the output, a file named as its folder.
+  expect_rc 2 "$hairgen" grow "$src/configs/default/setup.txt" -o "$tmp/taken.hair"
+  expect_err "taken.hair: is a directory; name a file to write"
+  grep -q "guides" "$tmp/err" && fail "grew before finding the output is a directory: $(cat "$tmp/err")"
+  : > "$tmp/a-file"
+  expect_rc 2 "$hairgen" grow "$src/configs/default/setup.txt" -o "$tmp/a-file/g.hair"
+  expect_err "a-file: is not a folder"
   expect_rc 2 "$hairgen" render "$src/configs/thesis/coupe3/setup.txt" --hair "$src/golden/fixtures/coupe3-shaded.hair" \
     -o "$tmp/i.exr" --preview "$tmp/taken.png" --set "Render.Resolution=32 32" -q
   [ ! -e "$tmp/i.exr" ] || fail "a failed render left its EXR"

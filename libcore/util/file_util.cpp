@@ -266,6 +266,22 @@ void InputFile::read(void* out, size_t bytes) {
   position_ += bytes;
 }
 
+void requireWritableOutput(const fs::path& target) {
+  const Destination destination = destinationOf(target);  // a directory is refused here
+  if (destination.direct) return;
+  // The nearest folder that exists on the way to the file's: the one a write creates folders in.
+  fs::path folder = destination.path.parent_path();
+  if (folder.empty()) folder = ".";
+  std::error_code ec;
+  while (!fs::exists(folder, ec) && folder.has_parent_path() && folder.parent_path() != folder)
+    folder = folder.parent_path();
+  if (fs::exists(folder, ec) && !fs::is_directory(folder, ec))
+    throw InputError({folder.string(), 0}, "is not a folder, so " + target.string() + " cannot be written");
+  if (::access(folder.c_str(), W_OK | X_OK) != 0)
+    throw IoError({target.string(), 0},
+                  std::string("cannot write in ") + folder.string() + ": " + std::strerror(errno));
+}
+
 std::string contentDigest(const fs::path& path) {
   constexpr uint64_t kPrime = 0x100000001b3ull;
   uint64_t lanes[4] = {0xcbf29ce484222325ull, 0x84222325cbf29ce4ull, 0x9ce484222325cbf2ull,

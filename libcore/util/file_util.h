@@ -55,6 +55,12 @@ class InputFile {
 // machine.
 std::string contentDigest(const std::filesystem::path& path);
 
+// Before the work: whether an output could be written where it is named. A directory there is an
+// InputError (exit 2); a folder this process cannot write into (nor create, for one that does not exist
+// yet) an IoError (exit 1), as the write itself would be, minutes later. Devices, FIFOs and the
+// command's own descriptors pass.
+void requireWritableOutput(const std::filesystem::path& target);
+
 // For inputs a library opens by name: an InputError unless `path` is a regular file.
 void requireRegularFile(const std::filesystem::path& path);
 
