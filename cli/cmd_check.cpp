@@ -51,6 +51,14 @@ void registerCheck(CLI::App& app, int& exitCode) {
         report["meshConversion"] = config.setup.meshConversion.describe();
       const std::vector<std::string> fitted = fittedShapeLines(config.collision);
       if (!fitted.empty()) report["fittedShapes"] = fitted;
+      // Roots alone grow guides, but interpolate (and run) need a surface: what run refuses, said here.
+      if (scene.wick && !config.setup.load && scene.wick->triangles.empty()) {
+        const std::string why =
+            "the wick has no faces, only points (roots): grow grows guides on them, but "
+            "interpolate and run need a surface (a scalp mesh) and refuse it";
+        report["warnings"].push_back(why);
+        note(options->common, "warning: " + why);
+      }
       if (scene.wick && !config.setup.load) {
         nlohmann::ordered_json work = nlohmann::ordered_json::array();
         for (const WorkEstimate& e :

@@ -129,12 +129,36 @@ std::vector<SceneFinding> checkScene(const Config& config, const Mesh& wick, con
   }
   const size_t penalising = std::count_if(config.collision.shapes.begin(), config.collision.shapes.end(),
                                           [](const CollisionShape& s) { return s.penalty > 0.0; });
+  const bool fitted = std::any_of(config.collision.shapes.begin(), config.collision.shapes.end(),
+                                  [](const CollisionShape& s) { return s.fitted; });
   if (penalising > 0 && touching * 2 < wick.positions.size())
     out.push_back({false, "most of the wick lies more than 3 cm outside every collision shape (" +
                               std::to_string(wick.positions.size() - touching) + " of " +
-                              std::to_string(wick.positions.size()) +
-                              " follicles): the shapes fit another head; use Ellipsoid VOLUME PENALTY auto"});
+                              std::to_string(wick.positions.size()) + " follicles): " +
+                              (fitted ? "the shapes fitted to the head's cranium do not reach it; check "
+                                        "WickGroup (the scalp's faces) and HeadModel"
+                                      : "the shapes fit another head; use Ellipsoid VOLUME PENALTY auto")});
   (void)near;
+  // Follicles lean away from RootFlow's point: one far from this head (the bundled head's crown, in a
+  // Hairstyle Info made for it) leans them all one way.
+  const Hairstyle& style = config.hairstyle;
+  if (style.rootTilt > 0.0 && style.rootFlow.kind == RootFlow::Kind::kAwayFrom &&
+      glm::length(style.rootFlow.value - centre) > std::max(diagonal, 0.05)) {
+    glm::dvec3 suggested = centre;
+    for (const CollisionShape& s : config.collision.shapes)
+      if (s.kind != ShapeKind::kCuboid) {
+        suggested = s.centre;
+        break;
+      }
+    auto point = [](const glm::dvec3& p) {
+      auto r = [](double v) { return formatReal(std::round(v * 1000.0) / 1000.0); };
+      return r(p.x) + " " + r(p.y) + " " + r(p.z);
+    };
+    out.push_back({false, "RootFlow's point (" + point(style.rootFlow.value) + ") lies " +
+                              formatReal(std::round(glm::length(style.rootFlow.value - centre) * 100) / 100) +
+                              " m from the wick's centre, so every follicle leans one way; for this head, " +
+                              "RootFlow away-from " + point(suggested)});
+  }
   // The camera: does it see the wick?
   if (!config.render.cameraAuto) {
     const glm::dvec3 view = glm::normalize(config.render.cameraTarget - config.render.cameraPosition);

@@ -371,6 +371,14 @@ real_hairutil)
 wick_info)
   expect_rc 0 "$hairgen" info "$src/configs/assets/wick.obj"
   grep -q "759 vertices, 1443 triangles, area" "$tmp/out" || fail "wick info: $(cat "$tmp/out")"
+  # Roots alone, as grow takes them: described, and check says that run cannot interpolate over them.
+  printf 'v 0 0.2 0\nv 0.01 0.2 0\nv 0 0.2 0.01\n' > "$tmp/roots.obj"
+  expect_rc 0 "$hairgen" info "$tmp/roots.obj"
+  grep -q "3 vertices, 0 triangles" "$tmp/out" || fail "roots info: $(cat "$tmp/out")"
+  printf 'HairLengths 0.05\n' > "$tmp/h.txt"
+  printf 'HairstyleInfo h.txt\nWickModel roots.obj\n' > "$tmp/setup.txt"
+  expect_rc 0 "$hairgen" check "$tmp/setup.txt"
+  expect_err "the wick has no faces, only points (roots)"
   ;;
 hardening_flags)
   # Flags are validated like config values: no sign wrapping, no NaN passing a range.

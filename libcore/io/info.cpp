@@ -104,7 +104,10 @@ nlohmann::ordered_json describeFile(const std::filesystem::path& file) {
   j["file"] = file.string();
   if (ext == ".obj") {
     MeshReadStats stats;
-    Mesh mesh = readObj(file, &stats);
+    // Roots alone (a wick of points, as grow takes one) are described too.
+    MeshReadOptions options;
+    options.allowPoints = true;
+    Mesh mesh = readObj(file, options, &stats);
     j["format"] = "obj";
     j["vertices"] = mesh.vertexCount();
     j["triangles"] = mesh.triangleCount();
@@ -113,12 +116,13 @@ nlohmann::ordered_json describeFile(const std::filesystem::path& file) {
     double edge = 0.0;
     for (const glm::uvec3& t : mesh.triangles)
       for (int c = 0; c < 3; ++c) edge += glm::length(mesh.positions[t[c]] - mesh.positions[t[(c + 1) % 3]]);
-    j["meanEdgeLength"] = edge / (3.0 * double(mesh.triangleCount()));
+    j["meanEdgeLength"] = mesh.triangles.empty() ? 0.0 : edge / (3.0 * double(mesh.triangleCount()));
     j["bounds"] = boundsJson(mesh.positions);
     j["uvs"] = !mesh.uvs.empty();
     j["normals"] = stats.normalsFromFile
                        ? (stats.normalsReindexed ? "from file, averaged per position" : "from file")
-                       : "computed (area-weighted)";
+                   : mesh.triangles.empty() ? "computed (away from the points' fitted sphere: no faces)"
+                                            : "computed (area-weighted)";
     j["polygonsTriangulated"] = stats.polygonsTriangulated;
     j["degenerateFacesDropped"] = stats.degenerateDropped;
     j["unreferencedVerticesDropped"] = stats.unreferencedDropped;
