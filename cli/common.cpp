@@ -112,10 +112,11 @@ int runCommand(const std::string& command, const CommonOptions& options, const s
   installInterruptCleanup();
   forgetCommittedOutputs();
   gFailedStats = nullptr;
+  bool statsWritable = true;  // false when --stats names a place nothing can be written: no second error
   auto failed = [&](const std::string& message, ExitCode code) {
     discardCommittedOutputs();  // a failed command leaves none of its outputs
     std::cerr << "hairgen " << command << ": error: " << oneLine(message) << "\n";
-    if (!options.statsFile.empty()) {
+    if (!options.statsFile.empty() && statsWritable) {
       // A farm script reads why, even from a command that failed before it gathered anything.
       nlohmann::ordered_json stats =
           gFailedStats.is_object() ? gFailedStats : nlohmann::ordered_json::object();
@@ -139,6 +140,17 @@ int runCommand(const std::string& command, const CommonOptions& options, const s
     int threads = options.threads > 0 ? options.threads : static_cast<int>(tbb::info::default_concurrency());
     tbb::global_control limit(tbb::global_control::max_allowed_parallelism, static_cast<size_t>(threads));
     setExrThreads(threads);
+    if (!options.statsFile.empty()) {  // before the work, as the outputs are
+      try {
+        requireWritableOutput(options.statsFile);
+      } catch (const InputError& e) {
+        statsWritable = false;
+        throw InputError(std::string("--stats: ") + e.what());
+      } catch (const IoError& e) {
+        statsWritable = false;
+        throw IoError(std::string("--stats: ") + e.what());
+      }
+    }
     body();
     forgetCommittedOutputs();
     return static_cast<int>(ExitCode::kSuccess);

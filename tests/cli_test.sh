@@ -402,6 +402,8 @@ hardening_outputs)
     expect_rc 0 "$hairgen" check "$src/configs/default/setup.txt" -q --stats /dev/null
     [ -c /dev/null ] || fail "/dev/null is no longer a device"
   fi
+  expect_rc 2 "$hairgen" convert "$src/golden/fixtures/coupe3-shaded.hair" "$tmp/c.ply" --stats "$tmp"
+  [ "$(wc -l < "$tmp/err")" -eq 1 ] && [ ! -e "$tmp/c.ply" ] || fail "--stats DIR: $(cat "$tmp/err")"
   expect_rc 1 "$hairgen" check "$src/configs/default/setup.txt" -q --stats /dev/full
   grep -q "/dev/full: write failed" "$tmp/err" || fail "full: $(cat "$tmp/err")"
   expect_rc 0 "$hairgen" check "$src/configs/default/setup.txt" -q --stats /dev/stdout
