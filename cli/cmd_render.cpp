@@ -219,6 +219,9 @@ void registerRender(CLI::App& app, int& exitCode) {
         if (renderOptions.zUp) headConversion.upAxis = UpAxis::kZ;
         for (glm::vec3& p : head->positions) p = headConversion.position(p);
         for (glm::vec3& n : head->normals) n = headConversion.direction(n);
+        note(options->common, "render: the head " + s.headModel.path.filename().string() +
+                                  " is read in the hair's units and axis too; to read it as it is, set "
+                                  "Setup.MeshUnits (and MeshUpAxis) for it");
       }
       renderOptions.keepDom = !options->dom.empty();
       // One context for every frame, opened once the first frame's hair has been read: bad input is
