@@ -73,6 +73,7 @@ void registerInterpolate(CLI::App& app, int& exitCode) {
       for (const std::string* pattern : {&options->guides, &options->output})
         if (!isFramePattern(*pattern))
           throw InputError(*pattern + ": with --frames, write #### where the frame number goes");
+      requireWritableOutput(framePath(options->output, frames.first));
       const HeadMotion head = headMotionOf(config);
       Progress progress("interpolate", "frames", size_t(frames.count()), !options->common.quiet);
       // Every frame has the same strands: each is written over the last one's arrays.

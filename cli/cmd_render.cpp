@@ -190,6 +190,9 @@ void registerRender(CLI::App& app, int& exitCode) {
       auto frameFile = [&](const std::string& pattern, int f) {
         return sequence && !pattern.empty() ? framePath(pattern, f).string() : pattern;
       };
+      if (sequence)
+        for (const std::string* file : {&options->output, &options->dom, &options->preview})
+          if (!file->empty()) requireWritableOutput(frameFile(*file, frames.first));
       Scene scene = readScene(options->common, config, fromGuides, true, stats);
       std::optional<Mesh> head = std::move(scene.head);
       const HeadMotion motion = headMotionOf(config);

@@ -99,6 +99,7 @@ void registerShade(CLI::App& app, int& exitCode) {
           for (const std::string* pattern : {&coupeFile, static_cast<const std::string*>(&options->output)})
             if (!isFramePattern(*pattern))
               throw InputError(*pattern + ": with --frames, write #### where the frame number goes");
+        if (sequence) requireWritableOutput(framePath(options->output, frames.first));
         Progress progress("shade", "frames", size_t(frames.count()), sequence && !options->common.quiet);
         for (int f = frames.first; f <= frames.last; ++f) {
           const std::string in = sequence ? framePath(coupeFile, f).string() : coupeFile;

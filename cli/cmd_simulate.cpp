@@ -4,6 +4,7 @@
 #include "cli/commands.h"
 #include "cli/common.h"
 #include "libcore/io/hair_cache.h"
+#include "libcore/util/file_util.h"
 #include "libcore/util/frames.h"
 #include "libcore/util/progress.h"
 #include "libcore/util/text.h"
@@ -46,6 +47,7 @@ void registerSimulate(CLI::App& app, int& exitCode) {
       const Dynamics& d = config.dynamics;
       const FrameRange frames = options->frames.empty() ? FrameRange{d.firstFrame, d.lastFrame}
                                                         : parseFrameRange(options->frames, "--frames");
+      requireWritableOutput(framePath(options->output, frames.first));
       const Strands rest = readStrands(options->guides);
       std::optional<Strands> restart;
       std::string restartName;

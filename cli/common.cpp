@@ -73,6 +73,7 @@ std::vector<Override> parseOverrides(const CommonOptions& options) {
 namespace {
 // What the Stats of a failing command had gathered when it was unwound, for runCommand.
 nlohmann::ordered_json gFailedStats;
+bool gStatsWriteFailed = false;  // Stats::write failed: the failure does not write --stats again
 }  // namespace
 
 Stats::~Stats() {
@@ -105,7 +106,13 @@ void Stats::write(const CommonOptions& options) {
   json_["outputs"] = outputs;
   json_["peakMemoryBytes"] = peakResidentBytes();
   json_["exitCode"] = 0;
-  if (!options.statsFile.empty()) writeFileAtomic(options.statsFile, jsonText(json_) + "\n");
+  if (options.statsFile.empty()) return;
+  try {
+    writeFileAtomic(options.statsFile, jsonText(json_) + "\n");
+  } catch (...) {
+    gStatsWriteFailed = true;  // the command fails, and does not try the same place again
+    throw;
+  }
 }
 
 int runCommand(const std::string& command, const CommonOptions& options, const std::function<void()>& body) {
@@ -113,10 +120,11 @@ int runCommand(const std::string& command, const CommonOptions& options, const s
   forgetCommittedOutputs();
   gFailedStats = nullptr;
   bool statsWritable = true;  // false when --stats names a place nothing can be written: no second error
+  gStatsWriteFailed = false;
   auto failed = [&](const std::string& message, ExitCode code) {
     discardCommittedOutputs();  // a failed command leaves none of its outputs
     std::cerr << "hairgen " << command << ": error: " << oneLine(message) << "\n";
-    if (!options.statsFile.empty() && statsWritable) {
+    if (!options.statsFile.empty() && statsWritable && !gStatsWriteFailed) {
       // A farm script reads why, even from a command that failed before it gathered anything.
       nlohmann::ordered_json stats =
           gFailedStats.is_object() ? gFailedStats : nlohmann::ordered_json::object();

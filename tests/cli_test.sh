@@ -379,6 +379,13 @@ wick_info)
   printf 'HairstyleInfo h.txt\nWickModel roots.obj\n' > "$tmp/setup.txt"
   expect_rc 0 "$hairgen" check "$tmp/setup.txt"
   expect_err "the wick has no faces, only points (roots)"
+  # RootFlow's point far from this wick (a Hairstyle Info made for another head): said, with a centre.
+  printf 'HairLengths 0.05\nRootTilt 30\nRootFlow away-from 0 2 0\n' > "$tmp/h.txt"
+  printf 'HairstyleInfo h.txt\nWickModel %s\n' "$src/configs/assets/wick.obj" > "$tmp/setup.txt"
+  expect_rc 0 "$hairgen" check "$tmp/setup.txt"
+  expect_err "RootFlow's point (0 2 0) lies"
+  expect_rc 0 "$hairgen" check "$src/configs/default/setup.txt"
+  grep -q "RootFlow" "$tmp/err" && fail "the default coupe's RootFlow was warned of: $(cat "$tmp/err")"
   ;;
 hardening_flags)
   # Flags are validated like config values: no sign wrapping, no NaN passing a range.
@@ -421,6 +428,19 @@ hardening_outputs)
   expect_rc 2 "$hairgen" grow "$src/configs/default/setup.txt" -o "$tmp/taken.hair"
   expect_err "taken.hair: is a directory; name a file to write"
   grep -q "guides" "$tmp/err" && fail "grew before finding the output is a directory: $(cat "$tmp/err")"
+  # A relative name in folders that do not exist yet: they are made.
+  (cd "$tmp" && "$hairgen" grow "$src/configs/thesis/coupe1/setup.txt" -o new/deeper/g.hair -q) ||
+    fail "grow -o new/deeper/g.hair (relative, folders to make) failed"
+  [ -s "$tmp/new/deeper/g.hair" ] || fail "no guides in the new folders"
+  # A descriptor that is not open, or open for reading only, is refused before the work, in one line.
+  expect_rc 2 "$hairgen" check "$src/configs/default/setup.txt" -q --stats /dev/fd/57
+  [ "$(wc -l < "$tmp/err")" -eq 1 ] || fail "closed descriptor: $(cat "$tmp/err")"
+  expect_rc 2 "$hairgen" check "$src/configs/default/setup.txt" -q --stats /dev/fd/0 < /dev/null
+  expect_err "open for reading only"
+  # --stats /dev/stdout after the report the command prints, not before it.
+  "$hairgen" check "$src/configs/default/setup.txt" --stats /dev/stdout > "$tmp/report.txt" 2>/dev/null
+  [ "$(head -c 1 "$tmp/report.txt")" != "{" ] && [ "$(tail -1 "$tmp/report.txt")" = "}" ] ||
+    fail "--stats /dev/stdout came before the report: $(head -3 "$tmp/report.txt")"
   : > "$tmp/a-file"
   expect_rc 2 "$hairgen" grow "$src/configs/default/setup.txt" -o "$tmp/a-file/g.hair"
   expect_err "a-file: is not a folder"
@@ -671,6 +691,17 @@ farm_plan)
   expect_rc 2 "$hairgen" farm submit "$src/tests/cli_test.sh" --scheduler slurm --dry-run
   grep -q "is not a hairgen farm plan" "$tmp/err" || fail "not a plan: $(cat "$tmp/err")"
   expect_rc 2 "$hairgen" farm submit "$plan" --scheduler pbs --dry-run
+  # A mesh edited after the plan: its tasks' outputs could never carry the plan's digest, so submitting
+  # it is refused until it is planned again.
+  mkdir "$tmp/edit"
+  cp "$src/configs/assets/wick.obj" "$tmp/edit/wick.obj"
+  printf 'HairLengths 0.05\nHairDensity 5\n' > "$tmp/edit/h.txt"
+  printf 'HairstyleInfo h.txt\nWickModel wick.obj\n' > "$tmp/edit/setup.txt"
+  expect_rc 0 "$hairgen" farm plan "$tmp/edit/setup.txt" -o "$tmp/edit/plan" --shards 1 --quiet
+  expect_rc 0 "$hairgen" farm submit "$tmp/edit/plan/plan.json" --scheduler slurm --dry-run --quiet
+  echo "# edited" >> "$tmp/edit/wick.obj"
+  expect_rc 2 "$hairgen" farm submit "$tmp/edit/plan/plan.json" --scheduler slurm --dry-run
+  expect_err "has changed since this plan was made"
   ;;
 farm_slurm)
   # On a one-node Slurm (scripts/slurm-local.sh): the default coupe grown and interpolated in 4 shards,

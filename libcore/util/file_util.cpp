@@ -8,9 +8,11 @@
 #include <algorithm>
 #include <array>
 #include <atomic>
+#include <bit>
 #include <cerrno>
 #include <cstdio>
 #include <cstring>
+#include <iostream>
 #include <mutex>
 #include <system_error>
 #include <vector>
@@ -92,26 +94,54 @@ struct Destination {
   int descriptor = -1;  // a descriptor this process has open (/dev/stdout, /dev/fd/N): written through it
 };
 
-// The descriptor N of this process that `path` names, or that a link on the way to it names:
-// /dev/stdout, /dev/stderr, /dev/fd/N, /proc/self/fd/N or /proc/PID/fd/N for this PID; −1 for any
-// other path or a descriptor that is not open. Opening such a path again would open the file behind
-// it anew (truncating a log that stdout is appended to); writing through the descriptor writes where
-// the shell's redirection points, at its offset, appending where it appends.
+// The number N when `text` names descriptor N of this process: /dev/stdout, /dev/stderr, /dev/fd/N,
+// or N under /proc's fd folder of this process or of one of its threads (self, thread-self, PID,
+// self/task/TID, PID/task/TID); −1 otherwise.
+int descriptorNumberIn(const std::string& text) {
+  if (text == "/dev/stdout") return 1;
+  if (text == "/dev/stderr") return 2;
+  const size_t slash = text.rfind('/');
+  if (slash == std::string::npos || slash + 1 == text.size() || text.size() - slash - 1 > 9 ||
+      text.find_first_not_of("0123456789", slash + 1) != std::string::npos)
+    return -1;
+  const std::string folder = text.substr(0, slash + 1), pid = std::to_string(::getpid());
+  auto isNumber = [](const std::string& t) {
+    return !t.empty() && t.find_first_not_of("0123456789") == std::string::npos;
+  };
+  bool ours = folder == "/dev/fd/";
+  for (const std::string& process : {std::string("self"), std::string("thread-self"), pid}) {
+    const std::string base = "/proc/" + process + "/";
+    if (folder == base + "fd/") ours = true;
+    // PROCESS/task/TID/fd/: a thread of this process.
+    if (process != "thread-self" && folder.size() > base.size() + 9 &&
+        folder.compare(0, base.size() + 5, base + "task/") == 0 &&
+        folder.compare(folder.size() - 4, 4, "/fd/") == 0 &&
+        isNumber(folder.substr(base.size() + 5, folder.size() - 4 - base.size() - 5)))
+      ours = true;
+  }
+  return ours ? std::stoi(text.substr(slash + 1)) : -1;
+}
+
+// The descriptor of this process that `requested` names, or that a link on the way to it names (see
+// descriptorNumberIn); −1 for a path that names none. A named descriptor that is not open, or is
+// open only for reading, is an InputError: nothing could be written through it. Opening such a path
+// again would open the file behind it anew (truncating a log that stdout is appended to); writing
+// through the descriptor writes where the shell's redirection points, at its offset, appending where
+// it appends.
 int descriptorNamed(const fs::path& requested) {
   std::error_code ec;
   fs::path path = requested.lexically_normal();
-  const std::string self = "/proc/" + std::to_string(::getpid()) + "/fd/";
   for (int depth = 0; depth < 40; ++depth) {
-    const std::string text = path.string();
-    int fd = -1;
-    if (text == "/dev/stdout") fd = 1;
-    if (text == "/dev/stderr") fd = 2;
-    for (const std::string& prefix : {std::string("/dev/fd/"), std::string("/proc/self/fd/"), self})
-      if (text.size() > prefix.size() && text.compare(0, prefix.size(), prefix) == 0 &&
-          text.find_first_not_of("0123456789", prefix.size()) == std::string::npos &&
-          text.size() - prefix.size() <= 9)
-        fd = std::stoi(text.substr(prefix.size()));
-    if (fd >= 0) return ::fcntl(fd, F_GETFD) != -1 ? fd : -1;
+    if (const int fd = descriptorNumberIn(path.string()); fd >= 0) {
+      const int flags = ::fcntl(fd, F_GETFL);
+      if (flags == -1)
+        throw InputError({requested.string(), 0}, "names descriptor " + std::to_string(fd) +
+                                                      ", which this command does not have open");
+      if ((flags & O_ACCMODE) == O_RDONLY)
+        throw InputError({requested.string(), 0},
+                         "names descriptor " + std::to_string(fd) + ", which is open for reading only");
+      return fd;
+    }
     if (!fs::is_symlink(fs::symlink_status(path, ec))) return -1;
     const fs::path to = fs::read_symlink(path, ec);
     if (ec) return -1;
@@ -188,8 +218,12 @@ void renameInto(const fs::path& temporary, const fs::path& target) {
   if (ec) throw IoError({target.string(), 0}, "cannot rename into place: " + ec.message());
 }
 
-// Copies a finished file to an open descriptor, at its offset.
+// Copies a finished file to an open descriptor, at its offset, after whatever the command had already
+// printed to its own streams (still in their buffers, it would otherwise come after).
 void copyToDescriptor(const fs::path& from, int fd, const fs::path& name) {
+  std::cout.flush();
+  std::cerr.flush();
+  std::fflush(nullptr);
   std::ifstream in(from, std::ios::binary);
   std::vector<char> buffer(1 << 16);
   while (in) {
@@ -267,12 +301,13 @@ void InputFile::read(void* out, size_t bytes) {
 }
 
 void requireWritableOutput(const fs::path& target) {
-  const Destination destination = destinationOf(target);  // a directory is refused here
+  const Destination destination = destinationOf(target);  // a directory, a closed descriptor: refused
   if (destination.direct) return;
   // The nearest folder that exists on the way to the file's: the one a write creates folders in.
-  fs::path folder = destination.path.parent_path();
-  if (folder.empty()) folder = ".";
   std::error_code ec;
+  fs::path folder = fs::absolute(destination.path, ec).parent_path();
+  if (ec) folder = destination.path.parent_path();
+  if (folder.empty()) folder = ".";
   while (!fs::exists(folder, ec) && folder.has_parent_path() && folder.parent_path() != folder)
     folder = folder.parent_path();
   if (fs::exists(folder, ec) && !fs::is_directory(folder, ec))
@@ -283,26 +318,55 @@ void requireWritableOutput(const fs::path& target) {
 }
 
 std::string contentDigest(const fs::path& path) {
-  constexpr uint64_t kPrime = 0x100000001b3ull;
-  uint64_t lanes[4] = {0xcbf29ce484222325ull, 0x84222325cbf29ce4ull, 0x9ce484222325cbf2ull,
-                       0x2325cbf29ce48422ull};
-  uint64_t size = 0;
-  try {
-    InputFile file(path);
-    size = file.size();
-    std::vector<uint64_t> words(1 << 17);  // 1 MiB a read
-    while (file.remaining() > 0) {
-      const size_t bytes = size_t(std::min<uint64_t>(file.remaining(), words.size() * 8));
-      if (bytes % 8 != 0) words[bytes / 8] = 0;  // the last word's missing bytes are zeros (size mixed in)
-      file.read(words.data(), bytes);
-      const size_t count = (bytes + 7) / 8;
-      for (size_t i = 0; i < count; ++i) lanes[i & 3] = (lanes[i & 3] ^ words[i]) * kPrime;
-    }
-  } catch (const Error&) {
+  // XXH64's round on each of four lanes (a rotate between multiplies carries every bit of a word into
+  // every bit of its lane) and MurmurHash3's finaliser on the result; words read little-endian.
+  constexpr uint64_t kP1 = 0x9e3779b185ebca87ull, kP2 = 0xc2b2ae3d27d4eb4full, kP3 = 0x165667b19e3779f9ull;
+  auto round = [](uint64_t lane, uint64_t word) { return std::rotl(lane + word * kP2, 31) * kP1; };
+  auto mix = [](uint64_t h) {
+    h ^= h >> 33;
+    h *= 0xff51afd7ed558ccdull;
+    h ^= h >> 33;
+    h *= 0xc4ceb9fe1a85ec53ull;
+    return h ^ (h >> 33);
+  };
+  uint64_t lanes[4] = {kP1 + kP2, kP2, 0, 0 - kP1};
+  // Not InputFile: its refusal of a file larger than the free memory would make the digest depend on
+  // the machine, and the file is read in pieces here.
+  const int fd = ::open(path.c_str(), O_RDONLY | O_NONBLOCK | O_CLOEXEC);
+  if (fd < 0) return "";
+  struct stat st {};
+  if (::fstat(fd, &st) != 0 || !S_ISREG(st.st_mode)) {
+    ::close(fd);
     return "";
   }
-  uint64_t hash = size * kPrime;
-  for (uint64_t lane : lanes) hash = (hash ^ lane) * kPrime ^ (hash >> 29);
+  std::vector<unsigned char> buffer(1 << 20);  // 1 MiB a read, a multiple of the 32 bytes a step takes
+  uint64_t size = 0;
+  bool ok = true;
+  for (;;) {
+    size_t filled = 0;
+    while (filled < buffer.size()) {
+      const ssize_t n = ::read(fd, buffer.data() + filled, buffer.size() - filled);
+      if (n < 0 && errno == EINTR) continue;
+      if (n < 0) ok = false;
+      if (n <= 0) break;
+      filled += size_t(n);
+    }
+    size += filled;
+    std::fill(buffer.begin() + std::ptrdiff_t(filled),
+              buffer.begin() + std::ptrdiff_t((filled + 31) / 32 * 32),
+              0);  // the last step's missing bytes are zeros (the size is mixed in after)
+    for (size_t at = 0; at < filled; at += 8) {
+      uint64_t word = 0;
+      for (int b = 7; b >= 0; --b) word = word << 8 | buffer[at + size_t(b)];
+      lanes[(at / 8) & 3] = round(lanes[(at / 8) & 3], word);
+    }
+    if (!ok || filled < buffer.size()) break;
+  }
+  ::close(fd);
+  if (!ok) return "";
+  uint64_t hash = size * kP3;
+  for (uint64_t lane : lanes) hash = mix(hash ^ round(0, lane)) * kP1;
+  hash = mix(hash);
   char hex[17];
   std::snprintf(hex, sizeof hex, "%016llx", static_cast<unsigned long long>(hash));
   return hex;

@@ -49,10 +49,10 @@ class InputFile {
   uint64_t size_ = 0, position_ = 0;
 };
 
-// A 64-bit digest of a file's bytes, 16 hex digits (FNV-1a's multiplier over 8-byte words in four
-// interleaved lanes, then the size: ~4 GB/s, so a 240 MB coupe costs a few tens of milliseconds); ""
-// where the file cannot be read as a regular file. The same bytes give the same digest on every
-// machine.
+// A 64-bit digest of a file's bytes, 16 hex digits (XXH64's round over little-endian 8-byte words in
+// four interleaved lanes, then the size and MurmurHash3's finaliser: a flipped bit anywhere changes
+// every bit of the result); "" where the file cannot be read as a regular file. The same bytes give
+// the same digest on every machine, whatever its memory or byte order.
 std::string contentDigest(const std::filesystem::path& path);
 
 // Before the work: whether an output could be written where it is named. A directory there is an
