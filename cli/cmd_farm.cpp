@@ -143,8 +143,31 @@ struct Submission {
 
 void waitForJobs(const FarmPlan& plan, const std::vector<Submission>& submitted, const std::string& logs);
 
+// The plan's configuration read again, as its tasks will read it: a Setup, Info file, mesh or shader
+// edited since the plan was made gives another digest, and the tasks' outputs would never carry the
+// plan's (every task rerun at each submit, --wait reporting tasks that succeeded as failed).
+void requireUnchangedConfig(const FarmPlan& plan, const std::string& planFile) {
+  CommonOptions asPlanned;
+  for (size_t i = 0; i + 1 < plan.overrides.size(); i += 2) {
+    if (plan.overrides[i] == "--set") asPlanned.sets.push_back(plan.overrides[i + 1]);
+    if (plan.overrides[i] == "--seed") {
+      const std::string& seed = plan.overrides[i + 1];
+      if (seed.empty() || seed.size() > 19 || seed.find_first_not_of("0123456789") != std::string::npos)
+        throw InputError({planFile, 0}, "its --seed '" + seed + "' is not a seed; make the plan again");
+      asPlanned.seed = std::stoull(seed);
+    }
+  }
+  const std::string now = loadConfig(plan.setup, parseOverrides(asPlanned), SetupUse::kRun).digest();
+  if (now != plan.configDigest)
+    throw InputError({planFile, 0},
+                     "the Setup or a file it names has changed since this plan was made (config " + now +
+                         " now, " + plan.configDigest +
+                         " planned); make the plan again with `hairgen farm plan`");
+}
+
 void submit(const FarmPlan& plan, const std::string& planFile, bool dryRun, bool wait,
             const CommonOptions& common) {
+  requireUnchangedConfig(plan, planFile);
   std::vector<Group> groups;
   std::map<std::string, size_t> taskIndex;  // id → plan index
   std::vector<size_t> groupOf(plan.tasks.size()), indexInGroup(plan.tasks.size());

@@ -179,7 +179,7 @@ WorkEstimate estimateRender(const RenderSettings& r, size_t strands, size_t poin
   // no render setting is what is wrong.
   if (hairLength > 3.0)
     e.timeKey = "the hair's units: its strands are " + formatReal(std::round(hairLength * 10.0) / 10.0) +
-                " m long (render --units cm or mm, or --frame to fit it in the view)";
+                " m long, so the file is in other units (render it with --units cm or mm, or --frame)";
   e.detail = std::to_string(r.resolution.x) + "x" + std::to_string(r.resolution.y) + " pixels at " +
              std::to_string(block * block) + " samples, " + std::to_string(strands) + " strands";
   return e;

@@ -144,12 +144,17 @@ std::vector<SceneFinding> checkScene(const Config& config, const Mesh& wick, con
   const Hairstyle& style = config.hairstyle;
   if (style.rootTilt > 0.0 && style.rootFlow.kind == RootFlow::Kind::kAwayFrom &&
       glm::length(style.rootFlow.value - centre) > std::max(diagonal, 0.05)) {
+    // The centre of the head: a shape fitted to its cranium, else the first round shape, else the wick's.
     glm::dvec3 suggested = centre;
-    for (const CollisionShape& s : config.collision.shapes)
-      if (s.kind != ShapeKind::kCuboid) {
-        suggested = s.centre;
-        break;
-      }
+    const auto& shapes = config.collision.shapes;
+    auto fittedShape =
+        std::find_if(shapes.begin(), shapes.end(), [](const CollisionShape& s) { return s.fitted; });
+    auto round = std::find_if(shapes.begin(), shapes.end(),
+                              [](const CollisionShape& s) { return s.kind != ShapeKind::kCuboid; });
+    if (fittedShape != shapes.end())
+      suggested = fittedShape->centre;
+    else if (round != shapes.end())
+      suggested = round->centre;
     auto point = [](const glm::dvec3& p) {
       auto r = [](double v) { return formatReal(std::round(v * 1000.0) / 1000.0); };
       return r(p.x) + " " + r(p.y) + " " + r(p.z);

@@ -301,6 +301,20 @@ TEST(Config, DigestFollowsTheMeshesContentNotTheirPaths) {
   EXPECT_NE(loadConfig(dir / "setup.txt", {}, SetupUse::kGrow).digest(), first.digest());
 }
 
+// A coupe to load shapes the output only when Load says it is loaded.
+TEST(Config, ALoadFileEntersTheDigestOnlyWhenLoaded) {
+  test::TempDir dir("config");
+  std::ofstream(dir / "coupe.hair") << "not read as hair here, only hashed";
+  std::ofstream(dir / "kept.txt") << "Load false\nLoadFile coupe.hair\n";
+  std::ofstream(dir / "loaded.txt") << "Load true\nLoadFile coupe.hair\n";
+  EXPECT_EQ(loadConfig(dir / "kept.txt", {}, SetupUse::kCheck).canonicalText().find("Input.LoadFile"),
+            std::string::npos);
+  const Config loaded = loadConfig(dir / "loaded.txt", {}, SetupUse::kCheck);
+  EXPECT_NE(loaded.canonicalText().find("Input.LoadFile "), std::string::npos);
+  std::ofstream(dir / "coupe.hair") << "another coupe";
+  EXPECT_NE(loadConfig(dir / "loaded.txt", {}, SetupUse::kCheck).digest(), loaded.digest());
+}
+
 // A key declared once, in a section of its own that only this test knows: the reader, the canonical
 // text behind the digest, --set and the key reference all find it with no other edit.
 struct ProbeSettings {

@@ -42,18 +42,26 @@ Config loadConfig(const std::filesystem::path& setupFile, const std::vector<Over
     need(s.hairstyleInfo, "HairstyleInfo", "path of the Hairstyle Info file");
     need(s.wickModel, "WickModel", "path of the wick OBJ");
   }
-  for (auto [ref, key] : {std::pair{&s.hairstyleInfo, "HairstyleInfo"},
-                          {&s.collisionInfo, "CollisionInfo"},
-                          {&s.visualityInfo, "VisualityInfo"},
-                          {&s.renderInfo, "RenderInfo"},
-                          {&s.dynamicsInfo, "DynamicsInfo"},
-                          {&s.wickModel, "WickModel"},
-                          {&s.headModel, "HeadModel"},
-                          {&s.hairVert, "HairVert"},
-                          {&s.hairFrag, "HairFrag"},
-                          {&s.headVert, "HeadVert"},
-                          {&s.headFrag, "HeadFrag"}})
-    if (ref->given()) requireExisting(*ref, key);
+  // Every file the Setup names must exist. The Info files enter the digest by their values; the
+  // others (`byContent`), whose bytes shape the output, by their content (below).
+  struct Named {
+    const PathRef* ref;
+    const char* key;
+    bool byContent;
+  };
+  const Named named[] = {{&s.hairstyleInfo, "HairstyleInfo", false},
+                         {&s.collisionInfo, "CollisionInfo", false},
+                         {&s.visualityInfo, "VisualityInfo", false},
+                         {&s.renderInfo, "RenderInfo", false},
+                         {&s.dynamicsInfo, "DynamicsInfo", false},
+                         {&s.wickModel, "WickModel", true},
+                         {&s.headModel, "HeadModel", true},
+                         {&s.hairVert, "HairVert", true},
+                         {&s.hairFrag, "HairFrag", true},
+                         {&s.headVert, "HeadVert", true},
+                         {&s.headFrag, "HeadFrag", true}};
+  for (const Named& n : named)
+    if (n.ref->given()) requireExisting(*n.ref, n.key);
   if (s.load && (use == SetupUse::kRun || use == SetupUse::kCheck)) requireExisting(s.loadFile, "LoadFile");
 
   auto text = [&](const PathRef& ref, const char* what) {
@@ -68,18 +76,15 @@ Config loadConfig(const std::filesystem::path& setupFile, const std::vector<Over
   config.dynamics.given = s.dynamicsInfo.given();
   // The inputs whose bytes shape the output, each by its content (Config::canonicalText). One that
   // cannot be read is left out here: the stage that reads it says why.
-  const bool densityTarget = config.dynamics.given && config.dynamics.densityTarget.given();
-  for (auto [ref, key] : {std::pair{&s.wickModel, "WickModel"},
-                          {&s.headModel, "HeadModel"},
-                          {s.load ? &s.loadFile : nullptr, "LoadFile"},
-                          {&s.hairVert, "HairVert"},
-                          {&s.hairFrag, "HairFrag"},
-                          {&s.headVert, "HeadVert"},
-                          {&s.headFrag, "HeadFrag"},
-                          {densityTarget ? &config.dynamics.densityTarget : nullptr, "DensityTarget"}})
-    if (ref && ref->given())
-      if (std::string content = contentDigest(ref->path); !content.empty())
-        config.inputContent.emplace_back(key, std::move(content));
+  auto byContent = [&](const PathRef& ref, const char* key) {
+    if (!ref.given()) return;
+    if (std::string content = contentDigest(ref.path); !content.empty())
+      config.inputContent.emplace_back(key, std::move(content));
+  };
+  for (const Named& n : named)
+    if (n.byContent) byContent(*n.ref, n.key);
+  if (s.load) byContent(s.loadFile, "LoadFile");
+  if (config.dynamics.given) byContent(config.dynamics.densityTarget, "DensityTarget");
   return config;
 }
 
