@@ -75,7 +75,7 @@ void registerGrow(CLI::App& app, int& exitCode) {
       "collisions), or Anjyo's cantilever beam (Model cantilever)");
   cmd->add_option("SETUP", options->setup, "The Setup file")->required();
   cmd->add_option("-o,--output", options->output,
-                  "Guides to write: .hair, .gltf, .glb, .ply, .data or .usda (written atomically)")
+                  "Guides to write: " + hairExtensionList() + " (written atomically)")
       ->required();
   cmd->add_option("--diagnostics", options->diagnostics,
                   "Write per guide: follicle, generalised coordinates, energy terms at start and end, stages "

@@ -3,6 +3,7 @@
 
 #include "cli/commands.h"
 #include "cli/common.h"
+#include "libcore/io/hair_cache.h"
 #include "libcore/io/info.h"
 #include "libcore/util/json.h"
 
@@ -15,10 +16,8 @@ void registerInfo(CLI::App& app, int& exitCode) {
     bool json = false;
   };
   auto options = std::make_shared<Options>();
-  CLI::App* cmd = app.add_subcommand(
-      "info",
-      "Describe a .hair, .gltf, .glb, .ply, .data, .usda, .obj or .exr file: counts, bounds, "
-      "attributes, provenance");
+  CLI::App* cmd = app.add_subcommand("info", "Describe a file (" + hairExtensionList() +
+                                                 ", .obj, .exr): counts, bounds, attributes, provenance");
   cmd->add_option("FILE", options->file, "The file to describe")->required();
   cmd->add_flag("--json", options->json, "Print the description as JSON");
   addCommonFlags(*cmd, options->common, false);

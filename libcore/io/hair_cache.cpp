@@ -24,15 +24,18 @@ constexpr FormatEntry kFormats[] = {
 
 }  // namespace
 
+std::string hairExtensionList() {
+  std::string known;
+  for (const FormatEntry& f : kFormats) known += std::string(known.empty() ? "" : ", ") + f.extension;
+  return known;
+}
+
 HairFormat hairFormatOf(const std::filesystem::path& file) {
   const std::string ext = toLower(file.extension().string());
-  std::string known;
-  for (const FormatEntry& f : kFormats) {
+  for (const FormatEntry& f : kFormats)
     if (ext == f.extension) return f.format;
-    known += std::string(known.empty() ? "" : ", ") + f.extension;
-  }
-  throw InputError({file.string(), 0},
-                   "unknown hair file extension '" + file.extension().string() + "'; use " + known);
+  throw InputError({file.string(), 0}, "unknown hair file extension '" + file.extension().string() +
+                                           "'; use " + hairExtensionList());
 }
 
 const char* describe(HairFormat format) {

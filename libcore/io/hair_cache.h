@@ -18,6 +18,8 @@ enum class HairFormat { kHair, kGltf, kGlb, kPly, kData, kUsda };
 
 // The format a path's extension names (case-insensitive). Throws InputError for any other extension.
 HairFormat hairFormatOf(const std::filesystem::path& file);
+// The extensions hairFormatOf knows, in its order: ".hair, .gltf, .glb, .ply, .data, .usda".
+std::string hairExtensionList();
 
 // "cyHair .hair", "PLY", ... for messages and `hairgen info`.
 const char* describe(HairFormat format);

@@ -145,8 +145,7 @@ nlohmann::ordered_json describeFile(const std::filesystem::path& file) {
     format = hairFormatOf(file);
   } catch (const InputError&) {  // info reads meshes and images too: name them with the hair formats
     throw InputError({file.string(), 0}, "unknown file extension '" + file.extension().string() +
-                                             "'; info reads .hair, .gltf, .glb, .ply, .data, .usda, .obj "
-                                             "and .exr");
+                                             "'; info reads " + hairExtensionList() + ", .obj and .exr");
   }
   Strands s;
   nlohmann::ordered_json details = nlohmann::ordered_json::object();
