@@ -170,8 +170,6 @@ void registerRender(CLI::App& app, int& exitCode) {
       if (options->setup.empty() || (options->hair.empty() && !fromGuides) || options->output.empty())
         throw InputError("render needs SETUP, --hair FILE and -o IMAGE.exr (or --list-devices)");
       requireExtension(options->output, ".exr", "-o");
-      for (const std::string* file : {&options->output, &options->dom, &options->preview})
-        if (!file->empty() && !isFramePattern(*file)) requireWritableOutput(*file);
       if (!options->dom.empty()) requireExtension(options->dom, ".exr", "--dom");
       if (!options->preview.empty()) requireExtension(options->preview, ".png", "--preview");
       Stats stats("render");
@@ -190,9 +188,9 @@ void registerRender(CLI::App& app, int& exitCode) {
       auto frameFile = [&](const std::string& pattern, int f) {
         return sequence && !pattern.empty() ? framePath(pattern, f).string() : pattern;
       };
-      if (sequence)
-        for (const std::string* file : {&options->output, &options->dom, &options->preview})
-          if (!file->empty()) requireWritableOutput(frameFile(*file, frames.first));
+      // Where it will write, before the work (a sequence's first frame's files).
+      for (const std::string* file : {&options->output, &options->dom, &options->preview})
+        if (!file->empty()) requireWritableOutput(frameFile(*file, frames.first));
       Scene scene = readScene(options->common, config, fromGuides, true, stats);
       std::optional<Mesh> head = std::move(scene.head);
       const HeadMotion motion = headMotionOf(config);

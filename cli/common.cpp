@@ -73,7 +73,9 @@ std::vector<Override> parseOverrides(const CommonOptions& options) {
 namespace {
 // What the Stats of a failing command had gathered when it was unwound, for runCommand.
 nlohmann::ordered_json gFailedStats;
-bool gStatsWriteFailed = false;  // Stats::write failed: the failure does not write --stats again
+// --stats names a place nothing could be written (its check before the work, or Stats::write, failed):
+// the failure does not try it again.
+bool gStatsWriteFailed = false;
 }  // namespace
 
 Stats::~Stats() {
@@ -119,12 +121,11 @@ int runCommand(const std::string& command, const CommonOptions& options, const s
   installInterruptCleanup();
   forgetCommittedOutputs();
   gFailedStats = nullptr;
-  bool statsWritable = true;  // false when --stats names a place nothing can be written: no second error
   gStatsWriteFailed = false;
   auto failed = [&](const std::string& message, ExitCode code) {
     discardCommittedOutputs();  // a failed command leaves none of its outputs
     std::cerr << "hairgen " << command << ": error: " << oneLine(message) << "\n";
-    if (!options.statsFile.empty() && statsWritable && !gStatsWriteFailed) {
+    if (!options.statsFile.empty() && !gStatsWriteFailed) {
       // A farm script reads why, even from a command that failed before it gathered anything.
       nlohmann::ordered_json stats =
           gFailedStats.is_object() ? gFailedStats : nlohmann::ordered_json::object();
@@ -151,12 +152,9 @@ int runCommand(const std::string& command, const CommonOptions& options, const s
     if (!options.statsFile.empty()) {  // before the work, as the outputs are
       try {
         requireWritableOutput(options.statsFile);
-      } catch (const InputError& e) {
-        statsWritable = false;
-        throw InputError(std::string("--stats: ") + e.what());
-      } catch (const IoError& e) {
-        statsWritable = false;
-        throw IoError(std::string("--stats: ") + e.what());
+      } catch (const Error& e) {
+        gStatsWriteFailed = true;
+        throw Error(e.code(), {}, std::string("--stats: ") + e.what());
       }
     }
     body();

@@ -240,12 +240,15 @@ void copyToDescriptor(const fs::path& from, int fd, const fs::path& name) {
 
 // Copies a finished file into a device or FIFO.
 void copyInto(const fs::path& from, const fs::path& device) {
-  std::ifstream in(from, std::ios::binary);
-  std::ofstream out(device, std::ios::binary);
-  if (!out) throw IoError({device.string(), 0}, std::string("cannot write: ") + std::strerror(errno));
-  out << in.rdbuf();
-  out.flush();
-  if (!in || !out) throw IoError({device.string(), 0}, "write failed (no space left on the device?)");
+  const int fd = ::open(device.c_str(), O_WRONLY | O_CLOEXEC);
+  if (fd < 0) throw IoError({device.string(), 0}, std::string("cannot write: ") + std::strerror(errno));
+  try {
+    copyToDescriptor(from, fd, device);
+  } catch (...) {
+    ::close(fd);
+    throw;
+  }
+  ::close(fd);
 }
 
 }  // namespace
