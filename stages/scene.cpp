@@ -129,8 +129,10 @@ std::vector<SceneFinding> checkScene(const Config& config, const Mesh& wick, con
   }
   const size_t penalising = std::count_if(config.collision.shapes.begin(), config.collision.shapes.end(),
                                           [](const CollisionShape& s) { return s.penalty > 0.0; });
-  const bool fitted = std::any_of(config.collision.shapes.begin(), config.collision.shapes.end(),
-                                  [](const CollisionShape& s) { return s.fitted; });
+  const auto& shapes = config.collision.shapes;
+  const auto fittedShape =
+      std::find_if(shapes.begin(), shapes.end(), [](const CollisionShape& s) { return s.fitted; });
+  const bool fitted = fittedShape != shapes.end();
   if (penalising > 0 && touching * 2 < wick.positions.size())
     out.push_back({false, "most of the wick lies more than 3 cm outside every collision shape (" +
                               std::to_string(wick.positions.size() - touching) + " of " +
@@ -146,12 +148,9 @@ std::vector<SceneFinding> checkScene(const Config& config, const Mesh& wick, con
       glm::length(style.rootFlow.value - centre) > std::max(diagonal, 0.05)) {
     // The centre of the head: a shape fitted to its cranium, else the first round shape, else the wick's.
     glm::dvec3 suggested = centre;
-    const auto& shapes = config.collision.shapes;
-    auto fittedShape =
-        std::find_if(shapes.begin(), shapes.end(), [](const CollisionShape& s) { return s.fitted; });
     auto round = std::find_if(shapes.begin(), shapes.end(),
                               [](const CollisionShape& s) { return s.kind != ShapeKind::kCuboid; });
-    if (fittedShape != shapes.end())
+    if (fitted)
       suggested = fittedShape->centre;
     else if (round != shapes.end())
       suggested = round->centre;
