@@ -18,9 +18,11 @@
 
 namespace hairgen::cli {
 
-ShadeResult shadeStage(const CommonOptions& common, const Config& config, Strands coupe, Stats& stats) {
-  ShadeResult result = shade(std::move(coupe), config.visuality, config.render,
-                             ShadeOptions{config.hairstyle.seed, config.digest(), common.force});
+ShadeResult shadeStage(const CommonOptions& common, const Config& config, Strands coupe, Stats& stats,
+                       bool volumeWritten) {
+  ShadeResult result =
+      shade(std::move(coupe), config.visuality, config.render,
+            ShadeOptions{config.hairstyle.seed, config.digest(), common.force, volumeWritten});
   const Strands& shaded = result.coupe;
   const Grid& grid = result.volume.density;
   stats.time("volume", result.timings.volume);
@@ -130,7 +132,7 @@ void registerShade(CLI::App& app, int& exitCode) {
       stats.time("read", clock.lap());
       ShadeResult shaded;
       try {
-        shaded = shadeStage(options->common, config, std::move(coupe), stats);
+        shaded = shadeStage(options->common, config, std::move(coupe), stats, !options->vdb.empty());
       } catch (const InputError& e) {  // what is wrong with the coupe, said of its file
         if (!e.where().file.empty()) throw;
         throw InputError({options->hair, 0}, e.message());

@@ -39,7 +39,9 @@ GrowResult growStage(const CommonOptions& common, const Config& config, const Me
 Strands interpolateStage(const CommonOptions& common, const Config& config, const Mesh& wick,
                          const Strands& guides, const std::string& guidesName, Stats& stats,
                          std::optional<ShardRange> shard = {});
-ShadeResult shadeStage(const CommonOptions& common, const Config& config, Strands coupe, Stats& stats);
+// `volumeWritten`: the volume is written out (--vdb), so its distance is computed at every node.
+ShadeResult shadeStage(const CommonOptions& common, const Config& config, Strands coupe, Stats& stats,
+                       bool volumeWritten = false);
 // Opens the device, reads the Setup's custom shader files and calls the render stage; records the
 // device and the passes' times in `stats`.
 // Opens the rendering device (once per command) and names it on stderr.

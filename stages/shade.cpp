@@ -44,7 +44,8 @@ ShadeResult shade(Strands coupe, const Visuality& visuality, const RenderSetting
   tbb::task_group sizing;
   sizing.run([&] { coupe.normals.resize(coupe.pointCount()); });
   try {
-    result.volume = buildVolume(coupe, render.voxelSize, render.volumePadding, render.shellDensity);
+    result.volume = buildVolume(coupe, render.voxelSize, render.volumePadding, render.shellDensity,
+                                options.distanceEverywhere);
   } catch (...) {
     sizing.wait();
     throw;

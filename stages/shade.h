@@ -44,6 +44,9 @@ struct ShadeOptions {
   uint64_t seed = 0;         // keys the per-strand ambient
   std::string configDigest;  // recorded in the coupe's provenance
   bool force = false;        // run work estimated to take absurdly long (never work that cannot fit)
+  // The volume's signed distance exact at every node (for a volume written out, `--vdb`); otherwise
+  // only where the normals read it (buildVolume), the same normals for less work.
+  bool distanceEverywhere = false;
 };
 
 // Normals from the coupe's own volume (VoxelSize, VolumePadding and ShellDensity of Render Info), and

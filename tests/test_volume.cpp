@@ -126,6 +126,30 @@ TEST(Volume, Coupe3NormalsPointAwayFromTheHeadOnTheOutside) {
   EXPECT_GE(double(away) / outer, 0.95) << away << " of " << outer;
 }
 
+// shade without --vdb slides only the nodes the normals read: the normals must be the same bits as with
+// the whole grid's distance, there and on a coupe whose points sit on the grid's planes (cells whose
+// upper corners weigh nothing), and the nodes left out must be a real part of the grid.
+TEST(Volume, NormalsFromTheDistanceWhereTheyReadItAreTheWholeGridsBits) {
+  Strands snapped = coupe3().coupe;
+  for (glm::vec3& p : snapped.points) p = glm::round(p / 0.004f) * 0.004f;
+  for (const Strands* coupe : {&coupe3().coupe, const_cast<const Strands*>(&snapped)}) {
+    const HairVolume whole = buildVolume(*coupe, 0.004, 3, 0.25, true),
+                     part = buildVolume(*coupe, 0.004, 3, 0.25, false);
+    const std::vector<uint8_t> read = nodesNormalsRead(part.distance, coupe->points);
+    size_t flagged = 0, differ = 0;
+    for (size_t id = 0; id < read.size(); ++id) {
+      flagged += read[id];
+      if (read[id]) {
+        EXPECT_EQ(whole.distance.values[id], part.distance.values[id]) << id;
+      }
+      differ += whole.distance.values[id] != part.distance.values[id];
+    }
+    EXPECT_LT(flagged, read.size() * 3 / 4);
+    EXPECT_GT(differ, 0u);
+    EXPECT_TRUE(volumeNormals(whole.distance, *coupe) == volumeNormals(part.distance, *coupe));
+  }
+}
+
 TEST(Volume, ReposingOntoTheRestPoseGivesTheRestNormals) {
   Strands rest = coupe3().coupe;
   rest.normals = volumeNormals(buildVolume(rest, 0.004, 3, 0.25).distance, rest);

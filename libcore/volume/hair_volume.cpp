@@ -1,6 +1,7 @@
 #include "libcore/volume/hair_volume.h"
 
 #include <algorithm>
+#include <atomic>
 #include <bit>
 #include <cmath>
 #include <cstdio>
@@ -469,20 +470,21 @@ inline bool ontoShell(const Grid& density, const glm::vec3* gradients, double is
   return std::abs(value) <= tolerance;
 }
 
-// Slides the nearest shell point of every node of z-slab k along the shell until x − p lies along the
-// shell's normal at p, the condition for the nearest point: a step along the tangent plane, then
-// ontoShell; kept while the distance falls. Most of signedDistance's time: built for AVX2 as well and
-// flattened, so the sampling it calls is built with it (the same scalar arithmetic in the same order,
-// with floor one instruction instead of a dozen and the cell's loads and weights scheduled together).
+// Slides the nearest shell point of every node of z-slab k (every flagged one, with `exactAt`) along the
+// shell until x − p lies along the shell's normal at p, the condition for the nearest point: a step along the
+// tangent plane, then ontoShell; kept while the distance falls. Most of signedDistance's time: built for AVX2
+// as well and flattened, so the sampling it calls is built with it (the same scalar arithmetic in the same
+// order, with floor one instruction instead of a dozen and the cell's loads and weights scheduled together).
 HAIRGEN_VECTOR_CLONES __attribute__((flatten)) void slideSlab(const Grid& density, const glm::vec3* gradients,
                                                               double iso, double tolerance, int k,
-                                                              glm::dvec3* nearest, double* dist2) {
+                                                              const uint8_t* exactAt, glm::dvec3* nearest,
+                                                              double* dist2) {
   const glm::ivec3 n = density.size;
   const double h = density.voxel;
   for (int j = 0; j < n.y; ++j)
     for (int i = 0; i < n.x; ++i) {
       const size_t id = density.index(i, j, k);
-      if (dist2[id] == kNone) continue;
+      if (dist2[id] == kNone || (exactAt && !exactAt[id])) continue;
       const glm::dvec3 x = density.origin + h * glm::dvec3(i, j, k);
       glm::dvec3 g = sampleGradient(density, gradients, nearest[id]);
       for (int round = 0; round < 6; ++round) {
@@ -504,7 +506,7 @@ HAIRGEN_VECTOR_CLONES __attribute__((flatten)) void slideSlab(const Grid& densit
 
 }  // namespace
 
-Grid signedDistance(const Grid& density, double iso) {
+Grid signedDistance(const Grid& density, double iso, const std::vector<uint8_t>* exactAt) {
   const glm::ivec3 n = density.size;
   const double h = density.voxel;
   const size_t count = density.values.size();
@@ -558,7 +560,8 @@ Grid signedDistance(const Grid& density, double iso) {
   const std::vector<glm::vec3> gradients = nodeGradients(density);
   auto slide = [&] {
     tbb::parallel_for(0, n.z, [&](int k) {
-      slideSlab(density, gradients.data(), iso, tolerance, k, nearest.data(), dist2.data());
+      slideSlab(density, gradients.data(), iso, tolerance, k, exactAt ? exactAt->data() : nullptr,
+                nearest.data(), dist2.data());
     });
   };
   sweep();
@@ -579,13 +582,19 @@ double typicalDensity(const Grid& density) {
   return sum > 0.0 ? squares / sum : 0.0;
 }
 
-HairVolume buildVolume(const Strands& strands, double voxel, int padding, double shellFraction) {
+HairVolume buildVolume(const Strands& strands, double voxel, int padding, double shellFraction,
+                       bool distanceEverywhere) {
   HairVolume volume;
   volume.density = gridAround(strands.points, voxel, padding);
   splat(volume.density, strands.points);
   const Grid smooth = smoothed(volume.density);
   volume.iso = shellFraction * typicalDensity(smooth);
-  volume.distance = signedDistance(smooth, volume.iso);
+  if (distanceEverywhere) {
+    volume.distance = signedDistance(smooth, volume.iso);
+  } else {
+    const std::vector<uint8_t> read = nodesNormalsRead(smooth, strands.points);
+    volume.distance = signedDistance(smooth, volume.iso, &read);
+  }
   return volume;
 }
 
@@ -635,12 +644,13 @@ inline __attribute__((always_inline)) void addCorners(std::integer_sequence<int,
 // at a time over the block so each runs across points in vector registers (libcore/util/vectorise.h),
 // with the arithmetic of trilinear() per point. The cell is the truncation of the clamped grid
 // coordinate: it is never negative, where truncating is flooring.
-HAIRGEN_VECTOR_CLONES
-void normalsOfBlock(const Grid& grid, const glm::vec3* __restrict gradients,
-                    const glm::vec3* __restrict points, size_t count, glm::vec3* __restrict normals) {
+// The cells of up to 256 points (axis by axis, kNormalsBlock apart in `c`) and their fractions within
+// them (`f`): the truncated grid coordinate, clamped. Inlined into its callers, so each is built for
+// their instruction sets and the two find the same cells.
+inline __attribute__((always_inline)) void cellsOfBlock(const Grid& grid, const glm::vec3* __restrict points,
+                                                        size_t count, int* __restrict c,
+                                                        double* __restrict f) {
   constexpr size_t kB = kNormalsBlock;
-  int c[3 * kB];
-  double f[3 * kB], out[3 * kB];
   const glm::dvec3 top = glm::dvec3(grid.size - 1) - 1e-9;
   const float* const xyz = &points[0].x;
   for (int axis = 0; axis < 3; ++axis) {
@@ -653,9 +663,30 @@ void normalsOfBlock(const Grid& grid, const glm::vec3* __restrict gradients,
       const int cell = static_cast<int>(g);
       c[axis * kB + p] = cell;
       f[axis * kB + p] = g - double(cell);
-      out[axis * kB + p] = 0.0;
     }
   }
+}
+
+// Flags the cell of each of up to 256 points (nodesNormalsRead). Threads may flag one cell together:
+// the same byte, written atomically.
+HAIRGEN_VECTOR_CLONES
+void flagCellsOfBlock(const Grid& grid, const glm::vec3* __restrict points, size_t count, uint8_t* cells) {
+  constexpr size_t kB = kNormalsBlock;
+  int c[3 * kB];
+  double f[3 * kB];
+  cellsOfBlock(grid, points, count, c, f);
+  for (size_t p = 0; p < count; ++p)
+    std::atomic_ref<uint8_t>(cells[grid.index(c[p], c[kB + p], c[2 * kB + p])])
+        .store(1, std::memory_order_relaxed);
+}
+
+HAIRGEN_VECTOR_CLONES
+void normalsOfBlock(const Grid& grid, const glm::vec3* __restrict gradients,
+                    const glm::vec3* __restrict points, size_t count, glm::vec3* __restrict normals) {
+  constexpr size_t kB = kNormalsBlock;
+  int c[3 * kB];
+  double f[3 * kB], out[3 * kB] = {};
+  cellsOfBlock(grid, points, count, c, f);
   addCorners(std::make_integer_sequence<int, 8>{}, count, grid.size, gradients, c, f, out);
   float* const n = &normals[0].x;
   double* const lengths = f;  // the fractions are spent
@@ -689,6 +720,47 @@ void volumeNormals(const Grid& distance, const Strands& strands, std::vector<glm
                         normalsOfBlock(distance, gradients.data(), &strands.points[p],
                                        std::min(kNormalsBlock, r.end() - p), &normals[p]);
                     });
+}
+
+std::vector<uint8_t> nodesNormalsRead(const Grid& grid, std::span<const glm::vec3> points) {
+  const glm::ivec3 n = grid.size;
+  const size_t count = grid.values.size();
+  // Each point's cell, found as normalsOfBlock finds it, flagged at its lowest corner.
+  std::vector<uint8_t> cells(count, 0);
+  tbb::parallel_for(
+      tbb::blocked_range<size_t>(0, points.size(), 8192), [&](const tbb::blocked_range<size_t>& r) {
+        for (size_t p = r.begin(); p < r.end(); p += kNormalsBlock)
+          flagCellsOfBlock(grid, &points[p], std::min(kNormalsBlock, r.end() - p), cells.data());
+      });
+  // The cells' corners (clamped to the grid, as addCorner clamps them), then their axis neighbours
+  // (clamped, as nodeGradients clamps them).
+  std::vector<uint8_t> corners(count, 0), read(count, 0);
+  auto clampedIndex = [&](int i, int j, int k) {
+    return grid.index(std::clamp(i, 0, n.x - 1), std::clamp(j, 0, n.y - 1), std::clamp(k, 0, n.z - 1));
+  };
+  tbb::parallel_for(0, n.z, [&](int k) {
+    for (int j = 0; j < n.y; ++j)
+      for (int i = 0; i < n.x; ++i) {
+        uint8_t any = 0;
+        for (int d = 0; d < 8; ++d) {
+          const int ci = i - (d & 1), cj = j - ((d >> 1) & 1), ck = k - (d >> 2);
+          if (ci >= 0 && cj >= 0 && ck >= 0) any |= cells[grid.index(ci, cj, ck)];
+        }
+        corners[grid.index(i, j, k)] = any;
+      }
+  });
+  // A cell's clamped corner is the cell's own node or one beyond it, so the loop above flags it unless
+  // the grid is one node wide on an axis (the corner is then the cell itself, already flagged).
+  for (size_t id = 0; id < count; ++id) corners[id] |= cells[id];
+  tbb::parallel_for(0, n.z, [&](int k) {
+    for (int j = 0; j < n.y; ++j)
+      for (int i = 0; i < n.x; ++i)
+        read[grid.index(i, j, k)] = corners[grid.index(i, j, k)] | corners[clampedIndex(i - 1, j, k)] |
+                                    corners[clampedIndex(i + 1, j, k)] | corners[clampedIndex(i, j - 1, k)] |
+                                    corners[clampedIndex(i, j + 1, k)] | corners[clampedIndex(i, j, k - 1)] |
+                                    corners[clampedIndex(i, j, k + 1)];
+  });
+  return read;
 }
 
 }  // namespace hairgen

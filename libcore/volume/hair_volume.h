@@ -86,7 +86,13 @@ double densityEnergy(const Grid& difference);
 // The signed distance to the isosurface density = `iso` (negative inside): the nodes next to the
 // shell start from its sub-voxel crossings, fast sweeping carries nearest points to the rest of the
 // grid, and each node slides its point along the shell to the true nearest one.
-Grid signedDistance(const Grid& density, double iso);
+// With `exactAt` (one flag per node), only the flagged nodes slide; the others keep the sweep's
+// distance, a shell point's, which is at most about a voxel too long.
+Grid signedDistance(const Grid& density, double iso, const std::vector<uint8_t>* exactAt = nullptr);
+
+// The nodes of `grid` whose values volumeNormals reads for these points: the corners of each point's
+// cell, and their neighbours along the axes (nodeGradients' central differences). One flag per node.
+std::vector<uint8_t> nodesNormalsRead(const Grid& grid, std::span<const glm::vec3> points);
 
 // The density at a typical hair point: Σd²/Σd over the nodes, the mean density weighted by how much
 // hair sits there. Scale-free shell densities are fractions of it.
@@ -100,7 +106,11 @@ struct HairVolume {
   Grid distance;  // metres, negative inside the shell
   double iso = 0.0;
 };
-HairVolume buildVolume(const Strands& strands, double voxel, int padding, double shellFraction);
+// `distanceEverywhere` false: the distance is exact only at the nodes the strands' normals read
+// (nodesNormalsRead), so volumeNormals gives the same bits for a fraction of the work; true for a
+// volume that is written out (`shade --vdb`).
+HairVolume buildVolume(const Strands& strands, double voxel, int padding, double shellFraction,
+                       bool distanceEverywhere = true);
 
 // Shading normals ∇S/|∇S| at every strand vertex.
 std::vector<glm::vec3> volumeNormals(const Grid& distance, const Strands& strands);
