@@ -60,7 +60,8 @@ struct RenderOptions {
   double scale = 1.0;     // multiplies the hair's positions and widths, to metres (0.01 for centimetres)
   bool keepDom = false;   // return the light's maps in RenderOutput::dom
   int domResolution = 0;  // texels per side of the light's maps; 0: domResolutionFor(Resolution)
-  bool force = false;     // render work estimated to take absurdly long (never work that cannot fit)
+  RenderInput::LightMaps lightMaps = RenderInput::LightMaps::kAuto;  // who draws them (RenderInput)
+  bool force = false;  // render work estimated to take absurdly long (never work that cannot fit)
   // The hair the camera is aimed at (--frame, CameraPosition auto), as read; null: the hair rendered.
   // A sequence names its shot's first frame, so the camera holds still over the shot.
   const Strands* framing = nullptr;

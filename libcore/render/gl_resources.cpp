@@ -193,9 +193,33 @@ void Framebuffer::bind() const {
   glViewport(0, 0, width, height);
 }
 
-Buffer::Buffer(const void* data, size_t bytes) {
-  glCreateBuffers(1, &id);
+bool readsInPlace() {
+  GLint count = 0;
+  glGetIntegerv(GL_NUM_EXTENSIONS, &count);
+  for (GLint i = 0; i < count; ++i) {
+    const char* name = reinterpret_cast<const char*>(glGetStringi(GL_EXTENSIONS, static_cast<GLuint>(i)));
+    if (name && std::strcmp(name, "GL_AMD_pinned_memory") == 0) return true;
+  }
+  return false;
+}
+
+Buffer::Buffer(const void* data, size_t bytes, bool readInPlace) {
   constexpr size_t kLarge = size_t(8) << 20;
+  if (readInPlace && data && bytes >= kLarge && readsInPlace()) {
+    // GL_AMD_pinned_memory: storage given at this target is the caller's memory itself, so a coupe is
+    // neither copied nor held twice while it is uploaded (the render's peak: README, Performance).
+    constexpr GLenum kExternalVirtualMemory = 0x9160;  // GL_EXTERNAL_VIRTUAL_MEMORY_BUFFER_AMD
+    glGenBuffers(1, &id);
+    glBindBuffer(kExternalVirtualMemory, id);
+    glBufferData(kExternalVirtualMemory, static_cast<GLsizeiptr>(bytes), data, GL_STATIC_DRAW);
+    glBindBuffer(kExternalVirtualMemory, 0);
+    if (glGetError() == GL_NO_ERROR) {
+      inPlace = true;
+      return;
+    }
+    glDeleteBuffers(1, &id);  // refused: a copy, as below
+  }
+  glCreateBuffers(1, &id);
   if (!data || bytes < kLarge) {
     glNamedBufferStorage(id, static_cast<GLsizeiptr>(std::max<size_t>(bytes, 4)), bytes ? data : nullptr, 0);
     return;
@@ -213,23 +237,29 @@ Buffer::Buffer(const void* data, size_t bytes) {
 }
 
 Buffer::~Buffer() {
-  glDeleteBuffers(1, &id);
+  reset();
 }
 
 void Buffer::reset() {
+  // Deleting a buffer does not wait for the draws queued with it, and memory read in place is the
+  // caller's, freed once this returns (a failing pass unwinds through here too).
+  if (inPlace && id) glFinish();
   glDeleteBuffers(1, &id);
   id = 0;
+  inPlace = false;
 }
 
 // ------------------------------------------------------------------------------------------ geometry
 
-HairGeometry::HairGeometry(const Strands& s, const PointArray& tangentData, const Strands* before)
-    : points(s.points.data(), s.points.size() * sizeof(glm::vec3)),
-      tangents(tangentData.data(), tangentData.size() * sizeof(glm::vec3)),
-      colors(s.colors.data(), s.colors.size() * sizeof(glm::vec3)),
-      normals(s.normals.data(), s.normals.size() * sizeof(glm::vec3)),
+HairGeometry::HairGeometry(const Strands& s, const PointArray& tangentData, const Strands* before,
+                           bool inPlace)
+    : points(s.points.data(), s.points.size() * sizeof(glm::vec3), inPlace),
+      tangents(tangentData.data(), tangentData.size() * sizeof(glm::vec3),
+               inPlace && &tangentData == &s.tangents),
+      colors(s.colors.data(), s.colors.size() * sizeof(glm::vec3), inPlace),
+      normals(s.normals.data(), s.normals.size() * sizeof(glm::vec3), inPlace),
       previous(before ? before->points.data() : nullptr,
-               before ? before->points.size() * sizeof(glm::vec3) : 0),
+               before ? before->points.size() * sizeof(glm::vec3) : 0, inPlace),
       hasColors(!s.colors.empty()),
       hasNormals(!s.normals.empty()),
       hasPrevious(before != nullptr) {

@@ -85,15 +85,23 @@ struct Framebuffer {
   int width = 0, height = 0;
 };
 
-// An immutable buffer holding `bytes` of `data` (at least 4 bytes, so an empty array still binds).
+// Whether the current context can read a large array in place, where it lies in the program's memory
+// (GL_AMD_pinned_memory: Mesa's llvmpipe has it; a GPU's driver mostly does not).
+bool readsInPlace();
+
+// A buffer holding `bytes` of `data` (at least 4 bytes, so an empty array still binds). With `inPlace`
+// and a context that reads in place, a large array is not copied: the buffer reads `data` where it
+// lies, which must then stay alive and unchanged until the buffer is deleted (`inPlace` then stays
+// true). Otherwise the buffer is immutable and holds a copy.
 struct Buffer {
-  Buffer(const void* data, size_t bytes);
+  Buffer(const void* data, size_t bytes, bool inPlace = false);
   ~Buffer();
   Buffer(const Buffer&) = delete;
   Buffer& operator=(const Buffer&) = delete;
-  void reset();  // deletes it now
+  void reset();  // deletes it now, after the draws that read it in place have finished
 
   GLuint id = 0;
+  bool inPlace = false;
 };
 
 // The strands of two points or more, those nearest `view`'s eye first (by their nearest point): drawn
@@ -129,7 +137,11 @@ struct LineStrips {
 // buffer 4.
 struct HairGeometry {
   // `tangents`: one per point. `previous`: null, or the same strands a frame before (as many points).
-  HairGeometry(const Strands& strands, const PointArray& tangents, const Strands* previous = nullptr);
+  // With `inPlace`, the large arrays are read where they lie where the context can (Buffer): the
+  // strands (and `previous`) must then stay alive and unchanged until release() or the destructor.
+  // `tangents` is read in place only when it is the strands' own.
+  HairGeometry(const Strands& strands, const PointArray& tangents, const Strands* previous = nullptr,
+               bool inPlace = false);
   ~HairGeometry();
   HairGeometry(const HairGeometry&) = delete;
   HairGeometry& operator=(const HairGeometry&) = delete;
@@ -144,6 +156,10 @@ struct HairGeometry {
 
   Buffer points, tangents, colors, normals, previous;
   bool hasColors, hasNormals, hasPrevious;
+  // Whether a buffer reads the strands (or the frame before) where they lie.
+  bool readsInPlace() const {
+    return points.inPlace || tangents.inPlace || colors.inPlace || normals.inPlace || previous.inPlace;
+  }
   std::vector<GLint> lineFirsts, ribbonFirsts;
   std::vector<GLsizei> lineCounts, ribbonCounts;
   std::vector<size_t> chunkEnds;  // where each of draw()'s chunks of strands ends (kCameraChunkVertices)

@@ -106,6 +106,15 @@ const PointArray& tangentsFor(const Strands& s, PointArray&& computed = {}) {
   return computed;
 }
 
+// Whether the context rasterises in software (Mesa's llvmpipe or softpipe), where the CPU draws the
+// light's maps faster than the driver (light_maps.h).
+bool softwareRasteriser() {
+  const char* renderer = reinterpret_cast<const char*>(glGetString(GL_RENDERER));
+  if (!renderer) return false;
+  const std::string name(renderer);
+  return name.find("llvmpipe") != std::string::npos || name.find("softpipe") != std::string::npos;
+}
+
 }  // namespace
 
 // hairgen's own hair shading stage compiled for one model, and for hair without colours
@@ -162,6 +171,7 @@ Programs::Programs(bool ribbons, int block, const CustomShaders& custom, bool mo
 struct Scene::Preparation {
   std::vector<uint32_t> order, light, camera;
   bool lightChords = false, cameraChords = false;
+  std::unique_ptr<LightRaster> lightRaster;  // the light's chords projected, when the CPU draws its maps
   tbb::task_group work;
 
   Preparation(const Scene& scene, const RenderInput& in) {
@@ -181,8 +191,14 @@ struct Scene::Preparation {
     const double lightTolerance = kChordTexels * lightPixel, cameraTolerance = kChordPixels * cameraPixel;
     const bool ordered = scene.block == 1;
     const glm::dmat4 view = scene.camera.view;
-    work.run([=, this, &hair] {
+    const bool lightOnCpu = lightChords && in.lightMaps != RenderInput::LightMaps::kGl &&
+                            (in.lightMaps == RenderInput::LightMaps::kCpu || softwareRasteriser());
+    const View& lightView = scene.light;
+    work.run([=, this, &hair, &lightView] {
       if (lightChords) light = decimatedLineStrips(hair, lightTolerance);
+      if (!lightOnCpu) return;
+      lightRaster = std::make_unique<LightRaster>(hair, light, lightView);
+      light = {};  // projected into the raster: no chords to upload
     });
     work.run([=, this, &hair] {
       if (ordered) order = frontToBack(hair, view);
@@ -210,7 +226,7 @@ Scene::Scene(const RenderInput& in)
       ribbons(drawsRibbons(in.settings, sphere, camera, block)),
       motion(in.previous.has_value()),
       preparing(std::make_unique<Preparation>(*this, in)),
-      hair(*in.hair, tangentsFor(*in.hair), motion ? in.previous->hair : nullptr),
+      hair(*in.hair, tangentsFor(*in.hair), motion ? in.previous->hair : nullptr, in.readInPlace),
       head(in.head && !in.head->triangles.empty()
                ? std::make_unique<HeadGeometry>(*in.head, motion ? in.previous->head : nullptr)
                : nullptr),
@@ -224,7 +240,8 @@ Scene::Scene(const RenderInput& in)
   }
   preparing->work.wait();
   if (!preparing->order.empty()) hair.drawInOrder(*in.hair, preparing->order);
-  if (preparing->lightChords) lightLines = std::make_unique<LineStrips>(preparing->light);
+  lightRaster = std::move(preparing->lightRaster);
+  if (preparing->lightChords && !lightRaster) lightLines = std::make_unique<LineStrips>(preparing->light);
   if (preparing->cameraChords)
     cameraLines = std::make_unique<LineStrips>(preparing->camera, kCameraChunkVertices);
   preparing.reset();
@@ -245,7 +262,7 @@ LightDepth lightDepthPass(const Scene& scene) {
   const int n = scene.light.width;
   const float far[4] = {kBackgroundZ, kBackgroundZ, kBackgroundZ, kBackgroundZ};
   const float one = 1.0f;
-  LightDepth depth{Texture(GL_R32F, n, n), Texture(GL_R32F, n, n)};
+  LightDepth depth{Texture(GL_R32F, n, n), Texture(GL_R32F, n, n), {}};
   glEnable(GL_DEPTH_TEST);
   glDepthFunc(GL_LESS);
   glDisable(GL_CULL_FACE);
@@ -265,11 +282,16 @@ LightDepth lightDepthPass(const Scene& scene) {
     fb.bind();
     glClearBufferfv(GL_COLOR, 0, far);
     glClearBufferfv(GL_DEPTH, 0, &one);
-    const Program& p = scene.programs.hairDepth;
-    p.use();
-    setView(p, scene.light);
-    setHairWidth(p, scene.light, scene.settings);
-    scene.hair.drawLines(scene.lightLines.get());
+    if (scene.lightRaster) {
+      depth.hairStartTexels = scene.lightRaster->depth(kBackgroundZ);
+      glTextureSubImage2D(depth.hairStart.id, 0, 0, 0, n, n, GL_RED, GL_FLOAT, depth.hairStartTexels.data());
+    } else {
+      const Program& p = scene.programs.hairDepth;
+      p.use();
+      setView(p, scene.light);
+      setHairWidth(p, scene.light, scene.settings);
+      scene.hair.drawLines(scene.lightLines.get());
+    }
   }
   checkGl("the light's depth pass");
   return depth;
@@ -278,6 +300,13 @@ LightDepth lightDepthPass(const Scene& scene) {
 Texture deepOpacityPass(const Scene& scene, const LightDepth& depth) {
   const int n = scene.light.width;
   Texture opacity(GL_RGBA32F, n, n, GL_LINEAR);
+  if (scene.lightRaster) {
+    const std::vector<glm::vec4> sums = scene.lightRaster->opacity(
+        depth.hairStartTexels, glm::vec4(scene.settings.layerSizes), float(scene.settings.strandOpacity));
+    glTextureSubImage2D(opacity.id, 0, 0, 0, n, n, GL_RGBA, GL_FLOAT, sums.data());
+    checkGl("the deep opacity map's upload");
+    return opacity;
+  }
   Framebuffer fb({&opacity}, n, n, false);
   fb.bind();
   const float zero[4] = {0, 0, 0, 0};

@@ -18,6 +18,7 @@
 #include <optional>
 
 #include "libcore/render/gl_resources.h"
+#include "libcore/render/light_maps.h"
 #include "libcore/render/renderer.h"
 #include "libcore/render/views.h"
 
@@ -56,20 +57,27 @@ struct Scene {
   // The hair as chords for the light's passes and for the shading pass when it draws lines (null: every
   // point; a custom HairVert always gets every point, since what it does to them is its own).
   std::unique_ptr<LineStrips> lightLines, cameraLines;
+  // The light's chords on the CPU, when it draws the light's hair maps (RenderInput::lightMaps); then
+  // there are no lightLines.
+  std::unique_ptr<LightRaster> lightRaster;
   std::unique_ptr<HeadGeometry> head;  // null when there is no head to draw
   Programs programs;
 
   // Frees the geometry once the passes that draw it are done, so what follows (the readback, the
   // images' writing) does not run with the coupe still held: the light's chords after its passes, all
   // of it after the last pass.
-  void releaseLightLines() { lightLines.reset(); }
+  void releaseLightLines() {
+    lightLines.reset();
+    lightRaster.reset();
+  }
   void releaseGeometry();
 };
 
 // The light's depth maps, metres along its axis (kBackgroundZ where nothing was drawn).
 struct LightDepth {
-  Texture head;       // R32F: to the head
-  Texture hairStart;  // R32F: to where the hair begins
+  Texture head;                        // R32F: to the head
+  Texture hairStart;                   // R32F: to where the hair begins
+  std::vector<float> hairStartTexels;  // the same, when the CPU drew it (Scene::lightRaster)
 };
 
 // An image the shading pass draws and the resolve averages.

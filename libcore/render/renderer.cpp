@@ -41,7 +41,8 @@ RenderOutput renderHair(GlContext&, const RenderInput& in) {
   out.worldToNdc = scene.camera.proj * scene.camera.view;
   out.worldToLight = scene.light.proj * scene.light.view;
   out.timings.upload = seconds(clock);
-  if (in.uploaded) in.uploaded();
+  out.hairReadInPlace = scene.hair.readsInPlace();
+  if (in.uploaded && !out.hairReadInPlace) in.uploaded();
   auto passDone = [&] {
     if (in.progress) in.progress->advance();
   };
@@ -64,6 +65,7 @@ RenderOutput renderHair(GlContext&, const RenderInput& in) {
     passDone();
   }
   scene.releaseGeometry();
+  if (in.uploaded && out.hairReadInPlace) in.uploaded();
   readBack(image, motion ? &*motion : nullptr, in.keepDom ? &depth : nullptr, in.keepDom ? &opacity : nullptr,
            out);
   out.timings.readback = seconds(clock);

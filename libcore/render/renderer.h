@@ -45,9 +45,10 @@ struct RenderOutput {
   glm::dmat4 worldToCamera{1.0}, worldToNdc{1.0};
   glm::dmat4 worldToLight{1.0};
   RenderTimings timings;
-  int samples = 1;          // the samples used (Samples, clamped to what the device offers)
-  RenderSettings settings;  // what was rendered: the input's, with the camera and light the render stage
-                            // aimed when asked to frame the hair
+  int samples = 1;               // the samples used (Samples, clamped to what the device offers)
+  bool hairReadInPlace = false;  // whether the device read the hair where it lay (RenderInput::readInPlace)
+  RenderSettings settings;       // what was rendered: the input's, with the camera and light the render stage
+                                 // aimed when asked to frame the hair
 };
 
 // The frame before this one, for motion vectors: the same strands (as many points) and head (as many
@@ -68,9 +69,18 @@ struct RenderInput {
   bool keepDom = false;
   std::optional<PreviousFrame> previous;  // motion vectors in the beauty image when given
   Progress* progress = nullptr;           // advanced once per pass (renderPassCount of them)
-  // Called once the hair (and the frame before's) is on the GPU and renderHair reads it no more: the
-  // caller may free it then, so the passes do not run with both copies held.
+  // Who draws the hair into the light's maps: the CPU (light_maps.h) or OpenGL. kAuto: the CPU on a
+  // software rasteriser (llvmpipe), OpenGL on a GPU; OpenGL always for a custom HairVert, whose
+  // vertices only it can place.
+  enum class LightMaps { kAuto, kCpu, kGl };
+  LightMaps lightMaps = LightMaps::kAuto;
+  // Called once renderHair reads the hair (and the frame before's) no more, so the caller may free
+  // it: after the upload when the device holds a copy (the passes then do not run with both held);
+  // after the last pass that draws it when the device reads it in place (readInPlace).
   std::function<void()> uploaded;
+  // Let the device read the hair's large arrays where they lie, where it can (GL_AMD_pinned_memory,
+  // llvmpipe): no copy, no second coupe held while it is made. The same images either way.
+  bool readInPlace = true;
 };
 
 // The passes renderHair reports to its Progress: upload, light depth, opacity, shading, (motion,)
