@@ -50,6 +50,8 @@ RenderOutput renderStage(const CommonOptions& common, const Config& config, GlCo
   stats.counts()["strands"] = strands;
   stats.counts()["points"] = points;
   stats.counts()["samples"] = out.samples;
+  stats.json()["device"]["lightMaps"] = out.lightMapsOnCpu ? "cpu" : "opengl";
+  stats.json()["device"]["hairReadInPlace"] = out.hairReadInPlace;
   return out;
 }
 

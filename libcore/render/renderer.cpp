@@ -42,6 +42,7 @@ RenderOutput renderHair(GlContext&, const RenderInput& in) {
   out.worldToLight = scene.light.proj * scene.light.view;
   out.timings.upload = seconds(clock);
   out.hairReadInPlace = scene.hair.readsInPlace();
+  out.lightMapsOnCpu = scene.lightRaster != nullptr;
   if (in.uploaded && !out.hairReadInPlace) in.uploaded();
   auto passDone = [&] {
     if (in.progress) in.progress->advance();

@@ -47,6 +47,7 @@ struct RenderOutput {
   RenderTimings timings;
   int samples = 1;               // the samples used (Samples, clamped to what the device offers)
   bool hairReadInPlace = false;  // whether the device read the hair where it lay (RenderInput::readInPlace)
+  bool lightMapsOnCpu = false;   // whether the CPU drew the light's hair maps (RenderInput::lightMaps)
   RenderSettings settings;       // what was rendered: the input's, with the camera and light the render stage
                                  // aimed when asked to frame the hair
 };
