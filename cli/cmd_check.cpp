@@ -51,6 +51,8 @@ void registerCheck(CLI::App& app, int& exitCode) {
         report["meshConversion"] = config.setup.meshConversion.describe();
       const std::vector<std::string> fitted = fittedShapeLines(config.collision);
       if (!fitted.empty()) report["fittedShapes"] = fitted;
+      if (scene.wick && config.hairstyle.rootFlow.fitted)  // the Hairstyle Info line that freezes it
+        report["fittedRootFlow"] = fittedRootFlowLine(config.hairstyle);
       // Roots alone grow guides, but interpolate (and run) need a surface: what run refuses, said here.
       if (scene.wick && !config.setup.load && scene.wick->triangles.empty()) {
         const std::string why =

@@ -42,9 +42,32 @@ void fitCollision(Collision& collision, const Mesh& wick, const Mesh* head) {
   }
 }
 
+glm::dvec3 headWhorl(const Mesh& wick, const Mesh* head) {
+  const HeadFit fit = fitHead(head ? head->positions : std::vector<glm::vec3>{}, wick.positions, false);
+  return fit.centre + fit.semiAxes * (glm::dvec3(0.0, 2.0, -1.0) / std::sqrt(5.0));
+}
+
+void fitRootFlow(Hairstyle& style, const Mesh& wick, const Mesh* head) {
+  if (style.rootFlow.fitted) style.rootFlow.value = headWhorl(wick, head);
+}
+
+namespace {
+
+std::string tenthOfMillimetre(double v) {
+  return formatReal(std::round(v * 1e4) / 1e4);
+}
+
+}  // namespace
+
+std::string fittedRootFlowLine(const Hairstyle& style) {
+  const glm::dvec3& p = style.rootFlow.value;
+  return "RootFlow away-from " + tenthOfMillimetre(p.x) + " " + tenthOfMillimetre(p.y) + " " +
+         tenthOfMillimetre(p.z);
+}
+
 std::vector<std::string> fittedShapeLines(const Collision& collision) {
   std::vector<std::string> lines;
-  auto mm = [](double v) { return formatReal(std::round(v * 1e4) / 1e4); };  // a tenth of a millimetre
+  auto mm = tenthOfMillimetre;
   for (const CollisionShape& s : collision.shapes) {
     if (!s.fitted) continue;
     std::string line = std::string(s.kind == ShapeKind::kSphere ? "Sphere" : "Ellipsoid") + " " +
@@ -144,16 +167,8 @@ std::vector<SceneFinding> checkScene(const Config& config, const Mesh& wick, con
   // Follicles lean away from RootFlow's point: one far from this head (the bundled head's crown, in a
   // Hairstyle Info made for it) leans them all one way.
   const Hairstyle& style = config.hairstyle;
-  if (style.rootTilt > 0.0 && style.rootFlow.kind == RootFlow::Kind::kAwayFrom &&
+  if (style.rootTilt > 0.0 && style.rootFlow.kind == RootFlow::Kind::kAwayFrom && !style.rootFlow.fitted &&
       glm::length(style.rootFlow.value - centre) > std::max(diagonal, 0.05)) {
-    // The centre of the head: a shape fitted to its cranium, else the first round shape, else the wick's.
-    glm::dvec3 suggested = centre;
-    auto round = std::find_if(shapes.begin(), shapes.end(),
-                              [](const CollisionShape& s) { return s.kind != ShapeKind::kCuboid; });
-    if (fitted)
-      suggested = fittedShape->centre;
-    else if (round != shapes.end())
-      suggested = round->centre;
     auto point = [](const glm::dvec3& p) {
       auto r = [](double v) { return formatReal(std::round(v * 1000.0) / 1000.0); };
       return r(p.x) + " " + r(p.y) + " " + r(p.z);
@@ -161,7 +176,7 @@ std::vector<SceneFinding> checkScene(const Config& config, const Mesh& wick, con
     out.push_back({false, "RootFlow's point (" + point(style.rootFlow.value) + ") lies " +
                               formatReal(std::round(glm::length(style.rootFlow.value - centre) * 100) / 100) +
                               " m from the wick's centre, so every follicle leans one way; for this head, " +
-                              "RootFlow away-from " + point(suggested)});
+                              "RootFlow away-from auto (its whorl, " + point(headWhorl(wick, head)) + ")"});
   }
   // The camera: does it see the wick?
   if (!config.render.cameraAuto) {

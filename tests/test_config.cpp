@@ -244,6 +244,18 @@ TEST(Config, MissingKeysTakePhysicalDefaults) {
   EXPECT_GT(h.hairRadius1, h.hairRadius2);
 }
 
+TEST(Config, RootFlowAwayFromAutoIsFittedLaterAndSaysSoInTheDigest) {
+  Config config;
+  config.hairstyle = readHairstyle(text("HairLengths 0.1\nRootTilt 30\nRootFlow away-from AUTO\n"), {});
+  EXPECT_EQ(config.hairstyle.rootFlow.kind, RootFlow::Kind::kAwayFrom);
+  EXPECT_TRUE(config.hairstyle.rootFlow.fitted);
+  EXPECT_NE(config.canonicalText().find("Hairstyle.RootFlow away-from auto"), std::string::npos);
+  EXPECT_NE(inputError([] {
+              readHairstyle(text("HairLengths 0.1\nRootFlow away-from auto 1\n"), {});
+            }).find("away-from auto"),
+            std::string::npos);
+}
+
 TEST(Overrides, ReplaceAValueAndAddAMissingOne) {
   std::vector<Override> o = {parseOverride("Hairstyle.HairDensity=160"),
                              parseOverride("hairstyle.clump=0.5")};

@@ -95,6 +95,35 @@ TEST(SceneCheck, NamesTheUnitsOfAScalpInCentimetres) {
   EXPECT_NE(found[0].message.find("set MeshUnits cm"), std::string::npos) << found[0].message;
 }
 
+// RootFlow away-from auto: the whorl of the head read, behind its top; and the warning for a point made
+// for another head names it.
+TEST(RootTilt, AwayFromAutoIsTheWhorlOfTheHeadRead) {
+  const glm::dvec3 centre(0.0, 1.7, 0.02), axes(0.08, 0.09, 0.11);
+  Mesh head, wick;
+  head.positions = onEllipsoid(centre, axes, 1.0);
+  wick.positions = onEllipsoid(centre, axes, 0.4);
+  Config config;
+  config.hairstyle.rootTilt = 30.0;
+  config.hairstyle.rootFlow = {RootFlow::Kind::kAwayFrom, glm::dvec3(0, 0.14, -0.04)};  // the bundled head's
+  bool named = false;
+  for (const SceneFinding& f : checkScene(config, wick, &head))
+    named = named || f.message.find("RootFlow away-from auto") != std::string::npos;
+  EXPECT_TRUE(named) << "the warning names away-from auto";
+  config.hairstyle.rootFlow.fitted = true;
+  fitRootFlow(config.hairstyle, wick, &head);
+  const glm::dvec3 whorl = config.hairstyle.rootFlow.value;
+  const glm::dvec3 expected = centre + axes * glm::dvec3(0.0, 2.0, -1.0) / std::sqrt(5.0);
+  EXPECT_LT(glm::length(whorl - expected), 0.01) << whorl.x << " " << whorl.y << " " << whorl.z;
+  for (const SceneFinding& f : checkScene(config, wick, &head))
+    EXPECT_EQ(f.message.find("RootFlow"), std::string::npos) << f.message;
+  // A follicle in front of the whorl leans forward, one behind it backward.
+  const glm::dvec3 front = centre + axes * glm::dvec3(0, 0.6, 0.8),
+                   back = centre + axes * glm::dvec3(0, 0.0, -1.0);
+  EXPECT_GT(config.hairstyle.growDirection(front, glm::normalize((front - centre) / (axes * axes))).z,
+            glm::normalize((front - centre) / (axes * axes)).z);
+  EXPECT_LT(config.hairstyle.growDirection(back, glm::dvec3(0, 0, -1)).y, 0.0);
+}
+
 TEST(RootTilt, LeansTheFollicleTowardTheFlowByTheAngle) {
   Hairstyle h;
   const glm::dvec3 n(0, 0, 1);

@@ -341,8 +341,8 @@ Key<Hairstyle> rootFlowKey() {
   return customKey<Hairstyle>(
       {"RootFlow", "m",
        "the direction follicles lean toward: down, a vector x y z, or away-from x y z (a point, e.g. the "
-       "crown)"},
-      "down | x y z | away-from x y z", "",
+       "crown) or away-from auto (the whorl of the head read, README Real heads)"},
+      "down | x y z | away-from x y z | away-from auto", "",
       [](SectionReader& r, Hairstyle& h) {
         const ConfigLine* line = r.line("RootFlow");
         if (!line) return;
@@ -350,8 +350,13 @@ Key<Hairstyle> rootFlowKey() {
         const std::string first = toLower(v[0]);
         if (first == "down" && v.size() == 1) return;
         const bool away = first == "away-from";
+        if (away && v.size() == 2 && toLower(v[1]) == "auto") {
+          h.rootFlow.kind = RootFlow::Kind::kAwayFrom;
+          h.rootFlow.fitted = true;
+          return;
+        }
         if (v.size() != (away ? 4u : 3u))
-          throw r.error(*line, "RootFlow takes down, a direction x y z, or away-from x y z");
+          throw r.error(*line, "RootFlow takes down, a direction x y z, away-from x y z or away-from auto");
         glm::dvec3 value;
         for (int i = 0; i < 3; ++i)
           value[i] = r.checkReal(*line, away + i, Range::closed(-1e4, 1e4), "RootFlow");
@@ -361,6 +366,8 @@ Key<Hairstyle> rootFlowKey() {
       },
       [](const Hairstyle& h) {
         if (h.rootTilt <= 0.0 || h.rootFlow.kind == RootFlow::Kind::kDown) return std::vector<std::string>{};
+        if (h.rootFlow.fitted)
+          return std::vector<std::string>{"away-from auto"};  // the head's digest decides
         return std::vector<std::string>{
             std::string(h.rootFlow.kind == RootFlow::Kind::kAwayFrom ? "away-from " : "") +
             join(h.rootFlow.value)};

@@ -311,6 +311,10 @@ std::string formatSetupReport(const nlohmann::ordered_json& report) {
     out << "  fitted collision shapes (to freeze them, put these lines in the Collision Info):\n";
     for (const auto& line : report["fittedShapes"]) out << "    " << line.get<std::string>() << "\n";
   }
+  if (report.contains("fittedRootFlow"))
+    out << "  the head's whorl, where the follicles lean away from (to freeze it, in the Hairstyle Info):\n  "
+           "  "
+        << report["fittedRootFlow"].get<std::string>() << "\n";
   if (report.contains("work"))
     for (const auto& w : report["work"])
       out << "  " << w["stage"].get<std::string>() << ": about " << formatBytes(w["bytes"].get<uint64_t>())
