@@ -312,8 +312,9 @@ void registerRender(CLI::App& app, int& exitCode) {
         // In a sequence the head moves with its keys (Dynamics Info), as the hair's roots did.
         std::optional<Mesh> posedHead = poseHead(f);
         stats.add("read", clock.lap());
-        // Without motion vectors the frame's hair has no use once it is on the GPU: freed then, the
-        // passes run without a second copy of it (a 150,000-strand coupe's 230 MB).
+        // Without motion vectors the frame's hair has no use once the render reads it no more: freed
+        // then (after the upload where the device copies it, so the passes run without a second copy
+        // of a 150,000-strand coupe's 230 MB).
         frameOptions.uploaded = nullptr;
         if (!options->motion) frameOptions.uploaded = [&hair] { hair = Strands{}; };
         FrameBefore before{hairBefore ? &*hairBefore : nullptr, headBefore ? &*headBefore

@@ -66,8 +66,9 @@ struct RenderOptions {
   // A sequence names its shot's first frame, so the camera holds still over the shot.
   const Strands* framing = nullptr;
   Progress* progress = nullptr;  // advanced once per pass (renderPassCount)
-  // Called once the hair is on the GPU and render() reads it no more (RenderInput::uploaded): a caller
-  // that has no more use for it may free it then.
+  // Called once render() reads the hair no more (RenderInput::uploaded: after the upload when the
+  // device copies it, after the last pass when it reads it in place): a caller that has no more use for
+  // it may free it then.
   std::function<void()> uploaded;
 };
 

@@ -36,7 +36,7 @@ struct ShadeTimings {
 
 struct ShadeResult {
   Strands coupe;
-  HairVolume volume;
+  HairVolume volume;  // its distance exact everywhere only with ShadeOptions::distanceEverywhere
   ShadeTimings timings;
 };
 

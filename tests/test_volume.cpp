@@ -132,9 +132,13 @@ TEST(Volume, Coupe3NormalsPointAwayFromTheHeadOnTheOutside) {
 TEST(Volume, NormalsFromTheDistanceWhereTheyReadItAreTheWholeGridsBits) {
   Strands snapped = coupe3().coupe;
   for (glm::vec3& p : snapped.points) p = glm::round(p / 0.004f) * 0.004f;
-  for (const Strands* coupe : {&coupe3().coupe, const_cast<const Strands*>(&snapped)}) {
-    const HairVolume whole = buildVolume(*coupe, 0.004, 3, 0.25, true),
-                     part = buildVolume(*coupe, 0.004, 3, 0.25, false);
+  // Padding 0 puts vertices in the grid's last cells, where the corners and the gradients' neighbours
+  // are clamped.
+  for (const auto& [coupe, padding] :
+       {std::pair{&coupe3().coupe, 3}, std::pair{static_cast<const Strands*>(&snapped), 3},
+        std::pair{&coupe3().coupe, 0}}) {
+    const HairVolume whole = buildVolume(*coupe, 0.004, padding, 0.25, true),
+                     part = buildVolume(*coupe, 0.004, padding, 0.25, false);
     const std::vector<uint8_t> read = nodesNormalsRead(part.distance, coupe->points);
     size_t flagged = 0, differ = 0;
     for (size_t id = 0; id < read.size(); ++id) {

@@ -29,6 +29,9 @@ openvdb::FloatGrid::Ptr toVdb(const Grid& grid, float background, bool everyNode
 }  // namespace
 
 void writeVdb(const std::filesystem::path& path, const HairVolume& volume) {
+  if (!volume.distanceEverywhere)  // a caller's slip, not the user's: the file would lie away from the hair
+    throw Error(ExitCode::kWorkFailed, {path.string(), 0},
+                "the volume's distance was computed only near the hair; shade it with distanceEverywhere");
   openvdb::initialize();
   openvdb::FloatGrid::Ptr density = toVdb(volume.density, 0.0f, false);
   density->setName("density");

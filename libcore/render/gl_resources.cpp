@@ -193,7 +193,15 @@ void Framebuffer::bind() const {
   glViewport(0, 0, width, height);
 }
 
-bool readsInPlace() {
+bool softwareRasteriser() {
+  const char* renderer = reinterpret_cast<const char*>(glGetString(GL_RENDERER));
+  if (!renderer) return false;
+  const std::string name(renderer);
+  return name.find("llvmpipe") != std::string::npos || name.find("softpipe") != std::string::npos;
+}
+
+bool contextReadsInPlace() {
+  if (!softwareRasteriser()) return false;
   GLint count = 0;
   glGetIntegerv(GL_NUM_EXTENSIONS, &count);
   for (GLint i = 0; i < count; ++i) {
@@ -205,7 +213,8 @@ bool readsInPlace() {
 
 Buffer::Buffer(const void* data, size_t bytes, bool readInPlace) {
   constexpr size_t kLarge = size_t(8) << 20;
-  if (readInPlace && data && bytes >= kLarge && readsInPlace()) {
+  if (readInPlace && data && bytes >= kLarge && contextReadsInPlace()) {
+    checkGl("before a buffer read in place");  // so the error tested below is this call's
     // GL_AMD_pinned_memory: storage given at this target is the caller's memory itself, so a coupe is
     // neither copied nor held twice while it is uploaded (the render's peak: README, Performance).
     constexpr GLenum kExternalVirtualMemory = 0x9160;  // GL_EXTERNAL_VIRTUAL_MEMORY_BUFFER_AMD

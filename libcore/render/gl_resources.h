@@ -85,16 +85,20 @@ struct Framebuffer {
   int width = 0, height = 0;
 };
 
-// Whether the current context can read a large array in place, where it lies in the program's memory
-// (GL_AMD_pinned_memory: Mesa's llvmpipe has it; a GPU's driver mostly does not).
-bool readsInPlace();
+// Whether the current context rasterises in software (Mesa's llvmpipe or softpipe: its GL_RENDERER).
+bool softwareRasteriser();
 
-// A buffer holding `bytes` of `data` (at least 4 bytes, so an empty array still binds). With `inPlace`
-// and a context that reads in place, a large array is not copied: the buffer reads `data` where it
-// lies, which must then stay alive and unchanged until the buffer is deleted (`inPlace` then stays
-// true). Otherwise the buffer is immutable and holds a copy.
+// Whether the current context reads a large array in place, where it lies in the program's memory: a
+// software rasteriser with GL_AMD_pinned_memory (llvmpipe). Not a GPU, even one whose driver has the
+// extension (AMD's): it would read pinned host memory across the bus in every pass.
+bool contextReadsInPlace();
+
+// A buffer holding `bytes` of `data` (at least 4 bytes, so an empty array still binds). With
+// `readInPlace` and a context that reads in place, a large array is not copied: the buffer reads
+// `data` where it lies, which must then stay alive and unchanged until the buffer is deleted
+// (`inPlace` says so). Otherwise the buffer is immutable and holds a copy.
 struct Buffer {
-  Buffer(const void* data, size_t bytes, bool inPlace = false);
+  Buffer(const void* data, size_t bytes, bool readInPlace = false);
   ~Buffer();
   Buffer(const Buffer&) = delete;
   Buffer& operator=(const Buffer&) = delete;
@@ -157,7 +161,7 @@ struct HairGeometry {
   Buffer points, tangents, colors, normals, previous;
   bool hasColors, hasNormals, hasPrevious;
   // Whether a buffer reads the strands (or the frame before) where they lie.
-  bool readsInPlace() const {
+  bool readsStrandsInPlace() const {
     return points.inPlace || tangents.inPlace || colors.inPlace || normals.inPlace || previous.inPlace;
   }
   std::vector<GLint> lineFirsts, ribbonFirsts;

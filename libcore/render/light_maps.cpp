@@ -33,11 +33,15 @@ LightRaster::LightRaster(const Strands& hair, const std::vector<uint32_t>& strip
                         if (strips[i] == kRestartIndex) continue;
                         const glm::dvec4 p(glm::dvec3(hair.points[strips[i]]), 1.0);
                         const glm::dvec4 clip = toClip * p;
-                        if (!(clip.w > 0.0))
-                          continue;  // at or behind the light: not drawn (never so inside the scene's sphere)
+                        // Nearer than the near plane (or at or behind the light): OpenGL would clip
+                        // it; not drawn. Never so inside the scene's sphere with the light outside it,
+                        // which the CPU's maps need (passes.cpp).
+                        if (!(clip.w > 0.0) || clip.z < -clip.w) continue;
                         const double invW = 1.0 / clip.w;
-                        v = {float((clip.x * invW + 1.0) * half), float((clip.y * invW + 1.0) * half),
-                             float(invW), float(glm::dot(depthRow, p) * invW)};
+                        const double x = (clip.x * invW + 1.0) * half, y = (clip.y * invW + 1.0) * half;
+                        if (!(std::abs(x) < 1e9 && std::abs(y) < 1e9))
+                          continue;  // far off: floats stay finite
+                        v = {float(x), float(y), float(invW), float(glm::dot(depthRow, p) * invW)};
                       }
                     });
   // The segments: each pair of consecutive points of a strip, both projected.
@@ -113,21 +117,40 @@ void LightRaster::drawBand(int band, Fragment&& fragment) const {
     from = std::max(from, 0.0f);
     to = std::min(to, alongX ? last : float(rowHi - 1));
     if (!alongX) from = std::max(from, float(rowLo));
-    if (!(from <= to)) continue;     // nothing in the band or the map (or a NaN): no int of a huge float
-    if (alongX && dMinor != 0.0f) {  // the columns whose row can lie in the band, a column to spare
-      const float slope = dMinor / dMajor;
-      const float c0 = major0 + (float(rowLo) - minor0) / slope - 0.5f,
-                  c1 = major0 + (float(rowHi) - minor0) / slope - 0.5f;
-      from = std::max(from, std::floor(std::min(c0, c1)) - 1.0f);
-      to = std::min(to, std::ceil(std::max(c0, c1)) + 1.0f);
+    if (!(from <= to)) continue;  // nothing in the band or the map (or a NaN): no int of a huge float
+    // A fragment's row (or column) across the major axis, as the loop below computes it.
+    auto minorAt = [&](int m) { return std::floor(minor0 + (float(m) + 0.5f - major0) / dMajor * dMinor); };
+    if (alongX) {
+      // The columns whose row lies in the band: an interval, since the row is monotone in the column
+      // (every step of it rounds monotonically), found with the row's own arithmetic, so a band draws
+      // exactly the columns the per-column test below keeps (an estimate from the slope misses some
+      // where a row's rounding divided by a small slope is many columns).
+      const bool rising = (dMinor > 0.0f) == (dMajor > 0.0f);
+      // The first column in [lo, hi] where `past` holds (it holds from some column on), or hi + 1.
+      auto first = [](int lo, int hi, auto past) {
+        while (lo <= hi) {
+          const int mid = lo + (hi - lo) / 2;
+          if (past(mid))
+            hi = mid - 1;
+          else
+            lo = mid + 1;
+        }
+        return lo;
+      };
+      const int lo = int(from), hi = int(to);
+      const int begin = rising ? first(lo, hi, [&](int m) { return minorAt(m) >= float(rowLo); })
+                               : first(lo, hi, [&](int m) { return minorAt(m) < float(rowHi); });
+      const int end = rising ? first(lo, hi, [&](int m) { return minorAt(m) >= float(rowHi); })
+                             : first(lo, hi, [&](int m) { return minorAt(m) < float(rowLo); });
+      from = float(begin);
+      to = float(end - 1);
       if (!(from <= to)) continue;
     }
     for (int m = int(from); m <= int(to); ++m) {
-      const float t = (float(m) + 0.5f - major0) / dMajor;
-      const float minor = std::floor(minor0 + t * dMinor);
+      const float minor = minorAt(m);
       if (alongX ? (minor < float(rowLo) || minor >= float(rowHi)) : (minor < 0.0f || minor > last)) continue;
       const int column = alongX ? m : int(minor), row = alongX ? int(minor) : m;
-      fragment(size_t(row) * size_t(size_) + size_t(column), depthAt(t));
+      fragment(size_t(row) * size_t(size_) + size_t(column), depthAt((float(m) + 0.5f - major0) / dMajor));
     }
   }
 }

@@ -4,7 +4,8 @@
 // 150,000 strands. Here each strand's chords are projected once, sorted into bands of texel rows, and
 // each band is drawn by one thread in the strands' order: the same maps whatever the thread count.
 //
-// The rules are a one-texel line's, as OpenGL draws lines of width 1: along a segment's major axis,
+// The rules are a one-texel line's, close to OpenGL's for lines of width 1 (whose diamond-exit rule
+// differs at a line's ends): along a segment's major axis,
 // one fragment per texel column (or row) whose centre the segment passes, half-open at its end so a
 // strip's shared points are drawn once; the fragment's texel is the one the segment crosses at that
 // centre. Depth is interpolated perspective-correctly (as a varying is). The depth map keeps the

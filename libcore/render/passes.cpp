@@ -6,6 +6,7 @@
 #include <tbb/task_group.h>
 
 #include "glsl/embedded_glsl.h"
+#include "libcore/render/light_maps.h"
 #include "libcore/render/line_decimation.h"
 #include "libcore/render/shader_interface.h"
 
@@ -104,15 +105,6 @@ const PointArray& tangentsFor(const Strands& s, PointArray&& computed = {}) {
   if (!s.tangents.empty()) return s.tangents;
   computed = polylineTangents(s);
   return computed;
-}
-
-// Whether the context rasterises in software (Mesa's llvmpipe or softpipe), where the CPU draws the
-// light's maps faster than the driver (light_maps.h).
-bool softwareRasteriser() {
-  const char* renderer = reinterpret_cast<const char*>(glGetString(GL_RENDERER));
-  if (!renderer) return false;
-  const std::string name(renderer);
-  return name.find("llvmpipe") != std::string::npos || name.find("softpipe") != std::string::npos;
 }
 
 }  // namespace
@@ -250,6 +242,11 @@ Scene::Scene(const RenderInput& in)
 
 Scene::~Scene() = default;
 
+void Scene::releaseLightLines() {
+  lightLines.reset();
+  lightRaster.reset();
+}
+
 void Scene::releaseGeometry() {
   glBindVertexArray(0);
   hair.release();
@@ -277,32 +274,31 @@ LightDepth lightDepthPass(const Scene& scene) {
       scene.head->draw();
     }
   }
-  {
+  if (scene.lightRaster) {
+    depth.hairStartTexels = scene.lightRaster->depth(kBackgroundZ);
+    glTextureSubImage2D(depth.hairStart.id, 0, 0, 0, n, n, GL_RED, GL_FLOAT, depth.hairStartTexels.data());
+  } else {
     Framebuffer fb({&depth.hairStart}, n, n, true);
     fb.bind();
     glClearBufferfv(GL_COLOR, 0, far);
     glClearBufferfv(GL_DEPTH, 0, &one);
-    if (scene.lightRaster) {
-      depth.hairStartTexels = scene.lightRaster->depth(kBackgroundZ);
-      glTextureSubImage2D(depth.hairStart.id, 0, 0, 0, n, n, GL_RED, GL_FLOAT, depth.hairStartTexels.data());
-    } else {
-      const Program& p = scene.programs.hairDepth;
-      p.use();
-      setView(p, scene.light);
-      setHairWidth(p, scene.light, scene.settings);
-      scene.hair.drawLines(scene.lightLines.get());
-    }
+    const Program& p = scene.programs.hairDepth;
+    p.use();
+    setView(p, scene.light);
+    setHairWidth(p, scene.light, scene.settings);
+    scene.hair.drawLines(scene.lightLines.get());
   }
   checkGl("the light's depth pass");
   return depth;
 }
 
-Texture deepOpacityPass(const Scene& scene, const LightDepth& depth) {
+Texture deepOpacityPass(const Scene& scene, LightDepth& depth) {
   const int n = scene.light.width;
   Texture opacity(GL_RGBA32F, n, n, GL_LINEAR);
   if (scene.lightRaster) {
     const std::vector<glm::vec4> sums = scene.lightRaster->opacity(
         depth.hairStartTexels, glm::vec4(scene.settings.layerSizes), float(scene.settings.strandOpacity));
+    depth.hairStartTexels = {};  // up to 64 MB at 4096 texels: the texture holds them now
     glTextureSubImage2D(opacity.id, 0, 0, 0, n, n, GL_RGBA, GL_FLOAT, sums.data());
     checkGl("the deep opacity map's upload");
     return opacity;

@@ -18,11 +18,12 @@
 #include <optional>
 
 #include "libcore/render/gl_resources.h"
-#include "libcore/render/light_maps.h"
 #include "libcore/render/renderer.h"
 #include "libcore/render/views.h"
 
 namespace hairgen {
+
+class LightRaster;  // light_maps.h
 
 // The programs of one render: hairgen's stages (libcore/render/glsl/), or the Setup's custom ones in
 // their place (HairVert in every program that draws hair, HeadVert in every one that draws the head).
@@ -66,18 +67,16 @@ struct Scene {
   // Frees the geometry once the passes that draw it are done, so what follows (the readback, the
   // images' writing) does not run with the coupe still held: the light's chords after its passes, all
   // of it after the last pass.
-  void releaseLightLines() {
-    lightLines.reset();
-    lightRaster.reset();
-  }
+  void releaseLightLines();
   void releaseGeometry();
 };
 
 // The light's depth maps, metres along its axis (kBackgroundZ where nothing was drawn).
 struct LightDepth {
-  Texture head;                        // R32F: to the head
-  Texture hairStart;                   // R32F: to where the hair begins
-  std::vector<float> hairStartTexels;  // the same, when the CPU drew it (Scene::lightRaster)
+  Texture head;       // R32F: to the head
+  Texture hairStart;  // R32F: to where the hair begins
+  std::vector<float>
+      hairStartTexels;  // the same, when the CPU drew it (Scene::lightRaster), until the opacity pass
 };
 
 // An image the shading pass draws and the resolve averages.
@@ -88,7 +87,8 @@ struct ShadedImage {
 
 LightDepth lightDepthPass(const Scene& scene);
 // RGBA32F, one layer per channel, the light's map size.
-Texture deepOpacityPass(const Scene& scene, const LightDepth& depth);
+// Frees depth.hairStartTexels once it has read them.
+Texture deepOpacityPass(const Scene& scene, LightDepth& depth);
 // At sub-pixel resolution.
 ShadedImage shadingPass(const Scene& scene, const LightDepth& depth, const Texture& opacity);
 // At the image's resolution.

@@ -41,7 +41,7 @@ RenderOutput renderHair(GlContext&, const RenderInput& in) {
   out.worldToNdc = scene.camera.proj * scene.camera.view;
   out.worldToLight = scene.light.proj * scene.light.view;
   out.timings.upload = seconds(clock);
-  out.hairReadInPlace = scene.hair.readsInPlace();
+  out.hairReadInPlace = scene.hair.readsStrandsInPlace();
   out.lightMapsOnCpu = scene.lightRaster != nullptr;
   if (in.uploaded && !out.hairReadInPlace) in.uploaded();
   auto passDone = [&] {
@@ -49,7 +49,7 @@ RenderOutput renderHair(GlContext&, const RenderInput& in) {
   };
   passDone();
 
-  const LightDepth depth = lightDepthPass(scene);
+  LightDepth depth = lightDepthPass(scene);
   out.timings.lightDepth = seconds(clock);
   passDone();
   const Texture opacity = deepOpacityPass(scene, depth);

@@ -71,8 +71,8 @@ struct RenderInput {
   std::optional<PreviousFrame> previous;  // motion vectors in the beauty image when given
   Progress* progress = nullptr;           // advanced once per pass (renderPassCount of them)
   // Who draws the hair into the light's maps: the CPU (light_maps.h) or OpenGL. kAuto: the CPU on a
-  // software rasteriser (llvmpipe), OpenGL on a GPU; OpenGL always for a custom HairVert, whose
-  // vertices only it can place.
+  // software rasteriser (llvmpipe), OpenGL on a GPU. OpenGL always for a custom HairVert, whose
+  // vertices only it can place, and for a light inside the scene's sphere (no chords: passes.cpp).
   enum class LightMaps { kAuto, kCpu, kGl };
   LightMaps lightMaps = LightMaps::kAuto;
   // Called once renderHair reads the hair (and the frame before's) no more, so the caller may free

@@ -589,6 +589,7 @@ HairVolume buildVolume(const Strands& strands, double voxel, int padding, double
   splat(volume.density, strands.points);
   const Grid smooth = smoothed(volume.density);
   volume.iso = shellFraction * typicalDensity(smooth);
+  volume.distanceEverywhere = distanceEverywhere;
   if (distanceEverywhere) {
     volume.distance = signedDistance(smooth, volume.iso);
   } else {
@@ -640,10 +641,6 @@ inline __attribute__((always_inline)) void addCorners(std::integer_sequence<int,
    ...);
 }
 
-// Normals ∇S/|∇S| of up to 256 points: sampleGradient and the normalisation of volumeNormals, one stage
-// at a time over the block so each runs across points in vector registers (libcore/util/vectorise.h),
-// with the arithmetic of trilinear() per point. The cell is the truncation of the clamped grid
-// coordinate: it is never negative, where truncating is flooring.
 // The cells of up to 256 points (axis by axis, kNormalsBlock apart in `c`) and their fractions within
 // them (`f`): the truncated grid coordinate, clamped. Inlined into its callers, so each is built for
 // their instruction sets and the two find the same cells.
@@ -680,6 +677,10 @@ void flagCellsOfBlock(const Grid& grid, const glm::vec3* __restrict points, size
         .store(1, std::memory_order_relaxed);
 }
 
+// Normals ∇S/|∇S| of up to 256 points: sampleGradient and the normalisation of volumeNormals, one stage
+// at a time over the block so each runs across points in vector registers (libcore/util/vectorise.h),
+// with the arithmetic of trilinear() per point. The cell is the truncation of the clamped grid
+// coordinate: it is never negative, where truncating is flooring.
 HAIRGEN_VECTOR_CLONES
 void normalsOfBlock(const Grid& grid, const glm::vec3* __restrict gradients,
                     const glm::vec3* __restrict points, size_t count, glm::vec3* __restrict normals) {
@@ -732,8 +733,9 @@ std::vector<uint8_t> nodesNormalsRead(const Grid& grid, std::span<const glm::vec
         for (size_t p = r.begin(); p < r.end(); p += kNormalsBlock)
           flagCellsOfBlock(grid, &points[p], std::min(kNormalsBlock, r.end() - p), cells.data());
       });
-  // The cells' corners (clamped to the grid, as addCorner clamps them), then their axis neighbours
-  // (clamped, as nodeGradients clamps them).
+  // The cells' corners (clamped to the grid, as addCorner clamps them: a clamped corner is the cell's
+  // node or one beyond it, each flagged below), then their axis neighbours (clamped, as nodeGradients
+  // clamps them).
   std::vector<uint8_t> corners(count, 0), read(count, 0);
   auto clampedIndex = [&](int i, int j, int k) {
     return grid.index(std::clamp(i, 0, n.x - 1), std::clamp(j, 0, n.y - 1), std::clamp(k, 0, n.z - 1));
@@ -749,9 +751,6 @@ std::vector<uint8_t> nodesNormalsRead(const Grid& grid, std::span<const glm::vec
         corners[grid.index(i, j, k)] = any;
       }
   });
-  // A cell's clamped corner is the cell's own node or one beyond it, so the loop above flags it unless
-  // the grid is one node wide on an axis (the corner is then the cell itself, already flagged).
-  for (size_t id = 0; id < count; ++id) corners[id] |= cells[id];
   tbb::parallel_for(0, n.z, [&](int k) {
     for (int j = 0; j < n.y; ++j)
       for (int i = 0; i < n.x; ++i)

@@ -105,6 +105,7 @@ struct HairVolume {
   Grid density;   // strand points per voxel, as splatted
   Grid distance;  // metres, negative inside the shell
   double iso = 0.0;
+  bool distanceEverywhere = true;  // false: `distance` is exact only where the normals read it
 };
 // `distanceEverywhere` false: the distance is exact only at the nodes the strands' normals read
 // (nodesNormalsRead), so volumeNormals gives the same bits for a fraction of the work; true for a
