@@ -51,7 +51,8 @@ void registerCheck(CLI::App& app, int& exitCode) {
         report["meshConversion"] = config.setup.meshConversion.describe();
       const std::vector<std::string> fitted = fittedShapeLines(config.collision);
       if (!fitted.empty()) report["fittedShapes"] = fitted;
-      if (scene.wick && config.hairstyle.rootFlow.fitted)  // the Hairstyle Info line that freezes it
+      if (scene.wick && config.hairstyle.rootFlow.resolved &&
+          config.hairstyle.rootTilt > 0.0)  // to freeze it
         report["fittedRootFlow"] = fittedRootFlowLine(config.hairstyle);
       // Roots alone grow guides, but interpolate (and run) need a surface: what run refuses, said here.
       if (scene.wick && !config.setup.load && scene.wick->triangles.empty()) {

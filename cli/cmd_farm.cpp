@@ -424,7 +424,7 @@ void registerFarm(CLI::App& app, int& exitCode) {
       Config config = loadStageConfig(o.setup, o.common, SetupUse::kRun, stats);
       if (!o.frames.empty() && !config.dynamics.given)
         throw InputError("--frames: " + o.setup + " names no Dynamics Info; a still has no frames");
-      Mesh wick = readObj(config.setup.wickModel.path);
+      Mesh wick = readWick(config);  // as the stages read it: MeshUnits, MeshUpAxis, WickGroup, roots alone
       FarmPlanOptions options;
       options.hairgen = executablePath();
       options.setup = fs::absolute(o.setup).lexically_normal().string();

@@ -29,14 +29,14 @@ Scene readScene(const CommonOptions& options, Config& config, bool needWick, boo
   Scene scene;
   bool fits = false;
   for (const CollisionShape& s : config.collision.shapes) fits = fits || s.fitted;
-  fits = fits || config.hairstyle.rootFlow.fitted;
+  fits = fits || (needWick && config.hairstyle.rootFlow.fitted);  // only grow leans follicles
   if ((needWick || fits) && config.setup.wickModel.given()) scene.wick = readWick(config);
   if ((needHead || fits) && config.setup.headModel.given()) scene.head = readHead(config);
   const std::string applied = config.setup.meshConversion.describe();
   if (!applied.empty()) stats.json()["meshConversion"] = applied;
   if (!scene.wick) return scene;
   if (fits) fitCollision(config.collision, *scene.wick, scene.head ? &*scene.head : nullptr);
-  fitRootFlow(config.hairstyle, *scene.wick, scene.head ? &*scene.head : nullptr);
+  if (needWick) fitRootFlow(config.hairstyle, *scene.wick, scene.head ? &*scene.head : nullptr);
   std::string refusal;
   for (const SceneFinding& f : checkScene(config, *scene.wick, scene.head ? &*scene.head : nullptr)) {
     if (f.refuse && refusal.empty())

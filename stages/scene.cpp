@@ -42,13 +42,26 @@ void fitCollision(Collision& collision, const Mesh& wick, const Mesh* head) {
   }
 }
 
+// The whorl's direction from the fitted cranium's centre, in units of its semi-axes: up 2, back 1 (heads
+// face +z), a point of its surface 27° behind its top. Chosen so that on the bundled head it is the point
+// the default coupe was groomed with by eye.
+const glm::dvec3 kWhorl = glm::dvec3(0.0, 2.0, -1.0) / std::sqrt(5.0);
+
 glm::dvec3 headWhorl(const Mesh& wick, const Mesh* head) {
   const HeadFit fit = fitHead(head ? head->positions : std::vector<glm::vec3>{}, wick.positions, false);
-  return fit.centre + fit.semiAxes * (glm::dvec3(0.0, 2.0, -1.0) / std::sqrt(5.0));
+  const bool found = glm::all(glm::greaterThan(fit.semiAxes, glm::dvec3(0.0))) &&
+                     glm::all(glm::lessThan(fit.semiAxes, glm::dvec3(1e6)));
+  if (!found)
+    throw InputError("RootFlow away-from auto: no head could be fitted to " +
+                     std::string(head ? "the head and the wick" : "the wick") +
+                     " (too few points, or a flat patch); name the point, RootFlow away-from X Y Z");
+  return fit.centre + fit.semiAxes * kWhorl;
 }
 
 void fitRootFlow(Hairstyle& style, const Mesh& wick, const Mesh* head) {
-  if (style.rootFlow.fitted) style.rootFlow.value = headWhorl(wick, head);
+  if (!style.rootFlow.fitted) return;
+  style.rootFlow.value = headWhorl(wick, head);
+  style.rootFlow.resolved = true;
 }
 
 namespace {
@@ -60,9 +73,11 @@ std::string tenthOfMillimetre(double v) {
 }  // namespace
 
 std::string fittedRootFlowLine(const Hairstyle& style) {
+  // To a micrometre: near the whorl a follicle's lean turns fast with the point, and a tenth of a
+  // millimetre moved the default coupe's tips by up to 4 mm.
+  auto micrometre = [](double v) { return formatReal(std::round(v * 1e6) / 1e6); };
   const glm::dvec3& p = style.rootFlow.value;
-  return "RootFlow away-from " + tenthOfMillimetre(p.x) + " " + tenthOfMillimetre(p.y) + " " +
-         tenthOfMillimetre(p.z);
+  return "RootFlow away-from " + micrometre(p.x) + " " + micrometre(p.y) + " " + micrometre(p.z);
 }
 
 std::vector<std::string> fittedShapeLines(const Collision& collision) {
@@ -164,7 +179,7 @@ std::vector<SceneFinding> checkScene(const Config& config, const Mesh& wick, con
                                         "WickGroup (the scalp's faces) and HeadModel"
                                       : "the shapes fit another head; use Ellipsoid VOLUME PENALTY auto")});
   (void)near;
-  // Follicles lean away from RootFlow's point: one far from this head (the bundled head's crown, in a
+  // Follicles lean away from RootFlow's point: one far from this head (the bundled head's whorl, in a
   // Hairstyle Info made for it) leans them all one way.
   const Hairstyle& style = config.hairstyle;
   if (style.rootTilt > 0.0 && style.rootFlow.kind == RootFlow::Kind::kAwayFrom && !style.rootFlow.fitted &&
@@ -176,7 +191,7 @@ std::vector<SceneFinding> checkScene(const Config& config, const Mesh& wick, con
     out.push_back({false, "RootFlow's point (" + point(style.rootFlow.value) + ") lies " +
                               formatReal(std::round(glm::length(style.rootFlow.value - centre) * 100) / 100) +
                               " m from the wick's centre, so every follicle leans one way; for this head, " +
-                              "RootFlow away-from auto (its whorl, " + point(headWhorl(wick, head)) + ")"});
+                              "RootFlow away-from auto (its whorl; hairgen check prints the point)"});
   }
   // The camera: does it see the wick?
   if (!config.render.cameraAuto) {

@@ -20,7 +20,8 @@ void fitCollision(Collision& collision, const Mesh& wick, const Mesh* head);
 // `RootFlow away-from auto`: the point is the whorl of the head, where hair parts and flows away on
 // every side: on the cranium fitted as fitCollision fits it, behind its top, at (0, 2, −1)/√5 of its
 // semi-axes from its centre (hairgen's heads face +z). On the bundled head that is the default
-// coupe's own point, (0, 0.14, −0.04), to 1.3 mm. Does nothing unless RootFlow asks for it.
+// coupe's own point, (0, 0.14, −0.04), to 4 mm. Does nothing unless RootFlow asks for it; InputError
+// when no head can be fitted (too few points, a flat patch).
 glm::dvec3 headWhorl(const Mesh& wick, const Mesh* head);
 void fitRootFlow(Hairstyle& style, const Mesh& wick, const Mesh* head);
 // The Hairstyle Info line that freezes a fitted RootFlow ("RootFlow away-from x y z", to 0.1 mm).

@@ -386,13 +386,27 @@ wick_info)
   printf 'HairstyleInfo h.txt\nWickModel roots.obj\n' > "$tmp/setup.txt"
   expect_rc 0 "$hairgen" check "$tmp/setup.txt"
   expect_err "the wick has no faces, only points (roots)"
-  # RootFlow's point far from this wick (a Hairstyle Info made for another head): said, with a centre.
+  # RootFlow's point far from this wick (a Hairstyle Info made for another head): said, naming auto.
   printf 'HairLengths 0.05\nRootTilt 30\nRootFlow away-from 0 2 0\n' > "$tmp/h.txt"
   printf 'HairstyleInfo h.txt\nWickModel %s\n' "$src/configs/assets/wick.obj" > "$tmp/setup.txt"
   expect_rc 0 "$hairgen" check "$tmp/setup.txt"
   expect_err "RootFlow's point (0 2 0) lies"
+  expect_err "RootFlow away-from auto"
   expect_rc 0 "$hairgen" check "$src/configs/default/setup.txt"
   grep -q "RootFlow" "$tmp/err" && fail "the default coupe's RootFlow was warned of: $(cat "$tmp/err")"
+  # away-from auto: check prints the line that freezes the whorl, and grow with that line grows what
+  # grow with auto grows (the guides' bounds to a tenth of a millimetre).
+  auto=(--set "Hairstyle.RootFlow=away-from auto" --set Hairstyle.HairDensity=10)
+  expect_rc 0 "$hairgen" check "$src/configs/default/setup.txt" "${auto[@]}"
+  frozen=$(grep -o 'RootFlow away-from [-0-9.]* [-0-9.]* [-0-9.]*' "$tmp/out" | head -1)
+  [ -n "$frozen" ] || fail "check printed no RootFlow line for auto: $(cat "$tmp/out")"
+  expect_rc 0 "$hairgen" grow "$src/configs/default/setup.txt" "${auto[@]}" -q -o "$tmp/auto.hair"
+  expect_rc 0 "$hairgen" grow "$src/configs/default/setup.txt" --set Hairstyle.HairDensity=10 -q \
+    --set "Hairstyle.RootFlow=${frozen#RootFlow }" -o "$tmp/frozen.hair"
+  bounds() { "$hairgen" info "$1" --json | tr -d ' \n' | grep -o '"bounds":{[^}]*}' | grep -o '[-0-9.e]*[0-9]'; }
+  paste <(bounds "$tmp/auto.hair") <(bounds "$tmp/frozen.hair") |
+    awk '{ d = $1 - $2; if (d < 0) d = -d; if (d > 1e-4) bad = 1; n++ } END { exit bad || n != 6 }' ||
+    fail "auto and its frozen line grow different guides: $(paste <(bounds "$tmp/auto.hair") <(bounds "$tmp/frozen.hair"))"
   ;;
 hardening_flags)
   # Flags are validated like config values: no sign wrapping, no NaN passing a range.

@@ -249,7 +249,17 @@ TEST(Config, RootFlowAwayFromAutoIsFittedLaterAndSaysSoInTheDigest) {
   config.hairstyle = readHairstyle(text("HairLengths 0.1\nRootTilt 30\nRootFlow away-from AUTO\n"), {});
   EXPECT_EQ(config.hairstyle.rootFlow.kind, RootFlow::Kind::kAwayFrom);
   EXPECT_TRUE(config.hairstyle.rootFlow.fitted);
-  EXPECT_NE(config.canonicalText().find("Hairstyle.RootFlow away-from auto"), std::string::npos);
+  const std::string digest = config.digest();
+  EXPECT_NE(config.canonicalText().find("Hairstyle.RootFlow away-from auto\n"), std::string::npos);
+  config.hairstyle.rootFlow.value = glm::dvec3(0.1, 1.8, -0.04);  // the point found later: not in it
+  config.hairstyle.rootFlow.resolved = true;
+  EXPECT_EQ(config.digest(), digest);
+  Config named = config;
+  named.hairstyle = readHairstyle(text("HairLengths 0.1\nRootTilt 30\nRootFlow away-from 0 -1 0\n"), {});
+  EXPECT_NE(named.digest(), digest);
+  const Hairstyle set = readHairstyle(text("HairLengths 0.1\nRootTilt 30\n"),
+                                      {parseOverride("Hairstyle.RootFlow=away-from auto")});
+  EXPECT_TRUE(set.rootFlow.fitted);
   EXPECT_NE(inputError([] {
               readHairstyle(text("HairLengths 0.1\nRootFlow away-from auto 1\n"), {});
             }).find("away-from auto"),

@@ -157,13 +157,18 @@ TEST(LightRaster, ALineCoversOneTexelPerColumnWhoseCentreItPassesOnceAlongAStrip
 // A nearly flat line crossing a band's edge far from the origin, where a row's rounding divided by the
 // slope is many columns: each column is still drawn once, by whichever band its row falls in.
 TEST(LightRaster, ANearlyFlatLineAcrossABandEdgeCoversEveryColumnOnce) {
-  for (const float rise : {3e-4f, 2.5e-4f, 1.0f / 4096.0f}) {
-    const Strands s = strip({{0.25f, 3008.0f - rise / 2, -1.0f}, {1000.25f, 3008.0f + rise / 2, -1.0f}});
-    // A texel is drawn by the one band holding its row, so a column can be missed but not drawn twice.
-    const std::vector<float> depth = LightRaster(s, wholeStrip(2), texelView(4096)).depth(1e10f);
-    for (int x = 0; x < 1000; ++x) {
-      const int covered = (depth[size_t(3007) * 4096 + x] == 1.0f) + (depth[size_t(3008) * 4096 + x] == 1.0f);
-      ASSERT_EQ(covered, 1) << "column " << x << " rise " << rise;
+  // Rising and falling, drawn left to right and right to left.
+  for (const float rise : {3e-4f, 2.5e-4f, 1.0f / 4096.0f, -3e-4f}) {
+    for (const bool reversed : {false, true}) {
+      const glm::vec3 a{0.25f, 3008.0f - rise / 2, -1.0f}, b{1000.25f, 3008.0f + rise / 2, -1.0f};
+      const Strands s = reversed ? strip({b, a}) : strip({a, b});
+      // A texel is drawn by the one band holding its row, so a column can be missed but not drawn twice.
+      const std::vector<float> depth = LightRaster(s, wholeStrip(2), texelView(4096)).depth(1e10f);
+      for (int x = 0; x < 1000; ++x) {
+        const int covered =
+            (depth[size_t(3007) * 4096 + x] == 1.0f) + (depth[size_t(3008) * 4096 + x] == 1.0f);
+        ASSERT_EQ(covered, 1) << "column " << x << " rise " << rise << (reversed ? " reversed" : "");
+      }
     }
   }
 }
@@ -816,7 +821,8 @@ TEST(Render, TheCpusLightMapsAreOpenGlsToTheirEdges) {
   EXPECT_GT(hair, 10000u);
   EXPECT_LT(double(differ), 0.005 * double(hair)) << differ << " of " << hair << " texels";
   for (int layer = 0; layer < 4; ++layer)
-    EXPECT_NEAR(cpuSum[layer], oglSum[layer], 5e-3 * oglSum[layer]) << "layer " << layer + 1;
+    EXPECT_NEAR(cpuSum[layer], oglSum[layer], (layer == 3 ? 1e-3 : 5e-3) * oglSum[layer])
+        << "layer " << layer + 1;
   size_t pixels = 0, shadowed = 0;
   for (int y = 0; y < 240; ++y)
     for (int x = 0; x < 320; ++x) {

@@ -340,8 +340,8 @@ Key<Hairstyle> rootTiltKey() {
 Key<Hairstyle> rootFlowKey() {
   return customKey<Hairstyle>(
       {"RootFlow", "m",
-       "the direction follicles lean toward: down, a vector x y z, or away-from x y z (a point, e.g. the "
-       "crown) or away-from auto (the whorl of the head read, README Real heads)"},
+       "the direction follicles lean toward: down, a vector x y z, away-from x y z (a point, e.g. the "
+       "whorl), or away-from auto (the whorl of the head read, README Real heads)"},
       "down | x y z | away-from x y z | away-from auto", "",
       [](SectionReader& r, Hairstyle& h) {
         const ConfigLine* line = r.line("RootFlow");

@@ -4,6 +4,7 @@
 #include <cstdio>
 #include <numeric>
 #include <sstream>
+#include <stdexcept>
 
 #include "libcore/util/text.h"
 
@@ -64,6 +65,8 @@ bool ForceField::contains(const glm::dvec3& p) const {
 }
 
 glm::dvec3 RootFlow::at(const glm::dvec3& root) const {
+  if (fitted && !resolved)
+    throw std::logic_error("RootFlow away-from auto read before the head's whorl was found (fitRootFlow)");
   if (kind == Kind::kAwayFrom) {
     const glm::dvec3 d = root - value;
     return glm::length(d) > 0.0 ? glm::normalize(d) : glm::dvec3(0.0);

@@ -1,6 +1,7 @@
 #include "libcore/io/vdb_io.h"
 
 #include <algorithm>
+#include <stdexcept>
 
 #include <openvdb/io/File.h>
 #include <openvdb/openvdb.h>
@@ -30,8 +31,9 @@ openvdb::FloatGrid::Ptr toVdb(const Grid& grid, float background, bool everyNode
 
 void writeVdb(const std::filesystem::path& path, const HairVolume& volume) {
   if (!volume.distanceEverywhere)  // a caller's slip, not the user's: the file would lie away from the hair
-    throw Error(ExitCode::kWorkFailed, {path.string(), 0},
-                "the volume's distance was computed only near the hair; shade it with distanceEverywhere");
+    throw std::logic_error(
+        "writing " + path.string() +
+        ": the volume's distance was computed only near the hair (ShadeOptions::distanceEverywhere)");
   openvdb::initialize();
   openvdb::FloatGrid::Ptr density = toVdb(volume.density, 0.0f, false);
   density->setName("density");

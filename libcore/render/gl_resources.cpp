@@ -226,7 +226,8 @@ Buffer::Buffer(const void* data, size_t bytes, bool readInPlace) {
       inPlace = true;
       return;
     }
-    glDeleteBuffers(1, &id);  // refused: a copy, as below
+    clearGlErrors();  // refused (every flag it raised): a copy, as below
+    glDeleteBuffers(1, &id);
   }
   glCreateBuffers(1, &id);
   if (!data || bytes < kLarge) {

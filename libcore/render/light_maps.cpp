@@ -34,8 +34,8 @@ LightRaster::LightRaster(const Strands& hair, const std::vector<uint32_t>& strip
                         const glm::dvec4 p(glm::dvec3(hair.points[strips[i]]), 1.0);
                         const glm::dvec4 clip = toClip * p;
                         // Nearer than the near plane (or at or behind the light): OpenGL would clip
-                        // it; not drawn. Never so inside the scene's sphere with the light outside it,
-                        // which the CPU's maps need (passes.cpp).
+                        // the segment and draw the rest; this drops it. Never so inside the scene's sphere
+                        // with the light outside it, which the CPU's maps need (passes.cpp).
                         if (!(clip.w > 0.0) || clip.z < -clip.w) continue;
                         const double invW = 1.0 / clip.w;
                         const double x = (clip.x * invW + 1.0) * half, y = (clip.y * invW + 1.0) * half;
@@ -148,7 +148,8 @@ void LightRaster::drawBand(int band, Fragment&& fragment) const {
     }
     for (int m = int(from); m <= int(to); ++m) {
       const float minor = minorAt(m);
-      if (alongX ? (minor < float(rowLo) || minor >= float(rowHi)) : (minor < 0.0f || minor > last)) continue;
+      if (alongX ? !(minor >= float(rowLo) && minor < float(rowHi)) : !(minor >= 0.0f && minor <= last))
+        continue;
       const int column = alongX ? m : int(minor), row = alongX ? int(minor) : m;
       fragment(size_t(row) * size_t(size_) + size_t(column), depthAt((float(m) + 0.5f - major0) / dMajor));
     }

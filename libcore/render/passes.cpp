@@ -190,7 +190,7 @@ struct Scene::Preparation {
       if (lightChords) light = decimatedLineStrips(hair, lightTolerance);
       if (!lightOnCpu) return;
       lightRaster = std::make_unique<LightRaster>(hair, light, lightView);
-      light = {};  // projected into the raster: no chords to upload
+      std::vector<uint32_t>().swap(light);  // projected into the raster: no chords to upload
     });
     work.run([=, this, &hair] {
       if (ordered) order = frontToBack(hair, view);
@@ -298,7 +298,7 @@ Texture deepOpacityPass(const Scene& scene, LightDepth& depth) {
   if (scene.lightRaster) {
     const std::vector<glm::vec4> sums = scene.lightRaster->opacity(
         depth.hairStartTexels, glm::vec4(scene.settings.layerSizes), float(scene.settings.strandOpacity));
-    depth.hairStartTexels = {};  // up to 64 MB at 4096 texels: the texture holds them now
+    std::vector<float>().swap(depth.hairStartTexels);  // up to 64 MB at 4096 texels: the texture has them
     glTextureSubImage2D(opacity.id, 0, 0, 0, n, n, GL_RGBA, GL_FLOAT, sums.data());
     checkGl("the deep opacity map's upload");
     return opacity;
