@@ -168,9 +168,8 @@ std::vector<SceneFinding> checkScene(const Config& config, const Mesh& wick, con
   const size_t penalising = std::count_if(config.collision.shapes.begin(), config.collision.shapes.end(),
                                           [](const CollisionShape& s) { return s.penalty > 0.0; });
   const auto& shapes = config.collision.shapes;
-  const auto fittedShape =
-      std::find_if(shapes.begin(), shapes.end(), [](const CollisionShape& s) { return s.fitted; });
-  const bool fitted = fittedShape != shapes.end();
+  const bool fitted =
+      std::any_of(shapes.begin(), shapes.end(), [](const CollisionShape& s) { return s.fitted; });
   if (penalising > 0 && touching * 2 < wick.positions.size())
     out.push_back({false, "most of the wick lies more than 3 cm outside every collision shape (" +
                               std::to_string(wick.positions.size() - touching) + " of " +
