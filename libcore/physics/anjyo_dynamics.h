@@ -29,9 +29,14 @@
 //   departure pointing into it (D·F < α|D||F|, D the ellipsoid's gradient) is multiplied by ε.
 // - Joint limits and collisions are measured against the rest shape: a node may turn as much as it did at
 //   rest, and sink as deep into a shape as it sat at rest, so the styled shape is always allowed.
+// - Precision: the angles, which the recurrences integrate, are doubles; the geometry (frames, forces,
+//   positions, collisions) is computed in floats, the precision the caches store, sixteen strands at a
+//   time (anjyo_kernel.h). Positions are kept relative to the centre of the rest hair's bounds, where a
+//   float resolves a tenth of a micrometre on a head.
 #pragma once
 
 #include <array>
+#include <atomic>
 #include <cstdint>
 #include <vector>
 
@@ -40,15 +45,9 @@
 #include "libcore/config/params.h"
 #include "libcore/model/strands.h"
 #include "libcore/physics/head_motion.h"
+#include "libcore/util/uninitialised.h"
 
 namespace hairgen {
-
-// The frame a segment's angles are measured in: `rest` its rest direction, `pole` perpendicular to it,
-// `side` = pole × rest. θ is the latitude toward the pole and φ the longitude from the rest direction,
-// so the rest is (0, 0) exactly and sits on the equator.
-struct SegmentFrame {
-  glm::dvec3 rest, pole, side;
-};
 
 class AnjyoHair {
  public:
@@ -58,133 +57,147 @@ class AnjyoHair {
   AnjyoHair(const Strands& rest, const Hairstyle& style, const Dynamics& dynamics, const Collision& collision,
             uint64_t seed);
 
-  // How a step is computed; each gives the same bits. kStrands: strand by strand. kLanes: kLanes strands
-  // at a time in AVX-512 vectors, where the processor has it (else kStrands), falling back to the
-  // strand's arithmetic where a segment meets a shape or its joint limit, and for the frames that draw
-  // fluctuations. kFastest: kLanes.
-  enum class Kernel { kFastest, kStrands, kLanes };
-  static constexpr size_t kLanes = 8;  // strands a vector step takes at once
+  // The builds of the step (anjyo_kernel.inc), which give the same bits: kPortable for any x86-64, kAvx512
+  // where the processor has AVX-512 (else kPortable). kFastest: the fastest this processor runs.
+  enum class Kernel { kFastest, kPortable, kAvx512 };
+  static constexpr size_t kLanes = 16;  // strands a step takes at once
 
-  // One substep of `dt` seconds for every strand (in parallel; the result does not depend on the
-  // thread count or the kernel). `frame` and `firstSubstep` key the fluctuations, drawn at the first
-  // substep of every Fluctuation-th frame.
+  // One substep of `dt` seconds for every strand (in parallel; the result depends on neither the thread
+  // count nor the kernel). `frame` and `firstSubstep` key the fluctuations, drawn at the first substep of
+  // every Fluctuation-th frame.
   void step(const AccelerationField& field, double dt, int frame, bool firstSubstep,
             Kernel kernel = Kernel::kFastest);
 
-  // step(), then posedInto(pose, out), in one pass over the hair where the kernel allows (the lanes):
-  // the same bits, the hair read once.
+  // step(), then posedInto(pose, out), in one pass over the hair: the same bits, the hair read once.
   void stepAndPose(const AccelerationField& field, double dt, int frame, bool firstSubstep, const Pose& pose,
                    Strands& out, Kernel kernel = Kernel::kFastest);
 
   // The current hair in world coordinates: the head frame moved by `pose`. Points at rest are the input
   // points exactly; tangents are the input's, turned with their segment.
   Strands posed(const Pose& pose) const;
-  // The same into `out`, reusing its arrays (any kernel gives the same bits).
+  // The same into `out`, reusing its arrays.
   void posedInto(const Pose& pose, Strands& out, Kernel kernel = Kernel::kFastest) const;
 
-  // What a restart needs, kStateValues values per segment: θ and φ, and the previous substep's (their sin
-  // and cos are computed from them by arithmetic alone, anjyo_sincos.h, so a resumed run computes
-  // exactly what the unbroken one did). Laid out as the vector step reads it: a header of kStateHeader
-  // values (kStateTag, kLanes, kStateValues, then zeros), then per block of kLanes strands, per
-  // segment, per value, the block's lanes (a lane past its strand's end holds the rest state, zeros).
-  // The hair keeps its state in this layout, so `swapState` lends it to a frame's cache without a copy:
-  // swap it out, write the cache, swap it back (stepping in between is an error).
+  // What a restart needs, kStateValues floats per segment: θ and φ (within half a turn of 0), and their
+  // turn over the last substep (the velocity Verlet's; their sin and cos are computed from them by
+  // arithmetic alone, lane_trig.h, so a resumed run computes exactly what the unbroken one did). Laid
+  // out as the step reads it: a header of kStateHeader doubles (kStateTag, kLanes, kStateValues, then
+  // zeros), then per block of kLanes strands, per segment, per value, the block's lanes as floats, two
+  // to a double (a lane past its strand's end holds the rest state, zeros). The hair keeps its state in
+  // this layout, so `swapState` lends it to a frame's cache without a copy: swap it out, write the
+  // cache, swap it back (stepping in between is an error).
   static constexpr size_t kStateValues = 4, kStateHeader = 8;
-  static constexpr double kStateTag = 0x414e4a33;  // "ANJ3": a state of this layout
-  static constexpr double kMaxAngle = 1e5;         // radians: the most a restart state may hold
+  static constexpr double kStateTag = 0x414e4a35;  // "ANJ5": a state of this layout
+  static constexpr double kMaxAngle = 4.0;         // radians: the most an angle of a restart state may be
+  static constexpr double kMaxTurn = 1e3;          // radians: the most its turn in a substep may be
   std::vector<double> state() const { return state_; }
   void swapState(std::vector<double>& other) { state_.swap(other); }
   void restore(const std::vector<double>& state, const std::string& source);
-  // One segment's values (θ, φ, the previous θ, φ), and setting them.
+  // One segment's values (θ, φ, and their turns over the last substep), and setting them.
   std::array<double, kStateValues> segmentState(size_t strand, uint32_t j) const;
   void setSegmentState(size_t strand, uint32_t j, const std::array<double, kStateValues>& values);
 
   size_t segmentCount() const { return firstSegment_.back(); }
-  // Diagnostics for tests: every node's position (head frame), and each joint's turn in radians.
-  std::vector<glm::dvec3> nodes() const;
+  // The kernel's atan2 (which reads a moved segment's angles back) on kLanes pairs, for its tests.
+  static void atan2Lanes(const float (&y)[kLanes], const float (&x)[kLanes], float (&out)[kLanes],
+                         Kernel kernel = Kernel::kFastest);
+  // Every node's position in the head frame, as the step computes them (in floats), point by point.
+  std::vector<glm::dvec3> nodes(Kernel kernel = Kernel::kFastest) const;
 
  private:
-  bool fluctuates(int frame, bool firstSubstep) const;  // whether this substep draws the fluctuations
-  void stepStrand(size_t strand, const AccelerationField& field, double dt, int frame, bool fluctuate);
-  // The substep of the block of kLanes strands from s0 (anjyo_lanes.cpp): stepStrand's arithmetic lane by
-  // lane, bit for bit, in AVX-512 vectors (the processor must have it).
-  void stepLanes(size_t s0, const AccelerationField& field, double dt, const Pose* pose = nullptr,
-                 Strands* out = nullptr);
-  void poseLanes(size_t s0, const Pose& pose, Strands& out) const;  // posedInto's, the same way
-  // The new direction `placed` of segment i, from `node` (point nodeIndex − 1) after `before`: out of the
-  // collision shapes and within the joint limit; where it moved, the angles are read off it. Returns
-  // whether it moved.
-  struct Segment;
-  bool settle(const Segment& segment, size_t nodeIndex, const glm::dvec3& node, const glm::dvec3& before,
-              glm::dvec3& placed, double& theta, double& phi) const;
-  glm::dvec3 directionOf(size_t strand, uint32_t j) const;  // segment j's, from its angles
-  // Where segment j of `strand` keeps its first value in state_; value v is kLanes further on per v.
-  size_t stateAt(size_t strand, uint32_t j) const {
-    return kStateHeader + ((blockFirst_[strand / kLanes] + j) * kStateValues) * kLanes + strand % kLanes;
-  }
-
-  // What a step reads of a segment: its frame (README, Dynamics), d_i, c_i u_i m_i (1/m), ω² / c_i (the
-  // rest spring as an acceleration), and the turn allowed at the node before it (cos −2 where there is
-  // no limit). Kept only lane by lane (lanes_); segmentOf gathers one.
-  struct Segment {
-    SegmentFrame frame;
-    double length, coefficient, springOverC, cosAllowed, sinAllowed;
-  };
-  Segment segmentOf(size_t strand, uint32_t j) const;
-  // The state's values of a segment, in the restart layout.
-  enum StateValue { kTheta, kPhi, kThetaPrev, kPhiPrev };
-
   // Segment j of a block of kLanes consecutive strands, lane by lane (a lane past its strand's last
-  // segment holds zeros): what stepLanes reads of the segments, laid out for its vectors.
-  struct Lanes;  // anjyo_lanes.cpp
+  // segment holds zeros): its frame (README, Dynamics: `rest` its rest direction, `pole` perpendicular
+  // to it, `side` = pole × rest), d_i, c_i u_i m_i (1/m), ω² / c_i (the rest spring as an acceleration),
+  // and the turn allowed at the node before it (cos −2 where there is no limit).
   struct LaneSegment {
-    double rest[3][kLanes], pole[3][kLanes], side[3][kLanes];
-    double length[kLanes], coefficient[kLanes], springOverC[kLanes], cosAllowed[kLanes], sinAllowed[kLanes];
-    Segment at(size_t lane) const;  // lane `lane`'s values
-    void set(size_t lane, const Segment& segment);
+    float rest[3][kLanes], pole[3][kLanes], side[3][kLanes];
+    float length[kLanes], coefficient[kLanes], springOverC[kLanes], cosAllowed[kLanes], sinAllowed[kLanes];
   };
-  std::vector<LaneSegment> lanes_;
-  std::vector<size_t> blockFirst_;  // per block, its first LaneSegment, + 1
   // Point j of a block's strands, lane by lane (a lane past its strand's last point repeats it): the
-  // input point, the rest node and the input tangent that posing starts from (the input's floats, kept
-  // as floats: posing reads them once a frame). Block b's points start at blockFirst_[b] + b (one more
-  // point than segments per block).
+  // input point and tangent that posing starts from, and the rest node as the step computes it (relative
+  // to origin_).
   struct LanePoint {
-    float point[3][kLanes];
-    double forward[3][kLanes];
-    float tangent[3][kLanes];
+    float point[3][kLanes], forward[3][kLanes], tangent[3][kLanes];
   };
-  std::vector<LanePoint> lanePoints_;
+  // A collision shape as the kernel reads it, relative to origin_: its axes over its semi-axes for an
+  // ellipsoid (`scaled`), the squared distance from its centre beyond which no point touches it
+  // (`reach2`), and `slack`, how much deeper than at rest a node may sit before it is turned out (a
+  // millionth of the shape's size: a few float roundings, not contact).
+  struct LaneShape {
+    ShapeKind kind = ShapeKind::kSphere;
+    bool collides = false;  // a shape without penalty does not collide, as in grow
+    float centre[3] = {}, axes[3][3] = {}, half[3] = {}, scaled[3][3] = {};
+    float reach2 = 0.0f, slack = 0.0f;
+  };
+  // What a substep reads besides the hair: the field in floats (relative to origin_), the recurrences'
+  // constants, and the fluctuations' key.
+  struct StepParams {
+    float base[3], fieldBase[3], restAcceleration[3], omega[3], alpha[3], centre[3];
+    bool rotating = false, fluctuate = false;
+    float keep = 1.0f, dt2 = 0.0f, invDt = 0.0f;
+    uint64_t fluctuationBlock = 0;
+  };  // What setup needs besides the hair: each strand's length (per strand), ω² of the rest spring, the
+  // joint limit, and the inertia's arrangement (Dynamics Info's Inertia).
+  struct SetupParams {
+    const float* totals;
+    float omega2, cosLimit, sinLimit;
+    bool limited;  // a JointAngleLimit below 180°
+    int jointFrom, rootSegments;
+    float rootInertia, inertiaExponent;
+  };
+  // The kernel (anjyo_kernel.inc), one block of kLanes strands a call, built for any x86-64 and for
+  // AVX-512 (anjyo_lanes.cpp): measure and setup fill the segments, rest nodes and depths once the points
+  // are filled; step takes a substep (and poses it into `out` where given); pose and nodes read the
+  // state; angleTrig finds the sin and cos of a restored state's angles.
+  struct Kernels {
+    struct Portable;  // the kernel built for any x86-64 (anjyo_kernel.inc)
 
-  Strands rest_;  // every attribute of the rest guides but their points and tangents
-  PointArray restPoints_;
+    struct Avx512;  // and for AVX-512
+    static void measure(AnjyoHair& hair, size_t block, float* totals, std::atomic<size_t>& firstBad,
+                        Kernel kernel);
+    static void setup(AnjyoHair& hair, size_t block, const SetupParams& params, Kernel kernel);
+    static void angleTrig(AnjyoHair& hair, size_t block, Kernel kernel);
+    static void step(AnjyoHair& hair, size_t block, const StepParams& params, const Pose* pose, Strands* out,
+                     Kernel kernel);
+    static void pose(const AnjyoHair& hair, size_t block, const Pose& pose, Strands& out, Kernel kernel);
+    static void nodes(const AnjyoHair& hair, size_t block, std::vector<glm::dvec3>& out, Kernel kernel);
+    static void atan2(const float* y, const float* x, float* out, Kernel kernel);
+    static constexpr uint64_t kFluctuationKey = 0x666c756374ull;  // "fluct": apart from every other stream
+  };
+  enum StateValue { kTheta, kPhi, kThetaRate, kPhiRate };  // a segment's values in the state
+  // The sin and cos of a segment's current angles, as the step computed them (lane_trig.h), kept beside
+  // the state so that a step computes them once: per block, per segment, per value, the block's lanes.
+  static constexpr size_t kTrigValues = 4;
+  enum TrigValue { kSinTheta, kCosTheta, kSinPhi, kCosPhi };
+
+  bool fluctuates(int frame, bool firstSubstep) const;  // whether this substep draws the fluctuations
+  StepParams paramsOf(const AccelerationField& field, double dt, int frame, bool firstSubstep) const;
+  size_t blockCount() const { return blockFirst_.size() - 1; }
+  // Block segment i's state, its values' lanes one after the other (floats in state_'s doubles).
+  float* stateAt(size_t i) {
+    return reinterpret_cast<float*>(state_.data() + kStateHeader) + i * kStateValues * kLanes;
+  }
+  const float* stateAt(size_t i) const {
+    return reinterpret_cast<const float*>(state_.data() + kStateHeader) + i * kStateValues * kLanes;
+  }  // The kernel's arrays, written whole by the constructor (UninitialisedAllocator: not zeroed first).
+  std::vector<LaneSegment, UninitialisedAllocator<LaneSegment>> segments_;  // per block, blockFirst_[b] on
+  std::vector<size_t> blockFirst_;  // per block, its first LaneSegment, + 1
+  // Per block, blockFirst_[b] + b on (one more point than segments).
+  std::vector<LanePoint, UninitialisedAllocator<LanePoint>> points_;
+  // Per block point, per shape, kLanes: how deep it sat at rest (≥ 0).
+  std::vector<float, UninitialisedAllocator<float>> restDepth_;
+  std::vector<LaneShape> laneShapes_;
+
+  Strands rest_;                        // every attribute of the rest guides but their points and tangents
   std::vector<uint32_t> firstSegment_;  // per strand, + 1
   std::vector<double> state_;           // kStateValues per segment (the restart layout): all 0 at rest
-  std::vector<double> shapeReach2_;     // per shape: beyond this squared distance nothing reaches it
-  // Per shape, a test cheaper than penetration() that rules out most points (exact for ellipsoids,
-  // always "maybe" for the other shapes). `v` is the point less the shape's centre.
-  struct ShapeTest {
-    bool ellipsoid = false;
-    glm::dvec3 scaled[3] = {};  // the axes over the semi-axes
-    double near2 = 0.0;  // (1 + PseudoForce reach / smallest semi-axis)²: within the pseudo-force's reach
-    double ratio2(const glm::dvec3& v) const {
-      const glm::dvec3 r(glm::dot(v, scaled[0]), glm::dot(v, scaled[1]), glm::dot(v, scaled[2]));
-      return glm::dot(r, r);
-    }
-    bool mayBeInside(const glm::dvec3& v) const { return !ellipsoid || ratio2(v) < 1.0; }
-    bool mayBeWithin(const glm::dvec3& v) const { return !ellipsoid || ratio2(v) < near2; }
-  };
-  std::vector<ShapeTest> shapeTests_;
-  PointArray restTangents_;
-  std::vector<glm::dvec3> restForward_;         // the rest nodes as the forward recurrence computes them
-  std::vector<std::vector<double>> restDepth_;  // per shape, per node: the depth it sat at in the shape
-  std::vector<CollisionShape> shapes_;
-  int head_ = -1;  // the first ellipsoid (the pseudo-force head), an index into shapes_
+  std::vector<float, UninitialisedAllocator<float>> trig_;  // kTrigValues per segment: of state_'s angles
+  glm::dvec3 origin_{0.0};                                  // the centre of the rest hair's bounds
+  int head_ = -1;  // the first ellipsoid (the pseudo-force head), an index into shapes
   glm::dvec3 restAcceleration_;
-  double springOmega2_ = 0.0, damping_ = 0.0;
-  double jointLimit_ = M_PI;  // radians
-  int jointFrom_ = 1;
-  double pseudoAlpha_, pseudoEpsilon_, pseudoReach_;
+  double damping_ = 0.0;
+  double pseudoAlpha_, pseudoEpsilon_;
+  float pseudoNear2_ = 0.0f;  // (1 + PseudoForce reach / smallest semi-axis)²: within its reach
   double fluctuation_;
   int fluctuationEvery_, firstFrame_;
   uint64_t seed_;

@@ -3,8 +3,8 @@
 
 namespace hairgen {
 
-// Whether the vector kernels of 8 doubles (libcore/physics/anjyo_lanes.cpp, spring_lanes.cpp) can run:
-// AVX-512 F and DQ.
+// Whether the kernels built for AVX-512 F and DQ can run (libcore/physics/anjyo_lanes.cpp, 16 floats a
+// vector; spring_lanes.cpp, 8 doubles).
 inline bool hasAvx512() {
   static const bool has = __builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512dq");
   return has;
