@@ -99,14 +99,19 @@ WorkEstimate estimateGrow(const Hairstyle& style, const Collision& collision, si
   e.memoryKey = output >= scratch ? "Hairstyle.VisualityStep" : "Hairstyle.CollisionStep";
   const double perEvaluation =
       kSecondsPerElement * elements + kSecondsPerSample * samples * double(shapes) + 1e-9 * coordinates;
-  // Rosenbrock: MaxIter stages of sweeps over every coordinate. BFGS: what it takes in practice, 1.4-12
-  // values with gradients per coordinate on the bundled coupes (5, or MaxIter if fewer), a gradient
-  // costing 4 + coordinates/3 values (GrowCoupe3Bfgs: 9 at 12 coordinates; 62 at 192, 251 at 768).
-  const double evaluations =
-      style.minimiser == Minimiser::kBfgs
-          ? std::min(double(style.maxIter), 5.0) * coordinates * (4.0 + coordinates / 3.0)
-          : double(style.maxIter) * sweepsPerStage(elements) * coordinates;
-  e.seconds = guides * evaluations * perEvaluation / cores(threads);
+  // Rosenbrock: MaxIter stages of sweeps over every coordinate. BFGS: what it takes in practice, up to
+  // 200 values with gradients a guide (17-142 on the bundled coupes, 36 at 256 elements), each costing 2.5
+  // values whatever the coordinates (one walk up the rod and one back: 2.3 at 4 elements, 1.7 at 256)
+  // and the update of the dense inverse Hessian, 4 ns per entry (2.4 ms at 768 coordinates).
+  if (style.minimiser == Minimiser::kBfgs) {
+    const double bound = 2.0 * double(style.maxIter) * coordinates + 40.0;  // quasi_newton's
+    const double evaluations = std::min(bound, 200.0);
+    e.seconds =
+        guides * evaluations * (2.5 * perEvaluation + 4e-9 * coordinates * coordinates) / cores(threads);
+  } else {
+    const double evaluations = double(style.maxIter) * sweepsPerStage(elements) * coordinates;
+    e.seconds = guides * evaluations * perEvaluation / cores(threads);
+  }
   e.timeKey = kSecondsPerSample * samples * double(shapes) > kSecondsPerElement * elements
                   ? "Hairstyle.CollisionStep"
                   : "Hairstyle.HairLengths (fewer Super-Helix elements) or Hairstyle.MaxIter";

@@ -17,11 +17,7 @@
 namespace hairgen {
 
 // Penetration depth (metres, positive inside) of `p` into a shape, as the thesis defines it per kind.
-template <class T>
-T penetrationOf(const CollisionShape& shape, const Vec3<T>& p);
-inline double penetration(const CollisionShape& shape, const glm::dvec3& p) {
-  return penetrationOf(shape, p);
-}
+double penetration(const CollisionShape& shape, const glm::dvec3& p);
 
 struct EnergyTerms {
   double elastic = 0.0, gravity = 0.0, collision = 0.0;
@@ -35,8 +31,9 @@ class StrandEnergy {
 
   double operator()(std::span<const double> q) const { return terms(q).total(); }
   EnergyTerms terms(std::span<const double> q) const;
-  // The energy and its gradient ∂E/∂q, `gradient` sized like q: the derivatives of the same closed
-  // forms (dual.h), kGradientWidth coordinates per walk along the rod. The value is operator()'s.
+  // The energy and its gradient ∂E/∂q, `gradient` sized like q: the derivatives of the same closed forms,
+  // in one walk up the rod and one back (strand_energy.cpp). The value is operator()'s, bit for bit. Not
+  // for two threads at once on one StrandEnergy (it keeps the walk's samples in scratch arrays).
   double valueAndGradient(std::span<const double> q, std::span<double> gradient) const;
 
   // The rest shape's coordinates (the minimiser's start) and the energy scale used for Epsilon:
@@ -67,14 +64,12 @@ class StrandEnergy {
     size_t gridCount = 0;
     std::vector<double> offGrid;
   };
-  // The three sums of terms() for q of any scalar type, over the elements from `first` on, whose
-  // start frame is `start`: the elastic term itself, height (metres², × weight_ for gravity) and
+  // The three sums of terms(): the elastic term itself, height (metres², × weight_ for gravity) and
   // penalty (× collisionStep_ for the collision term).
-  template <class T>
-  void accumulate(std::span<const T> q, size_t first, const RodFrame& start, T& elastic, T& height,
-                  T& penalty) const;
-  template <class T>
-  T penalty(const Vec3<T>& p) const;
+  void accumulate(std::span<const double> q, double& elastic, double& height, double& penalty) const;
+  double penalty(const glm::dvec3& p) const;
+  // penalty(p) (the same bits), and its gradient ∂/∂p into `gradient`.
+  double penaltyAndGradient(const glm::dvec3& p, glm::dvec3& gradient) const;
   // Whether any point within `radius` of p may touch a shape (else its penalty is exactly 0).
   bool mayTouch(const glm::dvec3& p, double radius) const;
 
@@ -86,6 +81,21 @@ class StrandEnergy {
   std::vector<Shape> shapes_;
   std::vector<ElementSamples> samples_;
   double collisionStep_;
+  // valueAndGradient's walk: per element its start frame, end and displacement integral (world), and the
+  // range of its samples that touch a shape; per such sample its arc length along the element, the
+  // cos and sin of Ω u there, its position and the penalty's gradient there (Δs included).
+  struct WalkedElement {
+    RodFrame start;
+    glm::dvec3 end, integral;
+    double cosLength, sinLength;  // of Ω ℓ (HelixElement's)
+    size_t firstSample, endSample;
+  };
+  struct TouchingSample {
+    double u, cosX, sinX;
+    glm::dvec3 position, force;
+  };
+  mutable std::vector<WalkedElement> walkedElements_;
+  mutable std::vector<TouchingSample> touchingSamples_;
 };
 
 }  // namespace hairgen

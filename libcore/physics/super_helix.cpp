@@ -12,18 +12,15 @@
 namespace hairgen {
 namespace {
 
-template <class T>
-BasicHelixCoefficients<T> coefficients(const T& omega, const T& invOmega, double u) {
-  using std::cos, std::sin;
-  const T x = omega * u;
-  if (std::abs(valueOf(x)) < kHelixSeriesBelow) return helixCoefficients(omega, invOmega, u, T(1.0), T(0.0));
-  return helixCoefficients(omega, invOmega, u, cos(x), sin(x));
+HelixCoefficients coefficients(double omega, double invOmega, double u) {
+  const double x = omega * u;
+  if (std::abs(x) < kHelixSeriesBelow) return helixCoefficients(omega, invOmega, u, 1.0, 0.0);
+  return helixCoefficients(omega, invOmega, u, std::cos(x), std::sin(x));
 }
 
-template <class T>
-Vec3<T> rotate(const Vec3<T>& v, const Vec3<T>& w, const BasicHelixCoefficients<T>& k) {
-  Vec3<T> wv = crossOf(w, v);
-  return v + k.a * wv + k.b * crossOf(w, wv);
+glm::dvec3 rotate(const glm::dvec3& v, const glm::dvec3& w, const HelixCoefficients& k) {
+  const glm::dvec3 wv = glm::cross(w, v);
+  return v + k.a * wv + k.b * glm::cross(w, wv);
 }
 
 }  // namespace
@@ -39,41 +36,32 @@ RodFrame follicleFrame(const glm::dvec3& root, const glm::dvec3& normal) {
   return f;
 }
 
-template <class T>
-BasicHelixElement<T>::BasicHelixElement(const BasicRodFrame<T>& start, const Vec3<T>& darboux, double length)
+HelixElement::HelixElement(const RodFrame& start, const glm::dvec3& darboux, double length)
     : start_(start),
       w_(darboux),
-      omega_(lengthOf(darboux)),
-      invOmega_(omega_ > 0.0 ? T(1.0 / omega_) : T(0.0)),
+      omega_(glm::length(darboux)),
+      invOmega_(omega_ > 0.0 ? 1.0 / omega_ : 0.0),
       length_(length) {
-  using std::cos, std::sin;
-  wn0_ = crossOf(w_, start.n0);
-  wwn0_ = crossOf(w_, wn0_);
-  const T x = omega_ * length;
-  const bool series = std::abs(valueOf(x)) < kHelixSeriesBelow;
-  sinL_ = series ? T(0.0) : sin(x);
-  cosL_ = series ? T(1.0) : cos(x);
-  BasicHelixCoefficients<T> k = helixCoefficients(omega_, invOmega_, length, cosL_, sinL_);
+  wn0_ = glm::cross(w_, start.n0);
+  wwn0_ = glm::cross(w_, wn0_);
+  const double x = omega_ * length;
+  const bool series = std::abs(x) < kHelixSeriesBelow;
+  sinL_ = series ? 0.0 : std::sin(x);
+  cosL_ = series ? 1.0 : std::cos(x);
+  const HelixCoefficients k = helixCoefficients(omega_, invOmega_, length, cosL_, sinL_);
   end_.position = along(length, k);
   end_.n0 = rotate(start.n0, w_, k);
   end_.n1 = rotate(start.n1, w_, k);
-  end_.n2 = crossOf(end_.n0, end_.n1);  // the frame stays right-handed; one rotation fewer
+  end_.n2 = glm::cross(end_.n0, end_.n1);  // the frame stays right-handed; one rotation fewer
 }
 
-template <class T>
-Vec3<T> BasicHelixElement<T>::position(double u) const {
+glm::dvec3 HelixElement::position(double u) const {
   return along(u, coefficients(omega_, invOmega_, u));
 }
 
-template <class T>
-glm::dvec3 BasicHelixElement<T>::valuePosition(double u) const {
-  return valueAlong(u, coefficients(valueOf(omega_), valueOf(invOmega_), u));
-}
-
-template <class T>
-BasicRodFrame<T> BasicHelixElement<T>::frame(double u) const {
-  BasicHelixCoefficients<T> k = coefficients(omega_, invOmega_, u);
-  BasicRodFrame<T> f;
+RodFrame HelixElement::frame(double u) const {
+  const HelixCoefficients k = coefficients(omega_, invOmega_, u);
+  RodFrame f;
   f.position = along(u, k);
   f.n0 = rotate(start_.n0, w_, k);
   f.n1 = rotate(start_.n1, w_, k);
@@ -81,28 +69,24 @@ BasicRodFrame<T> BasicHelixElement<T>::frame(double u) const {
   return f;
 }
 
-template <class T>
-Vec3<T> BasicHelixElement<T>::displacementIntegral() const {
+glm::dvec3 HelixElement::displacementIntegral() const {
   // Integrating the centreline of the file comment over the element:
   //   ∫0^ℓ (r(u) − r(0)) du = ℓ²/2 n0 + ib (W×n0) + ic (W×(W×n0)),
   //   ib = ∫0^ℓ b du = (x − sin x)/Ω³,   ic = ∫0^ℓ c du = (x²/2 − 1 + cos x)/Ω⁴.
   const double l = length_;
-  const T x = omega_ * l;
-  T ib, ic;
-  if (std::abs(valueOf(x)) < kHelixSeriesBelow) {
-    const T x2 = x * x;
+  const double x = omega_ * l;
+  double ib, ic;
+  if (std::abs(x) < kHelixSeriesBelow) {
+    const double x2 = x * x;
     ib = l * l * l * (1.0 / 6.0 - x2 / 120.0 * (1.0 - x2 / 42.0 * (1.0 - x2 / 72.0)));
     ic = l * l * l * l * (1.0 / 24.0 - x2 / 720.0 * (1.0 - x2 / 56.0 * (1.0 - x2 / 90.0)));
   } else {
-    const T inv2 = invOmega_ * invOmega_;
+    const double inv2 = invOmega_ * invOmega_;
     ib = (x - sinL_) * inv2 * invOmega_;
     ic = (0.5 * x * x - 1.0 + cosL_) * inv2 * inv2;
   }
   return 0.5 * l * l * start_.n0 + ib * wn0_ + ic * wwn0_;
 }
-
-template class BasicHelixElement<double>;
-template class BasicHelixElement<EnergyGradient>;
 
 RodFrame advance(const RodFrame& start, const glm::dvec3& darboux, double u) {
   return HelixElement(start, darboux, u).end();
