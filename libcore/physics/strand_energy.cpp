@@ -137,36 +137,6 @@ bool StrandEnergy::mayTouch(const glm::dvec3& p, double radius) const {
   return false;
 }
 
-double StrandEnergy::penalty(const glm::dvec3& p) const {
-  // penetration() per kind (equal to it within rounding), with the cheap rejections first.
-  double sum = 0.0;
-  for (const Shape& shape : shapes_) {
-    const glm::dvec3 v = p - shape.shape.centre;
-    const double dist2 = glm::dot(v, v);
-    if (dist2 >= shape.reach2) continue;
-    double dent;
-    if (shape.shape.kind == ShapeKind::kEllipsoid) {
-      const glm::dvec3 scaled(glm::dot(v, shape.scaledAxes[0]), glm::dot(v, shape.scaledAxes[1]),
-                              glm::dot(v, shape.scaledAxes[2]));
-      const double ratio2 = glm::dot(scaled, scaled);
-      if (ratio2 >= shape.ratio2Outside) continue;
-      if (!(ratio2 > 0.0)) {
-        dent = penetration(shape.shape, p);
-      } else {
-        const double dist = std::sqrt(dist2);  // |local| = |v|: the axes are orthonormal
-        dent = dist / std::sqrt(ratio2) - dist;
-      }
-    } else if (shape.shape.kind == ShapeKind::kSphere) {
-      dent = shape.shape.halfExtents.x - std::sqrt(dist2);
-    } else {
-      dent = penetration(shape.shape, p);
-    }
-    const double d = dent + shape.extra;
-    if (d > 0.0) sum += 0.5 * shape.shape.penalty * d * d;
-  }
-  return sum;
-}
-
 void StrandEnergy::accumulate(std::span<const double> q, double& elastic, double& height,
                               double& penalty) const {
   for (size_t k = 0; k < lengths_.size(); ++k) {
@@ -195,10 +165,11 @@ EnergyTerms StrandEnergy::terms(std::span<const double> q) const {
   return {elastic, weight_ * height, penalty * collisionStep_};
 }
 
-double StrandEnergy::penaltyAndGradient(const glm::dvec3& p, glm::dvec3& gradient) const {
-  // penalty<double>'s operations in its order, each shape's ∂/∂p beside them.
+double StrandEnergy::penalty(const glm::dvec3& p, glm::dvec3* gradient) const {
+  // penetration() per kind (equal to it within rounding), with the cheap rejections first; with
+  // `gradient`, each shape's ∂/∂p beside it.
   double sum = 0.0;
-  gradient = glm::dvec3(0.0);
+  if (gradient) *gradient = glm::dvec3(0.0);
   for (const Shape& shape : shapes_) {
     const glm::dvec3 v = p - shape.shape.centre;
     const double dist2 = glm::dot(v, v);
@@ -213,30 +184,36 @@ double StrandEnergy::penaltyAndGradient(const glm::dvec3& p, glm::dvec3& gradien
       if (!(ratio2 > 0.0)) {
         dent = penetration(shape.shape, p);  // at the centre: the smallest semi-axis, flat
       } else {
-        // dent = |v|/ρ − |v|, ρ = |A v|: ∇ = (1/ρ − 1) v/|v| − |v|/ρ³ AᵀA v.
-        const double dist = std::sqrt(dist2), ratio = std::sqrt(ratio2);
+        const double dist = std::sqrt(dist2);  // |local| = |v|: the axes are orthonormal
+        const double ratio = std::sqrt(ratio2);
         dent = dist / ratio - dist;
-        const glm::dvec3 stretched =
-            scaled.x * shape.scaledAxes[0] + scaled.y * shape.scaledAxes[1] + scaled.z * shape.scaledAxes[2];
-        slope = (1.0 / ratio - 1.0) / dist * v - dist / (ratio2 * ratio) * stretched;
+        // dent = |v|/ρ − |v|, ρ = |A v|: ∇ = (1/ρ − 1) v/|v| − |v|/ρ³ AᵀA v.
+        if (gradient) {
+          const glm::dvec3 stretched = scaled.x * shape.scaledAxes[0] + scaled.y * shape.scaledAxes[1] +
+                                       scaled.z * shape.scaledAxes[2];
+          slope = (1.0 / ratio - 1.0) / dist * v - dist / (ratio2 * ratio) * stretched;
+        }
       }
     } else if (shape.shape.kind == ShapeKind::kSphere) {
       const double dist = std::sqrt(dist2);
       dent = shape.shape.halfExtents.x - dist;
-      if (dist > 0.0) slope = -v / dist;
+      if (gradient && dist > 0.0) slope = -v / dist;
     } else {
       dent = penetration(shape.shape, p);
-      // The nearest face's: dent = half − |local| along its axis (the first of equals, as std::min picks).
-      const glm::dvec3 local(glm::dot(v, shape.shape.axes[0]), glm::dot(v, shape.shape.axes[1]),
-                             glm::dot(v, shape.shape.axes[2]));
-      const glm::dvec3 dents = shape.shape.halfExtents - glm::abs(local);
-      const int inner = dents[2] < dents[1] ? 2 : 1, axis = dents[inner] < dents[0] ? inner : 0;
-      slope = (local[axis] < 0.0 ? 1.0 : -1.0) * shape.shape.axes[axis];
+      if (gradient) {
+        // The nearest face's: dent = half − |local| along its axis (the first of equals, as std::min
+        // picks).
+        const glm::dvec3 local(glm::dot(v, shape.shape.axes[0]), glm::dot(v, shape.shape.axes[1]),
+                               glm::dot(v, shape.shape.axes[2]));
+        const glm::dvec3 dents = shape.shape.halfExtents - glm::abs(local);
+        const int inner = dents[2] < dents[1] ? 2 : 1, axis = dents[inner] < dents[0] ? inner : 0;
+        slope = (local[axis] < 0.0 ? 1.0 : -1.0) * shape.shape.axes[axis];
+      }
     }
     const double d = dent + shape.extra;
     if (d > 0.0) {
       sum += 0.5 * shape.shape.penalty * d * d;
-      gradient += shape.shape.penalty * d * slope;
+      if (gradient) *gradient += shape.shape.penalty * d * slope;
     }
   }
   return sum;
@@ -338,7 +315,7 @@ double StrandEnergy::valueAndGradient(std::span<const double> q, std::span<doubl
   touchingSamples_.clear();
   auto touch = [&](double u, double cosX, double sinX, const glm::dvec3& p) {
     glm::dvec3 force;
-    penalty += penaltyAndGradient(p, force);
+    penalty += this->penalty(p, &force);
     if (force != glm::dvec3(0.0)) touchingSamples_.push_back({u, cosX, sinX, p, collisionStep_ * force});
   };
   forEachElement(root_, std::span(lengths_), q, [&](const HelixElement& e, double, size_t i) {

@@ -67,9 +67,8 @@ class StrandEnergy {
   // The three sums of terms(): the elastic term itself, height (metres², × weight_ for gravity) and
   // penalty (× collisionStep_ for the collision term).
   void accumulate(std::span<const double> q, double& elastic, double& height, double& penalty) const;
-  double penalty(const glm::dvec3& p) const;
-  // penalty(p) (the same bits), and its gradient ∂/∂p into `gradient`.
-  double penaltyAndGradient(const glm::dvec3& p, glm::dvec3& gradient) const;
+  // The penalty at p, and with `gradient` its gradient ∂/∂p there.
+  double penalty(const glm::dvec3& p, glm::dvec3* gradient = nullptr) const;
   // Whether any point within `radius` of p may touch a shape (else its penalty is exactly 0).
   bool mayTouch(const glm::dvec3& p, double radius) const;
 
