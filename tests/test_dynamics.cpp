@@ -288,6 +288,28 @@ TEST(AnjyoDynamics, TheFirstGuideWithAZeroLengthSegmentIsNamed) {
   }
 }
 
+// Guides of a single point each (no segment anywhere: the kernel's arrays are empty) step and pose to
+// their points, and a state of no segments restores.
+TEST(AnjyoDynamics, GuidesOfOnePointStayPut) {
+  Strands hair;
+  for (int s = 0; s < 20; ++s) hair.addStrand({glm::vec3(0.01f * float(s), 0.2f, -0.05f)});
+  Collision head;
+  head.shapes.push_back(
+      {ShapeKind::kEllipsoid, 0.0, 1.0, glm::dvec3(0.0), glm::dvec3(0.1), glm::dmat3(1.0), {}});
+  AnjyoHair dynamic(hair, Hairstyle{}, still(), head, 1);
+  EXPECT_EQ(dynamic.segmentCount(), 0u);
+  AccelerationField wind;
+  wind.base = {3.0, -9.81, 0.0};
+  Pose pose;
+  pose.translation = {0.0, 0.5, 0.0};
+  Strands posed;
+  dynamic.stepAndPose(wind, 1.0 / 24.0, 2, true, pose, posed);
+  ASSERT_EQ(posed.points.size(), hair.points.size());
+  for (size_t p = 0; p < hair.points.size(); ++p)
+    EXPECT_EQ(posed.points[p], glm::vec3(pose.apply(glm::dvec3(hair.points[p]))));
+  EXPECT_NO_THROW(dynamic.restore(dynamic.state(), "state"));
+}
+
 TEST(AnjyoDynamics, JointLimitsHoldAndSegmentsKeepTheirLength) {
   Fig11 f = fig11();
   Hairstyle style;
