@@ -8,7 +8,6 @@
 #include <cmath>
 #include <cstring>
 #include <functional>
-
 #include <limits>
 
 #include "libcore/physics/anjyo_dynamics.h"
@@ -308,6 +307,30 @@ TEST(AnjyoDynamics, GuidesOfOnePointStayPut) {
   for (size_t p = 0; p < hair.points.size(); ++p)
     EXPECT_EQ(posed.points[p], glm::vec3(pose.apply(glm::dvec3(hair.points[p]))));
   EXPECT_NO_THROW(dynamic.restore(dynamic.state(), "state"));
+}
+
+// The angles are kept within half a turn of 0. A segment nearly upside down (θ near π), turned by a
+// shape across that wrap or across its latitude's zero, keeps its true turn: the wrap's 2π must not
+// enter it, or a damped or rotating hair would spin.
+TEST(AnjyoDynamics, ATurnAcrossTheWrapKeepsItsSize) {
+  for (const auto& [z, radius] : {std::pair{0.05, 0.1}, std::pair{0.3, 0.31}}) {
+    Collision ball;
+    ball.shapes.push_back(
+        {ShapeKind::kSphere, 0.0, 1.0, glm::dvec3(0.0, 1.0, z), glm::dvec3(radius), glm::dmat3(1.0), {}});
+    Hairstyle style;
+    style.gravity = 0.0;
+    AnjyoHair dynamic(chain(glm::dvec3(0.0), {{0, -1, 0}}, 1.0), style, still(), ball, 1);
+    dynamic.setSegmentState(0, 0, {3.13, 0.0, 0.0, 0.0});  // hanging down, turned nearly up into the ball
+    for (int n = 0; n < 5; ++n) {
+      dynamic.step(AccelerationField{}, 0.01, 2, false);
+      const std::array<double, AnjyoHair::kStateValues> s = dynamic.segmentState(0, 0);
+      // The first step turns it out of the ball, by up to half a turn; after that it barely moves.
+      const double most = n == 0 ? M_PI : 0.1;
+      EXPECT_LE(std::abs(s[2]), most) << "ball at z " << z << ", step " << n << ": θ turned " << s[2];
+      EXPECT_LE(std::abs(s[3]), most) << "ball at z " << z << ", step " << n << ": φ turned " << s[3];
+      EXPECT_LE(std::abs(s[0]), M_PI + 1e-6);
+    }
+  }
 }
 
 TEST(AnjyoDynamics, JointLimitsHoldAndSegmentsKeepTheirLength) {

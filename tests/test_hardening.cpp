@@ -265,8 +265,8 @@ TEST(Hardening, AbsurdConfigsAreRefusedBeforeTheWork) {
   EXPECT_NE(inputError([&] { requireFits(estimateGrow(fine, head, 759, 2), false); }).find("--force"),
             std::string::npos);
   EXPECT_NO_THROW(requireFits(estimateGrow(fine, head, 759, 2), true));  // --force runs it
-  // BFGS takes tens of gradients a guide, each two walks along the rod: 256 elements on 759 follicles is a
-  // minute (32 s measured); on a million follicles, days.
+  // BFGS takes tens of gradients a guide, each two walks along the rod: 256 elements on 759 follicles is
+  // estimated at three minutes (32 s measured); on a million follicles, days.
   fine.minimiser = Minimiser::kBfgs;
   EXPECT_NO_THROW(requireFits(estimateGrow(fine, head, 759, 2), false));
   EXPECT_NE(inputError([&] { requireFits(estimateGrow(fine, head, 1000000, 2), false); }).find("--force"),

@@ -185,11 +185,34 @@ TEST(StrandEnergy, CollisionTermEqualsDirectSamplingOfEveryShape) {
   EXPECT_GE(touching, 15);  // the shapes are where the strands go
 }
 
+// A box's envelope is the box grown by `extra` on every face: its corners lie beyond the bounding
+// sphere's growth, and a straight strand past a grown corner still feels it.
+TEST(StrandEnergy, ABoxEnvelopeReachesItsCorners) {
+  Hairstyle style;
+  style.hairLengths = {0.05};
+  style.helixRadius = 0.0;  // straight, up from (0.025, −0.025, 0.025)
+  style.collisionStep = 0.002;
+  Collision box;
+  box.shapes.push_back(
+      {ShapeKind::kCuboid, 0.02, 1.0, glm::dvec3(0.0), glm::dvec3(0.01), glm::dmat3(1.0), {}});
+  RodFrame root = follicleFrame(glm::dvec3(0.025, -0.025, 0.025), glm::dvec3(0.0, 1.0, 0.0));
+  StrandEnergy energy(style, box, root, 1.0);
+  const std::vector<double> q = energy.restCoordinates();
+  std::vector<glm::dvec3> p;
+  sampleRod(root, style.hairLengths, q, sampleArcLengths(0.05, style.collisionStep, false), p, nullptr);
+  double direct = 0.0;
+  for (const glm::dvec3& x : p) {
+    const double d = penetration(box.shapes[0], x) + 0.02;  // each sample 0.035-0.04 m from the centre
+    if (d > 0.0) direct += 0.5 * d * d;
+  }
+  direct *= style.collisionStep;
+  ASSERT_GT(direct, 0.0);
+  EXPECT_NEAR(energy.terms(q).collision, direct, 1e-12 * direct);
+}
+
 TEST(StrandEnergy, GradientMatchesCentralDifferencesAndValueIsTheEnergys) {
-  // The forward-mode gradient of every term (elastic, closed-form gravity, penalties of the three
-  // kinds of shape, the series and closed-form branches, a straight element at W = 0) against
-  // central differences; 12 coordinates, so the second of two walks starts mid-element and is
-  // partly seeded.
+  // The gradient of every term (elastic, closed-form gravity, penalties of the three kinds of shape, the
+  // series and closed-form branches, a straight element at W = 0) against central differences.
   Hairstyle style;
   style.hairLengths = {0.03, 0.05, 0.04, 0.006};
   style.collisionStep = 0.004;

@@ -1,11 +1,12 @@
 // Anjyo et al. 1992 §3, as anjyo_dynamics.h describes it: the hair set up for the kernel
-// (anjyo_kernel.h), its state, and the substeps run block by block on every core.
+// (anjyo_kernel.inc), its state, and the substeps run block by block on every core.
 #include "libcore/physics/anjyo_dynamics.h"
 
 #include <algorithm>
 #include <atomic>
 #include <cmath>
 #include <cstring>
+#include <stdexcept>
 
 #include <tbb/parallel_for.h>
 
@@ -149,13 +150,17 @@ AnjyoHair::AnjyoHair(const Strands& rest, const Hairstyle& style, const Dynamics
     Kernels::measure(*this, b, totals.data(), firstBad, kernel);
   });
   if (firstBad < strands) {
+    // Its first segment whose length, as the kernel measures it in floats, is not positive.
     const size_t s = firstBad;
     const uint32_t p0 = rest.firstPoint[s];
     uint32_t j = 0;
-    while (j + 2 < rest.pointsOf(s) && glm::vec3(rest.points[p0 + j + 1]) != glm::vec3(rest.points[p0 + j]))
-      ++j;
+    for (; j + 2 < rest.pointsOf(s); ++j) {
+      const glm::vec3 chord = rest.points[p0 + j + 1] - rest.points[p0 + j];
+      if (!(std::sqrt(chord.x * chord.x + chord.y * chord.y + chord.z * chord.z) > 0.0f)) break;
+    }
     throw InputError("guide " + std::to_string(s) + " has two points at the same place (points " +
-                     std::to_string(j) + " and " + std::to_string(j + 1) + "); a segment needs a length");
+                     std::to_string(j) + " and " + std::to_string(j + 1) +
+                     "); a segment needs a length that floats can hold");
   }
   // The rest spring: RestFrequency, or the longest hair's first bending mode.
   const float longest = totals.empty() ? 0.0f : *std::max_element(totals.begin(), totals.end());
@@ -173,6 +178,11 @@ AnjyoHair::AnjyoHair(const Strands& rest, const Hairstyle& style, const Dynamics
   params.rootInertia = float(dynamics.rootInertia);
   params.inertiaExponent = float(dynamics.inertiaExponent);
   tbb::parallel_for(size_t(0), blocks, [&](size_t b) { Kernels::setup(*this, b, params, kernel); });
+}
+
+void AnjyoHair::requireState() const {
+  if (state_.size() < kStateHeader)
+    throw std::logic_error("AnjyoHair: stepped while its state was lent out (swapState)");
 }
 
 bool AnjyoHair::fluctuates(int frame, bool firstSubstep) const {
@@ -199,6 +209,7 @@ AnjyoHair::StepParams AnjyoHair::paramsOf(const AccelerationField& field, double
 }
 
 void AnjyoHair::step(const AccelerationField& field, double dt, int frame, bool firstSubstep, Kernel kernel) {
+  requireState();
   const StepParams params = paramsOf(field, dt, frame, firstSubstep);
   kernel = available(kernel);
   tbb::parallel_for(size_t(0), blockCount(),
@@ -207,6 +218,7 @@ void AnjyoHair::step(const AccelerationField& field, double dt, int frame, bool 
 
 void AnjyoHair::stepAndPose(const AccelerationField& field, double dt, int frame, bool firstSubstep,
                             const Pose& pose, Strands& out, Kernel kernel) {
+  requireState();
   const StepParams params = paramsOf(field, dt, frame, firstSubstep);
   kernel = available(kernel);
   out.assignRestKeepingBuffers(rest_);  // every attribute but the points and tangents is the rest's

@@ -29,10 +29,11 @@
 //   departure pointing into it (D·F < α|D||F|, D the ellipsoid's gradient) is multiplied by ε.
 // - Joint limits and collisions are measured against the rest shape: a node may turn as much as it did at
 //   rest, and sink as deep into a shape as it sat at rest, so the styled shape is always allowed.
-// - Precision: the angles, which the recurrences integrate, are doubles; the geometry (frames, forces,
-//   positions, collisions) is computed in floats, the precision the caches store, sixteen strands at a
-//   time (anjyo_kernel.h). Positions are kept relative to the centre of the rest hair's bounds, where a
-//   float resolves a tenth of a micrometre on a head.
+// - Precision: everything is floats, the precision the caches store, sixteen strands at a time
+//   (anjyo_kernel.inc). The recurrences are velocity Verlet: each segment keeps its angles (within half
+//   a turn of 0) and its turn over the last substep, so the turn keeps its own precision. Positions are
+//   kept relative to the centre of the rest hair's bounds, where a float resolves a tenth of a
+//   micrometre on a head.
 #pragma once
 
 #include <array>
@@ -93,7 +94,8 @@ class AnjyoHair {
   std::vector<double> state() const { return state_; }
   void swapState(std::vector<double>& other) { state_.swap(other); }
   void restore(const std::vector<double>& state, const std::string& source);
-  // One segment's values (θ, φ, and their turns over the last substep), and setting them.
+  // One segment's values (θ, φ, and their turns over the last substep), and setting them: segment j < the
+  // strand's segments, strand < the guides'.
   std::array<double, kStateValues> segmentState(size_t strand, uint32_t j) const;
   void setSegmentState(size_t strand, uint32_t j, const std::array<double, kStateValues>& values);
 
@@ -136,7 +138,8 @@ class AnjyoHair {
     bool rotating = false, fluctuate = false;
     float keep = 1.0f, dt2 = 0.0f, invDt = 0.0f;
     uint64_t fluctuationBlock = 0;
-  };  // What setup needs besides the hair: each strand's length (per strand), ω² of the rest spring, the
+  };
+  // What setup needs besides the hair: each strand's length (per strand), ω² of the rest spring, the
   // joint limit, and the inertia's arrangement (Dynamics Info's Inertia).
   struct SetupParams {
     const float* totals;
@@ -171,6 +174,7 @@ class AnjyoHair {
   enum TrigValue { kSinTheta, kCosTheta, kSinPhi, kCosPhi };
 
   bool fluctuates(int frame, bool firstSubstep) const;  // whether this substep draws the fluctuations
+  void requireState() const;  // throws std::logic_error while the state is lent out (swapState)
   StepParams paramsOf(const AccelerationField& field, double dt, int frame, bool firstSubstep) const;
   size_t blockCount() const { return blockFirst_.size() - 1; }
   // Block segment i's state, its values' lanes one after the other (floats in state_'s doubles).
@@ -179,7 +183,9 @@ class AnjyoHair {
   }
   const float* stateAt(size_t i) const {
     return reinterpret_cast<const float*>(state_.data() + kStateHeader) + i * kStateValues * kLanes;
-  }  // The kernel's arrays, written whole by the constructor (UninitialisedAllocator: not zeroed first).
+  }
+
+  // The kernel's arrays, written whole by the constructor (UninitialisedAllocator: not zeroed first).
   std::vector<LaneSegment, UninitialisedAllocator<LaneSegment>> segments_;  // per block, blockFirst_[b] on
   std::vector<size_t> blockFirst_;  // per block, its first LaneSegment, + 1
   // Per block, blockFirst_[b] + b on (one more point than segments).

@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <atomic>
 #include <cmath>
-#include <optional>
 
 #include "libcore/physics/anjyo_dynamics.h"
 #include "libcore/physics/float_lanes.h"

@@ -1,8 +1,8 @@
-// Sixteen lanes of floats (and of doubles, for what must keep double precision) for the step of Anjyo's
-// dynamics, which takes sixteen strands at once (anjyo_kernel.h). Written with GCC's vector extensions,
-// so one source builds for any x86-64 (each vector split into the registers the target has) and for
-// AVX-512 (one register a vector); every operation is one IEEE operation per lane, so both builds give
-// the same bits. The files using them are built without contraction into fused multiply-adds.
+// Sixteen lanes of floats for the step of Anjyo's dynamics, which takes sixteen strands at once
+// (anjyo_kernel.inc). Written with GCC's vector extensions, so one source builds for any x86-64 (each vector
+// split into the registers the target has) and for AVX-512 (one register a vector); every operation is one
+// IEEE operation per lane, so both builds give the same bits. The files using them are built without
+// contraction into fused multiply-adds.
 //
 // The few operations GCC builds poorly from the generic form (comparisons, which it split into one
 // scalar compare per lane in large functions, and square roots) are an instruction set's own: `Isa` is
@@ -21,8 +21,6 @@ constexpr size_t kWidth = 16;
 
 using F = float __attribute__((vector_size(kWidth * sizeof(float))));
 using I = int32_t __attribute__((vector_size(kWidth * sizeof(int32_t))));  // a mask: all ones or zero
-using D = double __attribute__((vector_size(kWidth * sizeof(double))));
-using L = int64_t __attribute__((vector_size(kWidth * sizeof(int64_t))));
 
 struct F3 {
   F x, y, z;
@@ -34,9 +32,6 @@ struct F3 {
 HAIRGEN_LANES16 F splat(float v) {
   return F{} + v;
 }
-HAIRGEN_LANES16 D splatD(double v) {
-  return D{} + v;
-}
 HAIRGEN_LANES16 F3 splat3(float x, float y, float z) {
   return {splat(x), splat(y), splat(z)};
 }
@@ -45,16 +40,8 @@ HAIRGEN_LANES16 F load(const float* v) {
   __builtin_memcpy(&r, v, sizeof(F));
   return r;
 }
-HAIRGEN_LANES16 D loadD(const double* v) {
-  D r;
-  __builtin_memcpy(&r, v, sizeof(D));
-  return r;
-}
 HAIRGEN_LANES16 void store(float* to, F v) {
   __builtin_memcpy(to, &v, sizeof(F));
-}
-HAIRGEN_LANES16 void storeD(double* to, D v) {
-  __builtin_memcpy(to, &v, sizeof(D));
 }
 HAIRGEN_LANES16 F3 load3(const float (&v)[3][kWidth]) {
   return {load(v[0]), load(v[1]), load(v[2])};
@@ -63,12 +50,6 @@ HAIRGEN_LANES16 void store3(float (&to)[3][kWidth], const F3& v) {
   store(to[0], v.x);
   store(to[1], v.y);
   store(to[2], v.z);
-}
-HAIRGEN_LANES16 F toF(D v) {
-  return __builtin_convertvector(v, F);
-}
-HAIRGEN_LANES16 D toD(F v) {
-  return __builtin_convertvector(v, D);
 }
 
 HAIRGEN_LANES16 F3 operator+(const F3& a, const F3& b) {
@@ -91,9 +72,6 @@ HAIRGEN_LANES16 F3 cross(const F3& a, const F3& b) {
 }
 HAIRGEN_LANES16 F select(I m, F a, F b) {
   return m ? a : b;
-}
-HAIRGEN_LANES16 D select(I m, D a, D b) {
-  return __builtin_convertvector(m, L) ? a : b;
 }
 HAIRGEN_LANES16 I select(I m, I a, I b) {
   return m ? a : b;

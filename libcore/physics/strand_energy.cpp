@@ -64,7 +64,10 @@ StrandEnergy::StrandEnergy(const Hairstyle& style, const Collision& collision, c
   for (const CollisionShape& s : collision.shapes) {
     if (!(s.penalty > 0.0)) continue;
     double extra = s.envelopeGrowth * envelope;
-    double reach = boundingRadius(s) + std::max(extra, 0.0);
+    // A cuboid's envelope is the box grown by `extra` on every face, whose corner is farther out than
+    // its bounding sphere's growth.
+    double reach = s.kind == ShapeKind::kCuboid ? glm::length(s.halfExtents + std::max(extra, 0.0))
+                                                : boundingRadius(s) + std::max(extra, 0.0);
     Shape shape{s, extra, reach, reach * reach, {}, HUGE_VAL};
     if (s.kind == ShapeKind::kEllipsoid) {
       for (int k = 0; k < 3; ++k) shape.scaledAxes[k] = s.axes[k] / s.halfExtents[k];
@@ -297,7 +300,7 @@ double integralOfC(double omega, double l, double cosX) {
 double StrandEnergy::valueAndGradient(std::span<const double> q, std::span<double> gradient) const {
   if (q.size() != 3 * lengths_.size() || gradient.size() != q.size())
     throw std::invalid_argument("valueAndGradient: q and gradient need 3 coordinates per element");
-  // The value: accumulate<double>'s sums in its order, so it is operator()'s to the bit.
+  // The value: accumulate's sums in its order, so it is operator()'s to the bit.
   const size_t elements = lengths_.size();
   double elastic = 0.0;
   for (size_t k = 0; k < elements; ++k) {
@@ -323,6 +326,7 @@ double StrandEnergy::valueAndGradient(std::span<const double> q, std::span<doubl
     walked.start = e.start();
     walked.end = e.end().position;
     walked.integral = e.displacementIntegral();
+    walked.omega = e.omega();
     walked.cosLength = e.cosLength();
     walked.sinLength = e.sinLength();
     walked.firstSample = touchingSamples_.size();
@@ -331,10 +335,8 @@ double StrandEnergy::valueAndGradient(std::span<const double> q, std::span<doubl
       const ElementSamples& samples = samples_[i];
       e.visitGrid(samples.first, collisionStep_, samples.gridCount,
                   [&](size_t, double u, double c, double s) { touch(u, c, s, e.at(u, c, s)); });
-      for (double u : samples.offGrid) {
-        const double x = glm::length(glm::dvec3(q[3 * i], q[3 * i + 1], q[3 * i + 2])) * u;
-        touch(u, std::cos(x), std::sin(x), e.position(u));
-      }
+      for (double u : samples.offGrid)
+        touch(u, std::cos(e.omega() * u), std::sin(e.omega() * u), e.position(u));
     }
     walked.endSample = touchingSamples_.size();
   });
@@ -357,7 +359,8 @@ double StrandEnergy::valueAndGradient(std::span<const double> q, std::span<doubl
       return glm::dvec3(glm::dot(v, frame.n0), glm::dot(v, frame.n1), glm::dot(v, frame.n2));
     };
     const glm::dvec3 darboux(q[3 * i], q[3 * i + 1], q[3 * i + 2]);
-    const double omega = glm::length(darboux), invOmega = omega > 0.0 ? 1.0 / omega : 0.0, l = lengths_[i];
+    // Ω as the walk up took it (|W| in world axes), so each closed form takes the branch it took there.
+    const double omega = walked.omega, invOmega = omega > 0.0 ? 1.0 / omega : 0.0, l = lengths_[i];
     const glm::dvec3 a(0.0, darboux.z, -darboux.y),
         m = darboux.x * darboux - glm::dot(darboux, darboux) * glm::dvec3(1.0, 0.0, 0.0);
     const double cosL = walked.cosLength, sinL = walked.sinLength;  // read where x ≥ kHelixSeriesBelow

@@ -86,7 +86,7 @@ class StrandEnergy {
   struct WalkedElement {
     RodFrame start;
     glm::dvec3 end, integral;
-    double cosLength, sinLength;  // of Ω ℓ (HelixElement's)
+    double omega, cosLength, sinLength;  // Ω, and cos and sin of Ω ℓ (HelixElement's)
     size_t firstSample, endSample;
   };
   struct TouchingSample {
