@@ -10,7 +10,6 @@
 
 #include <tbb/parallel_for.h>
 
-#include "libcore/model/strand_frames.h"
 #include "libcore/physics/strand_energy.h"
 #include "libcore/util/cpu.h"
 #include "libcore/util/error.h"
@@ -23,18 +22,6 @@ namespace {
 AnjyoHair::Kernel available(AnjyoHair::Kernel asked) {
   return asked != AnjyoHair::Kernel::kPortable && hasAvx512() ? AnjyoHair::Kernel::kAvx512
                                                               : AnjyoHair::Kernel::kPortable;
-}
-
-double boundingRadius(const CollisionShape& c) {
-  switch (c.kind) {
-    case ShapeKind::kSphere:
-      return c.halfExtents.x;
-    case ShapeKind::kEllipsoid:
-      return std::max({c.halfExtents.x, c.halfExtents.y, c.halfExtents.z});
-    case ShapeKind::kCuboid:
-      return glm::length(c.halfExtents);
-  }
-  return 0.0;
 }
 
 void toFloats(const glm::dvec3& v, float (&to)[3]) {

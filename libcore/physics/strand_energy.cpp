@@ -31,8 +31,6 @@ double penetration(const CollisionShape& shape, const glm::dvec3& p) {
   return 0.0;
 }
 
-namespace {
-
 double boundingRadius(const CollisionShape& shape) {
   switch (shape.kind) {
     case ShapeKind::kSphere:
@@ -44,8 +42,6 @@ double boundingRadius(const CollisionShape& shape) {
   }
   return 0.0;
 }
-
-}  // namespace
 
 StrandEnergy::StrandEnergy(const Hairstyle& style, const Collision& collision, const RodFrame& root,
                            double envelope)
@@ -140,6 +136,7 @@ bool StrandEnergy::mayTouch(const glm::dvec3& p, double radius) const {
   return false;
 }
 
+template <bool kKeepWalk>
 void StrandEnergy::accumulate(std::span<const double> q, double& elastic, double& height,
                               double& penalty) const {
   for (size_t k = 0; k < lengths_.size(); ++k) {
@@ -148,23 +145,46 @@ void StrandEnergy::accumulate(std::span<const double> q, double& elastic, double
     elastic += lengths_[k] * (bend1_ * d1 * d1 + bend2_ * d2 * d2 + twist_ * dt * dt);
   }
   // One walk along the rod gives both the height integral (§4.1.1.3.2, closed form per element) and
-  // the collision samples (two sin/cos pairs per element, whatever the number of samples).
+  // the collision samples (two sin/cos pairs per element, whatever the number of samples). Kept for
+  // valueAndGradient's walk back: each element, and each sample that touches a shape with its force.
+  if constexpr (kKeepWalk) {
+    walkedElements_.resize(lengths_.size());
+    touchingSamples_.clear();
+  }
+  auto sample = [&](double u, double cosX, double sinX, const glm::dvec3& p) {
+    if constexpr (!kKeepWalk) {
+      penalty += this->penalty(p);
+      return;
+    }
+    glm::dvec3 force;
+    penalty += this->penalty(p, &force);
+    if (force != glm::dvec3(0.0)) touchingSamples_.push_back({u, cosX, sinX, p, collisionStep_ * force});
+  };
   auto element = [&](const HelixElement& e, double, size_t i) {
-    height += e.length() * (e.start().position.y - root_.position.y) + e.displacementIntegral().y;
+    const glm::dvec3 integral = e.displacementIntegral();
+    height += e.length() * (e.start().position.y - root_.position.y) + integral.y;
+    const size_t firstSample = touchingSamples_.size();
     // An element's samples lie within its length of its start (the arc is at least the chord): where no
     // shape reaches that far, each would add exactly 0, so none is placed.
-    if (shapes_.empty() || !mayTouch(e.start().position, e.length())) return;
-    const ElementSamples& samples = samples_[i];
-    e.visitGrid(samples.first, collisionStep_, samples.gridCount,
-                [&](size_t, double u, double c, double s) { penalty += this->penalty(e.at(u, c, s)); });
-    for (double u : samples.offGrid) penalty += this->penalty(e.position(u));
+    if (!shapes_.empty() && mayTouch(e.start().position, e.length())) {
+      const ElementSamples& samples = samples_[i];
+      e.visitGrid(samples.first, collisionStep_, samples.gridCount,
+                  [&](size_t, double u, double c, double s) { sample(u, c, s, e.at(u, c, s)); });
+      for (double u : samples.offGrid) {
+        const double x = e.omega() * u;
+        sample(u, kKeepWalk ? std::cos(x) : 1.0, kKeepWalk ? std::sin(x) : 0.0, e.position(u));
+      }
+    }
+    if constexpr (kKeepWalk)
+      walkedElements_[i] = {e.start(),     e.end().position, integral,    e.omega(),
+                            e.cosLength(), e.sinLength(),    firstSample, touchingSamples_.size()};
   };
   forEachElement(root_, std::span(lengths_), q, element);
 }
 
 EnergyTerms StrandEnergy::terms(std::span<const double> q) const {
   double elastic = 0.0, height = 0.0, penalty = 0.0;
-  accumulate(q, elastic, height, penalty);
+  accumulate<false>(q, elastic, height, penalty);
   return {elastic, weight_ * height, penalty * collisionStep_};
 }
 
@@ -300,46 +320,17 @@ double integralOfC(double omega, double l, double cosX) {
 double StrandEnergy::valueAndGradient(std::span<const double> q, std::span<double> gradient) const {
   if (q.size() != 3 * lengths_.size() || gradient.size() != q.size())
     throw std::invalid_argument("valueAndGradient: q and gradient need 3 coordinates per element");
-  // The value: accumulate's sums in its order, so it is operator()'s to the bit.
+  // The value as operator() takes it (accumulate, the same sums in the same order: the same bits), the
+  // walk up kept; the elastic term's gradient is its own, element by element.
   const size_t elements = lengths_.size();
-  double elastic = 0.0;
   for (size_t k = 0; k < elements; ++k) {
-    const double dt = q[3 * k] - rest_.tau, d1 = q[3 * k + 1] - rest_.kappa1,
-                 d2 = q[3 * k + 2] - rest_.kappa2;
-    elastic += lengths_[k] * (bend1_ * d1 * d1 + bend2_ * d2 * d2 + twist_ * dt * dt);
-    gradient[3 * k] = 2.0 * lengths_[k] * twist_ * dt;
-    gradient[3 * k + 1] = 2.0 * lengths_[k] * bend1_ * d1;
-    gradient[3 * k + 2] = 2.0 * lengths_[k] * bend2_ * d2;
+    const double l2 = 2.0 * lengths_[k];
+    gradient[3 * k] = l2 * twist_ * (q[3 * k] - rest_.tau);
+    gradient[3 * k + 1] = l2 * bend1_ * (q[3 * k + 1] - rest_.kappa1);
+    gradient[3 * k + 2] = l2 * bend2_ * (q[3 * k + 2] - rest_.kappa2);
   }
-  // The walk up the rod: each element's frame and the samples that touch a shape, with the force each
-  // feels (∂E/∂p).
-  double height = 0.0, penalty = 0.0;
-  walkedElements_.resize(elements);
-  touchingSamples_.clear();
-  auto touch = [&](double u, double cosX, double sinX, const glm::dvec3& p) {
-    glm::dvec3 force;
-    penalty += this->penalty(p, &force);
-    if (force != glm::dvec3(0.0)) touchingSamples_.push_back({u, cosX, sinX, p, collisionStep_ * force});
-  };
-  forEachElement(root_, std::span(lengths_), q, [&](const HelixElement& e, double, size_t i) {
-    WalkedElement& walked = walkedElements_[i];
-    walked.start = e.start();
-    walked.end = e.end().position;
-    walked.integral = e.displacementIntegral();
-    walked.omega = e.omega();
-    walked.cosLength = e.cosLength();
-    walked.sinLength = e.sinLength();
-    walked.firstSample = touchingSamples_.size();
-    height += e.length() * (e.start().position.y - root_.position.y) + walked.integral.y;
-    if (!shapes_.empty() && mayTouch(e.start().position, e.length())) {
-      const ElementSamples& samples = samples_[i];
-      e.visitGrid(samples.first, collisionStep_, samples.gridCount,
-                  [&](size_t, double u, double c, double s) { touch(u, c, s, e.at(u, c, s)); });
-      for (double u : samples.offGrid)
-        touch(u, std::cos(e.omega() * u), std::sin(e.omega() * u), e.position(u));
-    }
-    walked.endSample = touchingSamples_.size();
-  });
+  double elastic = 0.0, height = 0.0, penalty = 0.0;
+  accumulate<true>(q, elastic, height, penalty);
   const double value = elastic + weight_ * height + penalty * collisionStep_;
 
   // The walk back. A change of element i's coordinates bends element i and moves everything after it

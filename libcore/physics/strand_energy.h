@@ -18,6 +18,8 @@ namespace hairgen {
 
 // Penetration depth (metres, positive inside) of `p` into a shape, as the thesis defines it per kind.
 double penetration(const CollisionShape& shape, const glm::dvec3& p);
+// A radius about a shape's centre beyond which no point of it lies.
+double boundingRadius(const CollisionShape& shape);
 
 struct EnergyTerms {
   double elastic = 0.0, gravity = 0.0, collision = 0.0;
@@ -65,7 +67,10 @@ class StrandEnergy {
     std::vector<double> offGrid;
   };
   // The three sums of terms(): the elastic term itself, height (metres², × weight_ for gravity) and
-  // penalty (× collisionStep_ for the collision term).
+  // penalty (× collisionStep_ for the collision term). With kKeepWalk, the walk up the rod is kept in
+  // walkedElements_ and touchingSamples_ for valueAndGradient (a build of its own: the value alone pays
+  // nothing for it).
+  template <bool kKeepWalk>
   void accumulate(std::span<const double> q, double& elastic, double& height, double& penalty) const;
   // The penalty at p, and with `gradient` its gradient ∂/∂p there.
   double penalty(const glm::dvec3& p, glm::dvec3* gradient = nullptr) const;
