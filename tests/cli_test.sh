@@ -1,20 +1,7 @@
 #!/usr/bin/env bash
 # End-to-end checks of the hairgen command line: exit codes, messages, no partial output.
 # Usage: cli_test.sh HAIRGEN SOURCE_DIR CASE
-set -u
-hairgen=$1 src=$2 case=$3
-real="$src/../shared/testdata/real"
-tmp=$(mktemp -d)
-trap 'rm -rf "$tmp"' EXIT
-fail() { echo "FAIL ($case): $*"; exit 1; }
-expect_rc() { # expected-rc command...
-  local want=$1; shift
-  "$@" >"$tmp/out" 2>"$tmp/err"; local rc=$?
-  [ "$rc" -eq "$want" ] || { cat "$tmp/out" "$tmp/err"; fail "'$*' exited $rc, expected $want"; }
-}
-expect_err() { # text the last expect_rc's stderr must hold
-  grep -qF -- "$1" "$tmp/err" || fail "stderr lacks '$1': $(cat "$tmp/err")"
-}
+source "$(dirname "$0")/cli_lib.sh" "$@"
 
 case "$case" in
 help)
@@ -68,7 +55,7 @@ no_partial_output)
   expect_rc 2 "$hairgen" convert "$tmp/broken.hair" "$tmp/out.xyz"
   ;;
 real_cyhair)
-  [ -f "$real/luxcore/straight.hair" ] || { echo "shared/testdata/real is absent; skipped"; exit 0; }
+  [ -f "$real/luxcore/straight.hair" ] || skip "shared/testdata/real is absent"
   expect_rc 0 "$hairgen" info "$real/luxcore/straight.hair"
   grep -q "10000 strands, 160000 points" "$tmp/out" || fail "info: $(cat "$tmp/out")"
   expect_rc 0 "$hairgen" convert "$real/luxcore/straight.hair" "$tmp/s.glb" --quiet
@@ -365,7 +352,7 @@ real_hairutil)
   # hairutil's test data: the same 100 strands as .hair, .data and ASCII and binary PLY read to the same
   # points, bit for bit.
   d="$real/hairutil"
-  [ -f "$d/Bangs_100.data" ] || { echo "shared/testdata/real is absent; skipped"; exit 0; }
+  [ -f "$d/Bangs_100.data" ] || skip "shared/testdata/real is absent"
   for f in Bangs_100.hair Bangs_100_ascii.ply Bangs_100_binary.ply Bangs_100.data; do
     expect_rc 0 "$hairgen" convert "$d/$f" "$tmp/$f.data" -q
     cmp "$tmp/$f.data" "$d/Bangs_100.data" || fail "$f does not read to Bangs_100.data's points"
@@ -495,7 +482,7 @@ hardening_interrupt)
 hardening_memory)
   # Under a 4 GB address-space limit no config ends in "out of memory": each is refused first, naming
   # the key to change.
-  command -v prlimit >/dev/null || { echo "no prlimit here: skipped"; exit 0; }
+  command -v prlimit >/dev/null || skip "no prlimit here"
   limit=(prlimit --as=4000000000)
   d="$src/configs/default/setup.txt"
   for set in "Hairstyle.HairDensity=1e20" "Hairstyle.CollisionStep=1e-9" "Hairstyle.VisualityStep=1e-9" \
@@ -732,7 +719,7 @@ farm_slurm)
   slurm="$src/scripts/slurm-local.sh"
   was_up=0; bash "$slurm" status && was_up=1
   bash "$slurm" start >"$tmp/slurm.log" 2>&1; rc=$?
-  if [ "$rc" -ne 0 ]; then echo "SKIP: no local Slurm: $(cat "$tmp/slurm.log")"; exit 77; fi
+  [ "$rc" -eq 0 ] || skip "no local Slurm: $(cat "$tmp/slurm.log")"
   [ "$was_up" -eq 1 ] || trap 'bash "$slurm" stop >/dev/null 2>&1; rm -rf "$tmp"' EXIT
   setup="$src/configs/default/setup.txt"
   small=(--quiet --set Hairstyle.HairDensity=20 --set "Render.Resolution=64 48")
