@@ -41,6 +41,35 @@ std::string framesText(const FrameRange& f) {
   return std::to_string(f.first) + "-" + std::to_string(f.last);
 }
 
+// `frames` in runs of `chunk` frames, the last one shorter; counted in 64 bits, so a range that ends at
+// the largest int does not overflow.
+std::vector<FrameRange> chunksOf(const FrameRange& frames, int chunk) {
+  std::vector<FrameRange> chunks;
+  for (int64_t first = frames.first; first <= frames.last; first += chunk)
+    chunks.push_back({int(first), int(std::min<int64_t>(frames.last, first + chunk - 1))});
+  return chunks;
+}
+
+// The limits of farm_plan.h on the options and the shot, before any work.
+void checkLimits(const Config& config, const FarmPlanOptions& options) {
+  if (options.shards < 1 || options.shards > kFarmMaxGroupTasks)
+    throw InputError("--shards " + std::to_string(options.shards) + ": from 1 to " +
+                     std::to_string(kFarmMaxGroupTasks) + " (the most tasks of one job array)");
+  if (options.chunk < 1 || options.chunk > kFarmMaxFrames)
+    throw InputError("--chunk " + std::to_string(options.chunk) + ": from 1 to " +
+                     std::to_string(kFarmMaxFrames) + " frames");
+  if (!config.dynamics.given) return;
+  const FrameRange frames{config.dynamics.firstFrame, config.dynamics.lastFrame};
+  checkFarmFrames(frames, "the shot's frames (--frames, or Dynamics Frames)");
+  const int64_t chunks = (int64_t(frames.count()) + options.chunk - 1) / options.chunk;
+  if (chunks > kFarmMaxGroupTasks)
+    throw InputError("--chunk " + std::to_string(options.chunk) + ": the shot's " +
+                     std::to_string(frames.count()) + " frames make " + std::to_string(chunks) +
+                     " render tasks; a plan has at most " + std::to_string(kFarmMaxGroupTasks) +
+                     " (a --chunk of at least " +
+                     std::to_string((frames.count() + kFarmMaxGroupTasks - 1) / kFarmMaxGroupTasks) + ")");
+}
+
 }  // namespace
 
 FarmPlan planFarm(const Config& config, const Mesh& wick, const FarmPlanOptions& options) {
@@ -48,8 +77,7 @@ FarmPlan planFarm(const Config& config, const Mesh& wick, const FarmPlanOptions&
     throw InputError(config.setup.file.string() +
                      ": Load true: the coupe is loaded, not grown, so there is nothing to split; a farm "
                      "plan needs a Setup that grows its guides (Load false)");
-  if (options.shards < 1) throw InputError("--shards " + std::to_string(options.shards) + ": at least 1");
-  if (options.chunk < 1) throw InputError("--chunk " + std::to_string(options.chunk) + ": at least 1 frame");
+  checkLimits(config, options);
   FarmPlan plan;
   plan.setup = options.setup;
   plan.directory = options.directory;
@@ -131,6 +159,7 @@ FarmPlan planFarm(const Config& config, const Mesh& wick, const FarmPlanOptions&
     const std::string exr = dir + "/beauty.exr", png = dir + "/beauty.png";
     add("render", "render", {"render", setup, "--hair", rest, "-o", exr, "--preview", png}, {setup, rest},
         {exr, png}, {restTask}, request(estimate("render"), 1.0, options.maxCpus), true);
+    validateFarmPlan(plan, options.directory + "/plan.json");
     return plan;
   }
 
@@ -160,8 +189,7 @@ FarmPlan planFarm(const Config& config, const Mesh& wick, const FarmPlanOptions&
   // simulation is fast (it needs chunks only to resume), so its chunks are longer than the render's.
   const int simChunk = std::max(options.chunk, (frames.count() + kSimulationChunks - 1) / kSimulationChunks);
   std::vector<FrameRange> simulated;
-  for (int first = frames.first; first <= frames.last; first += simChunk) {
-    const FrameRange chunk{first, std::min(frames.last, first + simChunk - 1)};
+  for (const FrameRange& chunk : chunksOf(frames, simChunk)) {
     const size_t c = simulated.size() + 1;
     std::vector<std::string> simInputs = {setup, guides}, simDeps = {"merge-guides"};
     if (c > 1) {
@@ -175,8 +203,9 @@ FarmPlan planFarm(const Config& config, const Mesh& wick, const FarmPlanOptions&
     simulated.push_back(chunk);
   }
   std::vector<std::string> renders;
-  for (int first = frames.first, c = 1; first <= frames.last; first += options.chunk, ++c) {
-    const FrameRange chunk{first, std::min(frames.last, first + options.chunk - 1)};
+  int c = 0;
+  for (const FrameRange& chunk : chunksOf(frames, options.chunk)) {
+    ++c;
     std::vector<std::string> simulates;  // the simulation chunks that hold this chunk's frames
     for (size_t k = 0; k < simulated.size(); ++k)
       if (simulated[k].first <= chunk.last && chunk.first <= simulated[k].last)
@@ -204,78 +233,8 @@ FarmPlan planFarm(const Config& config, const Mesh& wick, const FarmPlanOptions&
       {"movie", pngPattern, "--frames", framesText(frames), "--fps", formatReal(config.dynamics.frameRate),
        "-o", mp4, "--gif", gif},
       frameFiles(pngPattern, frames), {mp4, gif}, renders, Request{}, false);
+  validateFarmPlan(plan, options.directory + "/plan.json");
   return plan;
-}
-
-nlohmann::ordered_json toJson(const FarmPlan& plan) {
-  nlohmann::ordered_json tasks = nlohmann::ordered_json::array();
-  for (const FarmTask& t : plan.tasks)
-    tasks.push_back({{"id", t.id},
-                     {"group", t.group},
-                     {"command", t.command},
-                     {"inputs", t.inputs},
-                     {"outputs", t.outputs},
-                     {"deps", t.deps},
-                     {"cpus", t.cpus},
-                     {"memoryMiB", t.memoryMiB},
-                     {"estimatedSeconds", t.estimatedSeconds}});
-  nlohmann::ordered_json frames = nullptr;
-  if (plan.frames) frames = {{"first", plan.frames->first}, {"last", plan.frames->last}};
-  return {{"format", "hairgen-farm-plan"},
-          {"version", 1},
-          {"setup", plan.setup},
-          {"directory", plan.directory},
-          {"configDigest", plan.configDigest},
-          {"overrides", plan.overrides},
-          {"shards", plan.shards},
-          {"chunk", plan.chunk},
-          {"frames", frames},
-          {"tasks", tasks}};
-}
-
-FarmPlan farmPlanFromJson(const nlohmann::ordered_json& j, const std::string& name) {
-  const FileLoc where{name, 0};
-  if (!j.is_object() || j.value("format", "") != "hairgen-farm-plan")
-    throw InputError(where, "is not a hairgen farm plan (no \"format\": \"hairgen-farm-plan\")");
-  if (j.value("version", 0) != 1)
-    throw InputError(where, "is a farm plan of version " +
-                                j.value("version", nlohmann::ordered_json()).dump() +
-                                "; this hairgen reads version 1");
-  try {
-    FarmPlan plan;
-    plan.setup = j.at("setup").get<std::string>();
-    plan.directory = j.at("directory").get<std::string>();
-    plan.configDigest = j.at("configDigest").get<std::string>();
-    plan.overrides = j.at("overrides").get<std::vector<std::string>>();
-    plan.shards = j.at("shards").get<int>();
-    plan.chunk = j.at("chunk").get<int>();
-    if (!j.at("frames").is_null())
-      plan.frames = FrameRange{j["frames"].at("first").get<int>(), j["frames"].at("last").get<int>()};
-    std::vector<std::string> seen;
-    for (const nlohmann::ordered_json& tj : j.at("tasks")) {
-      FarmTask t;
-      t.id = tj.at("id").get<std::string>();
-      t.group = tj.at("group").get<std::string>();
-      t.command = tj.at("command").get<std::vector<std::string>>();
-      t.inputs = tj.at("inputs").get<std::vector<std::string>>();
-      t.outputs = tj.at("outputs").get<std::vector<std::string>>();
-      t.deps = tj.at("deps").get<std::vector<std::string>>();
-      t.cpus = tj.at("cpus").get<int>();
-      t.memoryMiB = tj.at("memoryMiB").get<uint64_t>();
-      t.estimatedSeconds = tj.at("estimatedSeconds").get<double>();
-      if (t.command.empty()) throw InputError(where, "task " + t.id + " has an empty command");
-      if (std::find(seen.begin(), seen.end(), t.id) != seen.end())
-        throw InputError(where, "task id " + t.id + " appears twice");
-      for (const std::string& d : t.deps)
-        if (std::find(seen.begin(), seen.end(), d) == seen.end())
-          throw InputError(where, "task " + t.id + " depends on " + d + ", which is not a task before it");
-      seen.push_back(t.id);
-      plan.tasks.push_back(std::move(t));
-    }
-    return plan;
-  } catch (const nlohmann::json::exception& e) {
-    throw InputError(where, std::string("is not a valid farm plan: ") + e.what());
-  }
 }
 
 }  // namespace hairgen

@@ -687,14 +687,16 @@ farm_plan)
   done
   ! grep -q '"render.4"' "$tmp/shot/plan.json" || fail "12 frames in chunks of 5 make 3 render tasks"
   expect_rc 0 "$hairgen" farm submit "$tmp/shot/plan.json" --scheduler slurm --dry-run --quiet
-  grep -q "^grow=\$('sbatch' '--parsable' .*'--array=0,1,2,3'" "$tmp/out" || fail "dry run: $(cat "$tmp/out")"
-  grep -q "^render=.*'--array=0,1,2'.*'--dependency=afterok:\$shade,afterok:\$simulate.1,afterok:\$simulate.2,afterok:\$simulate.3'" "$tmp/out" ||
+  grep -q "^job_grow=\$('sbatch' '--parsable' .*'--array=1,2,3,4'" "$tmp/out" || fail "dry run: $(cat "$tmp/out")"
+  grep -qF "job_render=\$('sbatch' '--parsable' '--job-name=hairgen-render' '--array=1,2,3'" "$tmp/out" &&
+    grep -qF "'--dependency=afterok:'\"\${job_shade}\"',afterok:'\"\${job_simulate__1}\"',afterok:'\"\${job_simulate__2}\"',afterok:'\"\${job_simulate__3}\"" "$tmp/out" ||
     fail "render waits for the simulation and the shaded rest coupe: $(cat "$tmp/out")"
-  grep -q "^movie=.*'--dependency=afterok:\$render'" "$tmp/out" || fail "the movie waits for every frame: $(cat "$tmp/out")"
-  grep -q "^simulate.3=.*'--array=2'.*'--dependency=afterok:\$merge-guides,afterok:\$simulate.2'" "$tmp/out" ||
+  grep -qF "'--dependency=afterok:'\"\${job_render}\" '--kill-on-invalid-dep=yes' '$tmp/shot/slurm/movie.sh'" "$tmp/out" ||
+    fail "the movie waits for every frame: $(cat "$tmp/out")"
+  grep -q "^job_simulate__3=.*'--array=3'.*'--dependency=afterok:'\"\${job_merge_guides}\"',afterok:'\"\${job_simulate__2}\"" "$tmp/out" ||
     fail "a simulation chunk waits for the one before: $(cat "$tmp/out")"
   ! grep -q "interpolate-frames\|/frames/" "$tmp/shot/plan.json" || fail "the shot's plan writes per-frame coupes"
-  grep -q "^merge-guides=.*'--dependency=afterok:\$grow'" "$tmp/out" || fail "merge waits for every shard: $(cat "$tmp/out")"
+  grep -q "^job_merge_guides=.*'--dependency=afterok:'\"\${job_grow}\"" "$tmp/out" || fail "merge waits for every shard: $(cat "$tmp/out")"
   [ ! -e "$tmp/shot/slurm" ] || fail "a dry run wrote scripts"
   expect_rc 2 "$hairgen" farm plan "$src/configs/default/setup.txt" -o "$tmp/x" --frames 1-4 --quiet
   expect_rc 2 "$hairgen" farm submit "$src/tests/cli_test.sh" --scheduler slurm --dry-run
@@ -739,20 +741,20 @@ farm_slurm)
   [ -n "$job" ] || fail "no render job: $(cat "$tmp/sub.out" "$tmp/sub.err")"
   # Cancel chunk 3 (frames 11-15) mid-frame when the test sees it running, else while it waits.
   for _ in $(seq 1200); do
-    state=$(squeue --noheader --array --jobs="${job}_2" --format=%T 2>/dev/null)
+    state=$(squeue --noheader --array --jobs="${job}_3" --format=%T 2>/dev/null)
     [ "$state" = RUNNING ] && { sleep 0.3; break; }
     [ -z "$state" ] && break
     sleep 0.05
   done
   echo "render.3 was ${state:-gone} when cancelled"
-  scancel "${job}_2"
+  scancel "${job}_3"
   wait "$submitter"; rc=$?
   if [ "$rc" -eq 0 ]; then
     echo "render.3 finished before it could be cancelled: its outputs are removed instead"
     rm -f "$tmp"/shot/beauty.001[1-5].*
   else
     [ "$rc" -eq 1 ] || fail "--wait after a cancelled task exited $rc: $(cat "$tmp/sub.err")"
-    grep -q "task render.3 (job ${job}_2, log $tmp/shot/logs/render.2.log)\|render.3 (job ${job}_2" "$tmp/sub.err" ||
+    grep -q "task render.3 (job ${job}_3, log $tmp/shot/logs/render.3.log)\|render.3 (job ${job}_3" "$tmp/sub.err" ||
       fail "--wait does not name the cancelled task: $(cat "$tmp/sub.err")"
   fi
   [ ! -e "$tmp/shot/beauty.0015.png" ] || fail "the cancelled chunk finished"

@@ -531,45 +531,68 @@ void writeHair(const std::filesystem::path& file, const Strands& strands) {
 }
 
 Provenance readHairProvenance(const std::filesystem::path& file) {
-  requireRegularFile(file);
+  // The file read from its start with seeks over the arrays and the other chunks; every read and every
+  // seek is first checked against what remains of the file (Reader::need), as decodeHair's are, so no
+  // length a header declares moves past its end.
+  class SeekingSource final : public Source {
+   public:
+    explicit SeekingSource(const std::filesystem::path& path) : in_(path, std::ios::binary) {
+      requireRegularFile(path);
+      if (!in_) throw IoError("cannot open " + path.string());
+      size_ = std::filesystem::file_size(path);
+    }
+    uint64_t remaining() const override { return size_ - position_; }
+    void read(void* out, size_t bytes) override {
+      if (!in_.read(static_cast<char*>(out), std::streamsize(bytes))) throw IoError("cannot read the file");
+      position_ += bytes;
+    }
+    void skip(uint64_t bytes) {  // after need(bytes)
+      position_ += bytes;
+      in_.seekg(std::streamoff(position_));
+    }
+
+   private:
+    std::ifstream in_;
+    uint64_t size_ = 0, position_ = 0;
+  };
   const std::string name = file.string();
-  std::ifstream in(file, std::ios::binary);
-  if (!in) throw IoError("cannot open " + name);
-  auto read = [&](void* to, size_t bytes, const char* what) {
-    if (!in.read(static_cast<char*>(to), std::streamsize(bytes)))
-      throw InputError({name, 0}, std::string("ends inside ") + what);
-  };
-  auto u32 = [&](const char* what) {
-    uint8_t b[4];
-    read(b, 4, what);
-    return uint32_t(b[0]) | uint32_t(b[1]) << 8 | uint32_t(b[2]) << 16 | uint32_t(b[3]) << 24;
-  };
+  SeekingSource source(file);
+  Reader r(source, name);
+  r.need(kHeaderSize, "the 128-byte header");
   char magic[4];
-  read(magic, 4, "the header");
+  r.bytes(magic, 4);
   if (std::memcmp(magic, "HAIR", 4) != 0) throw InputError({name, 0}, "is not a .hair file");
-  const uint64_t strands = u32("the header"), points = u32("the header"), flags = u32("the header");
-  uint64_t arrays = (flags & kSegments ? 2 * strands : 0) + (flags & kPoints ? 12 * points : 0) +
-                    (flags & kThickness ? 4 * points : 0) + (flags & kTransparency ? 4 * points : 0) +
-                    (flags & kColor ? 12 * points : 0);
-  in.seekg(std::streamoff(kHeaderSize + arrays));
-  char block[4];
-  if (!in.read(block, 4)) return {};  // no chunk block: made elsewhere
-  if (std::memcmp(block, "HGEN", 4) != 0) return {};
-  u32("the chunk block header");
-  const uint32_t chunks = u32("the chunk block header");
+  const uint64_t strands = r.u32(), points = r.u32(), flags = r.u32();
+  const uint64_t arrays = (flags & kSegments ? 2 * strands : 0) + (flags & kPoints ? 12 * points : 0) +
+                          (flags & kThickness ? 4 * points : 0) + (flags & kTransparency ? 4 * points : 0) +
+                          (flags & kColor ? 12 * points : 0);
+  r.need(kHeaderSize - 16 + arrays,
+         "the arrays for " + std::to_string(strands) + " strands and " + std::to_string(points) + " points");
+  source.skip(kHeaderSize - 16 + arrays);
+  if (r.remaining() < 12) return {};  // no chunk block: made elsewhere
+  r.bytes(magic, 4);
+  if (std::memcmp(magic, "HGEN", 4) != 0) return {};
+  r.u32();  // the block's version
+  const uint32_t chunks = r.u32();
+  if (chunks > kMaxChunks)
+    throw InputError({name, 0}, "declares " + std::to_string(chunks) + " chunks; hairgen reads at most " +
+                                    std::to_string(kMaxChunks));
   for (uint32_t c = 0; c < chunks; ++c) {
+    r.need(12, "chunk " + std::to_string(c) + "'s header");
     char tag[4];
-    read(tag, 4, "a chunk header");
-    const uint64_t low = u32("a chunk header"), high = u32("a chunk header");
+    r.bytes(tag, 4);
+    const uint64_t low = r.u32(), high = r.u32();
     const uint64_t length = low | high << 32;
+    r.need(length, "chunk " + std::to_string(c));
+    r.need(length + 4, "chunk " + std::to_string(c) + " and its CRC");
     if (std::memcmp(tag, "PROV", 4) == 0) {
       if (length > (1u << 20))
         throw InputError({name, 0}, "PROV chunk of " + std::to_string(length) + " bytes");
       std::string text(length, '\0');
-      read(text.data(), length, "the PROV chunk");
+      r.bytes(text.data(), length);
       return parseProvenance(text, name);
     }
-    in.seekg(std::streamoff(length + 4), std::ios::cur);
+    source.skip(length + 4);
   }
   return {};
 }
