@@ -2,6 +2,10 @@
 // gives back the whole and refuses parts that do not belong together, and plans whose tasks run in order.
 #include <gtest/gtest.h>
 
+#include <chrono>
+#include <climits>
+#include <fstream>
+#include <functional>
 #include <set>
 
 #include "libcore/io/hair_io.h"
@@ -145,6 +149,159 @@ TEST(FarmPlan, EveryTaskComesAfterWhatItReads) {
       EXPECT_TRUE(done.count("render." + std::to_string((frames + 6) / 7)));
       EXPECT_FALSE(done.count("render." + std::to_string((frames + 6) / 7 + 1)));
     }
+  }
+}
+
+// A 152-byte file whose one chunk declares 2^64-16 bytes: the reader must stop at the file's end, not
+// seek back onto the chunk's header and read it again for each of the 2^32-1 chunks declared.
+TEST(Shards, ProvenanceReaderBoundsEverySeekByTheFileSize) {
+  test::TempDir dir("provenance");
+  std::string bytes = "HAIR";
+  auto u32 = [&](uint32_t v) {
+    for (int i = 0; i < 4; ++i) bytes += char(v >> (8 * i));
+  };
+  for (uint32_t v : {0u, 0u, 2u, 0u}) u32(v);  // no strands, no points, flag 2 (points)
+  bytes.resize(128, '\0');
+  bytes += "HGEN";
+  u32(1);
+  u32(0xFFFFFFFFu);
+  bytes += "XXXX";
+  u32(0xFFFFFFF0u);
+  u32(0xFFFFFFFFu);
+  ASSERT_EQ(bytes.size(), 152u);
+  const auto file = dir.path() / "huge-chunk.hair";
+  std::ofstream(file, std::ios::binary) << bytes;
+  const auto start = std::chrono::steady_clock::now();
+  EXPECT_THROW(readHairProvenance(file), InputError);
+  EXPECT_LT(std::chrono::steady_clock::now() - start, std::chrono::seconds(1));
+  // Arrays declared past the end are refused too, rather than taken for a file without chunks.
+  bytes.replace(8, 4, std::string("\xff\xff\xff\x0f", 4));
+  std::ofstream(file, std::ios::binary) << bytes;
+  EXPECT_THROW(readHairProvenance(file), InputError);
+}
+
+FarmPlan stillPlan(int shards = 2) {
+  const test::Job job = test::loadJob("default/setup.txt", SetupUse::kRun);
+  FarmPlanOptions options;
+  options.hairgen = "/usr/bin/hairgen";
+  options.setup = "/s/setup.txt";
+  options.directory = "/d";
+  options.shards = shards;
+  return planFarm(job.config, job.wick, options);
+}
+
+// Refused with an InputError whose message holds `culprit` (the task, the field).
+void expectRefused(const std::function<void()>& read, const std::string& culprit) {
+  try {
+    read();
+    ADD_FAILURE() << "accepted; expected a refusal naming " << culprit;
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find(culprit), std::string::npos) << e.what();
+  }
+}
+
+TEST(FarmPlan, ReadingRefusesWhatCouldReachAShellOrLeaveTheFolder) {
+  const nlohmann::ordered_json good = toJson(stillPlan());
+  ASSERT_NO_THROW(farmPlanFromJson(good, "plan.json"));
+  using Edit = std::function<void(nlohmann::ordered_json&)>;
+  auto renameGrow1 = [](const std::string& id) {
+    return Edit([id](nlohmann::ordered_json& j) {
+      j["tasks"][0]["id"] = id;
+      for (auto& t : j["tasks"])
+        for (auto& d : t["deps"])
+          if (d == "grow.1") d = id;
+    });
+  };
+  const std::vector<std::pair<Edit, std::string>> attacks = {
+      {renameGrow1("grow.1$(touch /tmp/x)"), "its id is neither"},
+      {renameGrow1("grow.01"), "its id is neither"},
+      {renameGrow1("grow.1001"), "its id is neither"},
+      {[](auto& j) { j["tasks"][0]["group"] = "../../escaped"; },
+       "task \"grow.1\": its group \"../../escaped\""},
+      {[](auto& j) { j["tasks"][0]["group"] = "gr--ow"; }, "its group"},
+      {[](auto& j) { j["setup"] = "/s/a\ntouch /tmp/x\n/setup.txt"; }, "control character"},
+      {[](auto& j) { j["directory"] = "/d\r"; }, "control character"},
+      {[](auto& j) { j["directory"] = "/"; }, "its directory"},
+      {[](auto& j) { j["tasks"][0]["inputs"][0] = std::string("/s/setup.txt\0", 13); },
+       "task \"grow.1\": input"},
+      {[](auto& j) { j["tasks"][0]["outputs"][0] = "/etc/passwd"; },
+       "task \"grow.1\": output \"/etc/passwd\""},
+      {[](auto& j) { j["tasks"][0]["outputs"][0] = "/d/../x.hair"; }, "task \"grow.1\": output"},
+      {[](auto& j) { j["tasks"][0]["outputs"][0] = "/d/slurm/grow.sh"; }, "slurm/"},
+      {[](auto& j) { j["tasks"][0]["outputs"][0] = "/dx/guides.1.hair"; }, "task \"grow.1\": output"},
+      {[](auto& j) { j["tasks"][0]["command"][0] = "/bin/sh"; }, "is not a hairgen executable"},
+      {[](auto& j) { j["tasks"][0]["command"][0] = "hairgen"; }, "is not a hairgen executable"},
+      {[](auto& j) { j["tasks"][0]["command"][1] = "-c"; }, "its stage"},
+      {[](auto& j) { j["tasks"][0]["command"].push_back("--exec"); }, "option \"--exec\""},
+      {[](auto& j) { j["tasks"][0]["command"].push_back("/tmp/elsewhere.hair"); }, "command path"},
+      {[](auto& j) { j["tasks"][0]["command"].push_back("relative.hair"); }, "command path"},
+      {[](auto& j) { j["tasks"][0]["command"].back() = "1; rm -rf ~"; }, "--threads"},
+      {[](auto& j) { j["tasks"][0]["cpus"] = 1e300; }, "\"cpus\""},
+      {[](auto& j) { j["tasks"][0]["memoryMiB"] = -1; }, "\"memoryMiB\""},
+      {[](auto& j) { j["version"] = 1e300; }, "version"},
+      {[](auto& j) { j["format"] = 7; }, "not a hairgen farm plan"},
+      {[](auto& j) { j["shards"] = 100000; }, "\"shards\""},
+      {[](auto& j) {
+         j["frames"] = {{"first", INT_MIN}, {"last", INT_MAX}};
+       },
+       "frames"},
+      {[](auto& j) {
+         j["overrides"] = {"--exec", "x"};
+       },
+       "override"},
+      {[](auto& j) { j["tasks"][2]["deps"].push_back("grow.1"); }, "twice"},
+  };
+  for (const auto& [edit, culprit] : attacks) {
+    nlohmann::ordered_json j = good;
+    edit(j);
+    expectRefused([&] { farmPlanFromJson(j, "plan.json"); }, culprit);
+    expectRefused([&] { farmPlanFromJson(j, "plan.json"); }, "plan.json");
+  }
+}
+
+TEST(FarmPlan, MakingRefusesControlCharactersAndBoundsTheSize) {
+  const test::Job job = test::loadJob("default/setup.txt", SetupUse::kRun);
+  FarmPlanOptions options;
+  options.hairgen = "/usr/bin/hairgen";
+  options.setup = "/s/setup.txt";
+  options.directory = "/d";
+  auto refused = [&](FarmPlanOptions o, const std::string& culprit) {
+    expectRefused([&] { planFarm(job.config, job.wick, o); }, culprit);
+  };
+  FarmPlanOptions o = options;
+  o.directory = "/d\ntouch /tmp/x\n";
+  refused(o, "control character");
+  o = options;
+  o.setup = "/s\n/setup.txt";
+  refused(o, "control character");
+  o = options;
+  o.hairgen = "/usr/bin/hairgen\x7f";
+  refused(o, "control character");
+  o = options;
+  o.shards = 100000;
+  refused(o, "--shards 100000: from 1 to 1000");
+  o = options;
+  o.chunk = INT_MAX;
+  refused(o, "--chunk");
+  test::Job shot = test::loadJob("anjyo/gust/setup.txt", SetupUse::kRun);
+  shot.config.dynamics.firstFrame = 1;
+  shot.config.dynamics.lastFrame = 1000000;
+  options.chunk = 1;
+  const auto start = std::chrono::steady_clock::now();
+  expectRefused([&] { planFarm(shot.config, shot.wick, options); }, "1000000 frames");
+  shot.config.dynamics.lastFrame = 5000;
+  expectRefused([&] { planFarm(shot.config, shot.wick, options); }, "5000 render tasks");
+  EXPECT_LT(std::chrono::steady_clock::now() - start, std::chrono::seconds(2));
+  // At the limits the plan is made, and read back.
+  shot.config.dynamics.lastFrame = 1000;
+  const FarmPlan plan = planFarm(shot.config, shot.wick, options);
+  EXPECT_EQ(toJson(farmPlanFromJson(toJson(plan), "plan.json")), toJson(plan));
+}
+
+TEST(FarmPlan, ArrayIndexIsTheIdsNumber) {
+  for (const FarmTask& t : stillPlan(3).tasks) {
+    const size_t dot = t.id.find('.');
+    EXPECT_EQ(farmArrayIndex(t), dot == std::string::npos ? 0 : std::stoi(t.id.substr(dot + 1))) << t.id;
   }
 }
 
