@@ -8,7 +8,11 @@
 // exist and carry the plan's config digest (.hair provenance, the EXR header; other files by their
 // presence), so submitting a plan again redoes only what is missing or stale. Every output is written
 // atomically, so a task killed mid-way leaves nothing that passes for done; tasks are submitted
-// requeueable.
+// requeueable. Array task N runs task GROUP.N (0 a group's only task) and logs to logs/ID.log.
+//
+// A plan is input: farmPlanFromJson checks it by validateFarmPlan's rules, and its data reaches the
+// scripts and the printed dry run only through shellQuote (one word, single-quoted; no control
+// character) and shellWord (a job id's or SLURM_CPUS_PER_TASK's variable, double-quoted).
 #include <poll.h>
 #include <spawn.h>
 #include <sys/wait.h>

@@ -57,7 +57,8 @@ constexpr size_t kFarmMaxTasks = 3 * kFarmMaxGroupTasks + 16;
 // The most CPUs one task asks for (`farm plan --cpus`); and the most memory, far above any node's.
 constexpr int kFarmMaxCpus = 4096;
 constexpr uint64_t kFarmMaxMemoryMiB = uint64_t(1) << 30;
-// The largest plan file `farm submit` reads: a plan at the limits above is about 20 MB.
+// The largest plan file `farm submit` reads: a plan at the limits above is 6 MB (with a short folder;
+// each path is written some 20000 times), so this leaves room for long paths.
 constexpr uint64_t kFarmMaxPlanBytes = uint64_t(64) << 20;
 
 struct FarmTask {

@@ -174,6 +174,10 @@ plan_limits)
   expect_err "20000 frames"
   ((SECONDS < 15)) || fail "refusing took $SECONDS s"
   [ ! -e "$tmp/p" ] || fail "a refused plan left a folder"
+  # A plan file is read only up to a size (a plan at the limits is about 20 MB).
+  mkdir "$tmp/big" && truncate -s 70M "$tmp/big/plan.json"
+  expect_rc 2 "$hairgen" farm submit "$tmp/big/plan.json" --scheduler slurm --dry-run
+  expect_err "a farm plan is at most 67108864"
   ;;
 dry_run_shell)
   # --dry-run prints a shell script: sh -n and bash -n pass, and run with a fake sbatch each job waits for
