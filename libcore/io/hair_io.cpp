@@ -539,7 +539,9 @@ Provenance readHairProvenance(const std::filesystem::path& file) {
     explicit SeekingSource(const std::filesystem::path& path) : in_(path, std::ios::binary) {
       requireRegularFile(path);
       if (!in_) throw IoError("cannot open " + path.string());
-      size_ = std::filesystem::file_size(path);
+      std::error_code ec;
+      size_ = std::filesystem::file_size(path, ec);
+      if (ec) throw IoError("cannot read the size of " + path.string() + ": " + ec.message());
     }
     uint64_t remaining() const override { return size_ - position_; }
     void read(void* out, size_t bytes) override {
