@@ -72,7 +72,7 @@ TEST(Outputs, ADanglingLinkMakesNoFolder) {
   // A folder on the way that is a link to nowhere is refused, before and while writing.
   ASSERT_EQ(::symlink((dir / "nowhere/sim").c_str(), (dir / "sim").c_str()), 0);
   EXPECT_THROW(requireWritableOutput(dir / "sim/g.0001.hair"), InputError);
-  EXPECT_THROW(writeFileAtomic(dir / "sim/g.0001.hair", std::string("hair")), InputError);
+  EXPECT_THROW(writeFileAtomic(dir / "sim/g.0001.hair", std::string("hair")), IoError);
   EXPECT_THROW(createOutputFolder(dir / "sim/deeper"), InputError);
   EXPECT_FALSE(fs::exists(dir / "nowhere"));
 }

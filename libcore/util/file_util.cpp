@@ -256,7 +256,13 @@ struct Temporary {
 Temporary createTemporaryBeside(const fs::path& target) {
   static std::atomic<unsigned> counter{0};
   static const std::string host = hostName();
-  walkFolders(target, target.string(), true);
+  try {
+    walkFolders(target, target.string(), true);
+  } catch (const InputError& e) {
+    // Found only while writing (the command did not check this output before its work): the write
+    // failed, as a folder that cannot be made fails it.
+    throw IoError(e.where(), e.message());
+  }
   const std::string prefix = target.filename().string() + ".tmp-" + host + "-";
   sweepStaleTemporaries(target, prefix);
   for (int attempt = 0;; ++attempt) {

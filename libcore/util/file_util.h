@@ -8,8 +8,10 @@
 // renamed over the name on commit. A symbolic link named as an output is replaced by the file, as mv
 // replaces it: nothing is written through the link into the file it points to, and no folder is made
 // for a link that points nowhere. Folders on the way are made as needed, one by one, but never through
-// a dangling link (an InputError, exit 2). A device, FIFO or socket (`--stats /dev/stdout`, a pipe),
-// reached directly or through links, is written directly and never replaced. A directory is refused.
+// a dangling link: requireWritableOutput refuses one before the work (an InputError, exit 2), a write
+// that finds one fails (an IoError, exit 1), as it does where something on the way is not a folder.
+// A device, FIFO or socket (`--stats /dev/stdout`, a pipe), reached directly or through links, is
+// written directly and never replaced. A directory is refused.
 // Write errors (a full disk, /dev/full) are IoErrors (exit 1).
 //
 // Interruptions and failures: installInterruptCleanup() makes SIGINT, SIGTERM and SIGHUP remove the
