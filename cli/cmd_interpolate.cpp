@@ -87,6 +87,7 @@ void registerInterpolate(CLI::App& app, int& exitCode) {
         interpolateInto(wick, guides, config.hairstyle, config.collision, frameOptions, coupe);
         stats.add("interpolate", clock.lap());
         writeStrands(framePath(options->output, f), coupe);
+        keepCommittedOutputs();  // a finished frame stays, whatever a later one does
         stats.add("write", clock.lap());
         stats.counts()["strands"] = coupe.strandCount();
         stats.counts()["points"] = coupe.pointCount();

@@ -17,8 +17,9 @@ void registerMovie(CLI::App& app, int& exitCode) {
   auto options = std::make_shared<Options>();
   CLI::App* cmd = app.add_subcommand(
       "movie",
-      "Encode a shot's PNG frames into the preview movie `run` writes (H.264 MP4 with Debian's ffmpeg, "
-      "and a small GIF): the farm's last task for a shot");
+      "Encode a shot's PNG frames into the preview movie `run` writes (H.264 MP4 with Debian's ffmpeg, an "
+      "odd width or height padded to even, and a small GIF): the farm's last task for a shot; when ffmpeg "
+      "fails, exit 1 with its last message and no movie");
   cmd->add_option("PATTERN", options->pattern,
                   "The frames, #### standing for the frame number (beauty.####.png)")
       ->required();

@@ -334,6 +334,7 @@ void registerRender(CLI::App& app, int& exitCode) {
         if (options->frame) rendered.render = out.settings;
         writeRenderOutputs(rendered, out, frameFile(options->output, f), frameFile(options->dom, f),
                            frameFile(options->preview, f));
+        if (sequence) keepCommittedOutputs();  // a finished frame stays, whatever a later one does
         stats.add("write", clock.lap());
         if (options->motion) {
           hairBefore = std::move(hair);

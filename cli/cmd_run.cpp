@@ -85,6 +85,7 @@ void runShot(const CommonOptions& common, const Config& config, const Mesh& wick
   simulate(guides, config, simOptions, [&](int f, const Strands& frameGuides) {
     stats.add("simulate", clock.lap());
     writeStrands(framePath(simPattern, f), frameGuides);
+    keepCommittedOutputs();  // a finished frame stays, whatever a later one does
     stats.add("write", clock.lap());
     if (!render) return progress.advance();
     InterpolateOptions interpolation{config.digest(), framePath(simPattern, f).string(), nullptr,
@@ -103,6 +104,7 @@ void runShot(const CommonOptions& common, const Config& config, const Mesh& wick
     clock.lap();
     writeRenderOutputs(config, image, framePath(exrPattern, f).string(), "",
                        framePath(pngPattern, f).string());
+    keepCommittedOutputs();
     stats.add("write", clock.lap());
     progress.advance();
   });
@@ -112,11 +114,19 @@ void runShot(const CommonOptions& common, const Config& config, const Mesh& wick
   clock.lap();
   MovieOptions movie;
   movie.frameRate = d.frameRate;
-  if (writeMovie(pngPattern, frames, out / "beauty.mp4", out / "beauty.gif", movie))
-    note(common, "run: wrote " + framePath(exrPattern, frames.first).string() + " to " +
-                     framePath(exrPattern, frames.last).filename().string() + ", beauty.mp4 and beauty.gif");
-  else
-    note(common, "run: ffmpeg is not installed, so no preview movie; the frames are " + pngPattern.string());
+  // The frames are the shot; the movie only previews them. One that cannot be made is a warning (even
+  // with --quiet) and run still succeeds, so a farm script does not render the shot again for it.
+  try {
+    if (writeMovie(pngPattern, frames, out / "beauty.mp4", out / "beauty.gif", movie))
+      note(common, "run: wrote " + framePath(exrPattern, frames.first).string() + " to " +
+                       framePath(exrPattern, frames.last).filename().string() +
+                       ", beauty.mp4 and beauty.gif");
+    else
+      note(common,
+           "run: ffmpeg is not installed, so no preview movie; the frames are " + pngPattern.string());
+  } catch (const Error& e) {
+    std::cerr << "hairgen run: warning: no preview movie: " << oneLine(e.what()) << "; the frames are kept\n";
+  }
   stats.add("movie", clock.lap());
 }
 
@@ -158,14 +168,12 @@ void registerRun(CLI::App& app, int& exitCode) {
         throw InputError(setup.string() + ": --motion renders motion vectors of a shot, and " +
                          (options->noRender ? "--no-render renders nothing"
                                             : "this Setup names no Dynamics Info (DynamicsInfo FILE)"));
-      std::error_code made;
-      fs::create_directories(out, made);
-      if (made) {
-        // A name that is already something else is bad usage; a folder that cannot be made (read-only
-        // file system, permissions) is the work failing to write.
-        const std::string why = "-o " + out.string() + ": cannot create the output folder: " + made.message();
-        if (fs::exists(out) && !fs::is_directory(out)) throw InputError(why);
-        throw IoError(why);
+      // A name that is already something else (or a link to nothing) is bad usage; a folder that cannot
+      // be made (read-only file system, permissions) is the work failing to write.
+      try {
+        createOutputFolder(out);
+      } catch (const Error& e) {
+        throw Error(e.code(), {}, "-o " + out.string() + ": cannot create the output folder: " + e.what());
       }
       // The first file it writes, before minutes of growing: a folder it cannot write in is found now.
       requireWritableOutput(out / "guides.hair");

@@ -114,7 +114,9 @@ void registerShade(CLI::App& app, int& exitCode) {
           stats.counts()["points"] = out.pointCount();
           writeStrands(written, out);
           stats.add("write", clock.lap());
-          if (sequence) progress.advance();
+          if (!sequence) continue;
+          keepCommittedOutputs();  // a finished frame stays, whatever a later one does
+          progress.advance();
         }
         progress.finish();
         note(options->common, "shade: re-posed the normals of " + options->rest + " onto " +
@@ -138,15 +140,10 @@ void registerShade(CLI::App& app, int& exitCode) {
         throw InputError({options->hair, 0}, e.message());
       }
       clock.lap();
-      // The volume first: if the coupe then cannot be written, the volume goes too (no partial output).
+      // The volume first: if the coupe then cannot be written, runCommand removes the volume (no
+      // partial output).
       if (!options->vdb.empty()) writeVdb(options->vdb, shaded.volume);
-      try {
-        writeStrands(options->output, shaded.coupe);
-      } catch (...) {
-        std::error_code ignored;
-        if (!options->vdb.empty()) std::filesystem::remove(options->vdb, ignored);
-        throw;
-      }
+      writeStrands(options->output, shaded.coupe);
       stats.time("write", clock.lap());
       note(options->common,
            "shade: wrote " + options->output + (options->vdb.empty() ? "" : " and " + options->vdb));

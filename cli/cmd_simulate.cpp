@@ -75,6 +75,7 @@ void registerSimulate(CLI::App& app, int& exitCode) {
       simulate(rest, config, simOptions, [&](int frame, const Strands& guides) {
         Stopwatch write;
         writeStrands(framePath(options->output, frame), guides);
+        keepCommittedOutputs();  // a finished frame stays, whatever a later one does
         writing += write.lap();
       });
       progress.finish();

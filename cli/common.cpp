@@ -123,7 +123,7 @@ int runCommand(const std::string& command, const CommonOptions& options, const s
   gFailedStats = nullptr;
   gStatsWriteFailed = false;
   auto failed = [&](const std::string& message, ExitCode code) {
-    discardCommittedOutputs();  // a failed command leaves none of its outputs
+    discardCommittedOutputs();  // a failed command leaves none of its outputs but finished frames
     std::cerr << "hairgen " << command << ": error: " << oneLine(message) << "\n";
     if (!options.statsFile.empty() && !gStatsWriteFailed) {
       // A farm script reads why, even from a command that failed before it gathered anything.
@@ -131,7 +131,10 @@ int runCommand(const std::string& command, const CommonOptions& options, const s
           gFailedStats.is_object() ? gFailedStats : nlohmann::ordered_json::object();
       if (!stats.contains("command")) stats["command"] = command;
       if (!stats.contains("version")) stats["version"] = HAIRGEN_VERSION;
-      stats["outputs"] = nlohmann::ordered_json::array();
+      // What stays: a sequence's finished frames.
+      nlohmann::ordered_json kept = nlohmann::ordered_json::array();
+      for (const std::filesystem::path& p : committedOutputs()) kept.push_back(p.string());
+      stats["outputs"] = kept;
       stats["peakMemoryBytes"] = peakResidentBytes();
       stats["exitCode"] = int(code);
       stats["error"] = oneLine(message);

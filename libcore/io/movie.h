@@ -17,9 +17,13 @@ struct MovieOptions {
   double gifFrameRate = 12;  // frames per second of the GIF (every other frame at 24)
 };
 
-// Encodes the PNG files of `pngPattern` (#### for the frame number) for `frames` into `mp4` and `gif`
-// (either may be empty: not wanted), each written through a temporary and renamed into place. Returns
-// false, with nothing written, when ffmpeg is not installed; throws IoError when it fails.
+// Encodes the PNG files of `pngPattern` (#### or %04d for the frame number) for `frames` into `mp4` and
+// `gif` (either may be empty: not wanted), each written through a temporary and renamed into place.
+// The frames are read here and piped to ffmpeg, and the outputs named to it with the file: protocol, so
+// any path works (a folder with % or :, a name starting with -). An odd width or height is padded with
+// one black column or row for H.264, which needs even sizes. Returns false, with nothing written, when
+// ffmpeg is not installed; throws InputError for a frame that cannot be read, IoError when ffmpeg fails
+// ("ffmpeg failed (exit N): its last message line"), with the failed file's temporary removed.
 bool writeMovie(const std::filesystem::path& pngPattern, const FrameRange& frames,
                 const std::filesystem::path& mp4, const std::filesystem::path& gif,
                 const MovieOptions& options = {});

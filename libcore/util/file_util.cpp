@@ -44,17 +44,23 @@ struct TemporarySlot {
 };
 std::array<TemporarySlot, 256> gTemporaries;
 
-int registerTemporary(const fs::path& path) {
+// Reserves a slot for `path` (being filled: a handler leaves it alone until markLive); −1 when every
+// slot is taken (the write still happens, only a signal does not clean it).
+int reserveTemporary(const fs::path& path) {
   const std::string text = path.string();
   if (text.size() >= sizeof gTemporaries[0].path) return -1;
   for (size_t i = 0; i < gTemporaries.size(); ++i) {
     int expected = 0;
     if (!gTemporaries[i].state.compare_exchange_strong(expected, 1)) continue;
     std::memcpy(gTemporaries[i].path, text.c_str(), text.size() + 1);
-    gTemporaries[i].state.store(2);
     return int(i);
   }
-  return -1;  // more writes in flight than slots: still written, only not cleaned on a signal
+  return -1;
+}
+
+// The slot's file exists now, made by this process: a signal removes it.
+void markLive(int slot) {
+  if (slot >= 0) gTemporaries[size_t(slot)].state.store(2);
 }
 
 void releaseTemporary(int slot) {
@@ -67,13 +73,22 @@ extern "C" void removeTemporariesAndExit(int signal) {
   ::_exit(128 + signal);
 }
 
-// Files committed by this command, removed if it fails.
-std::mutex gCommittedMutex;
-std::vector<fs::path> gCommitted;
+// A file this process made and renamed into place: its name, and the device and inode of the file it
+// created there, so that a cleanup removes that file and nothing that has taken its name since.
+struct Committed {
+  fs::path path;
+  dev_t device = 0;
+  ino_t inode = 0;
+};
 
-void recordCommitted(const fs::path& path) {
+// Files committed by this command, in commit order; those from gKept on are removed if it fails.
+std::mutex gCommittedMutex;
+std::vector<Committed> gCommitted;
+size_t gKept = 0;
+
+void recordCommitted(const Committed& file) {
   std::lock_guard<std::mutex> lock(gCommittedMutex);
-  gCommitted.push_back(path);
+  gCommitted.push_back(file);
 }
 
 // ---------------------------------------------------------------------------------------------- outputs
@@ -163,19 +178,52 @@ Destination destinationOf(const fs::path& requested) {
     throw InputError({requested.string(), 0}, "is a directory; name a file to write");
   // A device, FIFO or socket, however reached (/dev/stdout is a link to /proc/self/fd/1): written as is.
   if (fs::exists(status) && !fs::is_regular_file(status)) return {requested, true};
-  // A link to a file, or a dangling one: the file it names is replaced, the link stays.
-  fs::path path = requested;
-  for (int depth = 0; fs::is_symlink(fs::symlink_status(path, ec)); ++depth) {
-    if (depth == 40) throw InputError({requested.string(), 0}, "too many levels of symbolic links");
-    const fs::path to = fs::read_symlink(path, ec);
-    if (ec) throw IoError({requested.string(), 0}, "cannot follow the symbolic link: " + ec.message());
-    path = to.is_absolute() ? to : path.parent_path() / to;
+  // A regular file, a new name, or a symbolic link to a file or to nothing: the name itself is
+  // replaced by the rename, as mv replaces it; nothing is written through a link.
+  return {requested, false};
+}
+
+// The folders on the way to `file` (its name `target` for messages), root first: each that exists must
+// be a folder (a link to one is followed); a missing one is made when `create`. A symbolic link that
+// points nowhere is refused either way: no folder is made through a link. Returns the deepest folder
+// that exists when done (the file's own after creating). Throws InputError for something on the way
+// that is not a folder or is a dangling link, IoError for a folder that cannot be made or examined.
+fs::path walkFolders(const fs::path& file, const std::string& target, bool create) {
+  const fs::path folder = file.parent_path();
+  fs::path walked, deepest = folder.is_absolute() ? folder.root_path() : fs::path(".");
+  for (const fs::path& part : folder) {
+    walked /= part;
+    struct stat st {};
+    if (::stat(walked.c_str(), &st) == 0) {
+      if (!S_ISDIR(st.st_mode))
+        throw InputError({walked.string(), 0}, "is not a folder, so " + target + " cannot be written");
+      deepest = walked;
+      continue;
+    }
+    if (errno != ENOENT)
+      throw IoError({target, 0}, "cannot reach " + walked.string() + ": " + std::strerror(errno));
+    if (::lstat(walked.c_str(), &st) == 0) {  // there, but stat found nothing behind it
+      std::error_code ec;
+      const fs::path to = fs::read_symlink(walked, ec);
+      throw InputError({walked.string(), 0}, "is a symbolic link to " +
+                                                 (ec ? std::string("nothing") : to.string()) +
+                                                 ", which does not exist; hairgen makes no folder through a "
+                                                 "link, so " +
+                                                 target + " cannot be written");
+    }
+    if (!create) return deepest;
+    if (::mkdir(walked.c_str(), 0777) != 0 && errno != EEXIST)
+      throw IoError({walked.string(), 0}, std::string("cannot create directory: ") + std::strerror(errno));
+    // Made, or made meanwhile by another process (a farm's tasks share folders): a folder either way?
+    if (::stat(walked.c_str(), &st) != 0 || !S_ISDIR(st.st_mode))
+      throw IoError({walked.string(), 0}, "cannot create directory: something else took its name");
+    deepest = walked;
   }
-  return {path, false};
+  return deepest;
 }
 
 // Removes temporaries beside `target` that a process of this host left when it died (a kill -9, a
-// lost node): NAME.tmp-HOST-PID-N whose PID no longer runs.
+// lost node): regular files named NAME.tmp-HOST-PID-N whose PID no longer runs.
 void sweepStaleTemporaries(const fs::path& target, const std::string& prefix) {
   std::error_code ec;
   const fs::path dir = target.parent_path().empty() ? fs::path(".") : target.parent_path();
@@ -190,26 +238,56 @@ void sweepStaleTemporaries(const fs::path& target, const std::string& prefix) {
     if (parsed != rest.c_str() + dash || pid <= 0) continue;
     if (::kill(pid_t(pid), 0) == 0 || errno != ESRCH) continue;  // alive, or not ours to judge
     std::error_code ignored;
+    if (!fs::is_regular_file(it->symlink_status(ignored))) continue;  // never one of ours
     fs::remove(it->path(), ignored);
   }
 }
 
-// A fresh name beside `target` (its folder created), registered for cleanup.
-fs::path temporaryBeside(const fs::path& target, int& slot) {
+// A temporary this process created, and the open descriptor it was created with.
+struct Temporary {
+  fs::path path;
+  int fd = -1;
+  int slot = -1;  // its entry in the interrupt cleanup table
+};
+
+// Creates a fresh temporary beside `target` (the folders on the way made, never through a dangling
+// link): O_CREAT | O_EXCL | O_NOFOLLOW, so it is a new file of this process and never a name someone
+// had put there (a link, a file); registered for cleanup on a signal.
+Temporary createTemporaryBeside(const fs::path& target) {
   static std::atomic<unsigned> counter{0};
   static const std::string host = hostName();
-  const fs::path dir = target.parent_path();
-  if (!dir.empty()) {
-    std::error_code ec;
-    fs::create_directories(dir, ec);
-    if (ec) throw IoError({dir.string(), 0}, "cannot create directory: " + ec.message());
+  try {
+    walkFolders(target, target.string(), true);
+  } catch (const InputError& e) {
+    // Found only while writing (the command did not check this output before its work): the write
+    // failed, as a folder that cannot be made fails it.
+    throw IoError(e.where(), e.message());
   }
   const std::string prefix = target.filename().string() + ".tmp-" + host + "-";
   sweepStaleTemporaries(target, prefix);
-  fs::path temporary = target;
-  temporary.replace_filename(prefix + std::to_string(::getpid()) + "-" + std::to_string(counter++));
-  slot = registerTemporary(temporary);
-  return temporary;
+  for (int attempt = 0;; ++attempt) {
+    Temporary t;
+    t.path = target;
+    t.path.replace_filename(prefix + std::to_string(::getpid()) + "-" + std::to_string(counter++));
+    t.slot = reserveTemporary(t.path);
+    t.fd = ::open(t.path.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_NOFOLLOW | O_CLOEXEC, 0666);
+    if (t.fd >= 0) {
+      markLive(t.slot);
+      return t;
+    }
+    const int error = errno;
+    releaseTemporary(t.slot);
+    if (error != EEXIST || attempt == 100)  // a name taken is someone else's: the next one is tried
+      throw IoError({target.string(), 0}, std::string("cannot write: ") + std::strerror(error));
+  }
+}
+
+// The device and inode of a file this process holds open; throws IoError when it cannot tell.
+Committed identityOf(int fd, const fs::path& target) {
+  struct stat st {};
+  if (::fstat(fd, &st) != 0)
+    throw IoError({target.string(), 0}, std::string("cannot write: ") + std::strerror(errno));
+  return {target, st.st_dev, st.st_ino};
 }
 
 void renameInto(const fs::path& temporary, const fs::path& target) {
@@ -306,18 +384,16 @@ void InputFile::read(void* out, size_t bytes) {
 void requireWritableOutput(const fs::path& target) {
   const Destination destination = destinationOf(target);  // a directory, a closed descriptor: refused
   if (destination.direct) return;
-  // The nearest folder that exists on the way to the file's: the one a write creates folders in.
-  std::error_code ec;
-  fs::path folder = fs::absolute(destination.path, ec).parent_path();
-  if (ec) folder = destination.path.parent_path();
-  if (folder.empty()) folder = ".";
-  while (!fs::exists(folder, ec) && folder.has_parent_path() && folder.parent_path() != folder)
-    folder = folder.parent_path();
-  if (fs::exists(folder, ec) && !fs::is_directory(folder, ec))
-    throw InputError({folder.string(), 0}, "is not a folder, so " + target.string() + " cannot be written");
+  // The deepest folder that exists on the way to the file's: the one a write creates folders in (or
+  // renames in).
+  const fs::path folder = walkFolders(destination.path, target.string(), false);
   if (::access(folder.c_str(), W_OK | X_OK) != 0)
     throw IoError({target.string(), 0},
                   std::string("cannot write in ") + folder.string() + ": " + std::strerror(errno));
+}
+
+void createOutputFolder(const fs::path& folder) {
+  walkFolders(folder / "file", folder.string(), true);
 }
 
 std::string contentDigest(const fs::path& path) {
@@ -383,47 +459,99 @@ std::vector<uint8_t> readFileBytes(const fs::path& path) {
   return readWhole<std::vector<uint8_t>>(path);
 }
 
-AtomicFile::AtomicFile(fs::path target) {
+// The stream's bytes to a descriptor, in 64 KiB writes; a failed write leaves the stream bad and keeps
+// its errno for the message.
+class AtomicFile::Buffer : public std::streambuf {
+ public:
+  explicit Buffer(int fd) : fd_(fd), buffer_(size_t(1) << 16) {
+    setp(buffer_.data(), buffer_.data() + buffer_.size());
+  }
+  int error() const { return error_; }
+
+ protected:
+  int_type overflow(int_type ch) override {
+    if (!drain()) return traits_type::eof();
+    if (!traits_type::eq_int_type(ch, traits_type::eof())) {
+      *pptr() = traits_type::to_char_type(ch);
+      pbump(1);
+    }
+    return traits_type::not_eof(ch);
+  }
+  int sync() override { return drain() ? 0 : -1; }
+  std::streamsize xsputn(const char* data, std::streamsize size) override {
+    if (size < std::streamsize(buffer_.size())) return std::streambuf::xsputn(data, size);
+    // A large block goes to the descriptor as it is, after what is buffered.
+    return drain() && writeAll(data, size_t(size)) ? size : 0;
+  }
+
+ private:
+  bool drain() {
+    const bool ok = writeAll(pbase(), size_t(pptr() - pbase()));
+    setp(buffer_.data(), buffer_.data() + buffer_.size());
+    return ok;
+  }
+  bool writeAll(const char* data, size_t size) {
+    for (size_t done = 0; done < size;) {
+      const ssize_t n = ::write(fd_, data + done, size - done);
+      if (n < 0 && errno == EINTR) continue;
+      if (n <= 0) {
+        error_ = n < 0 ? errno : ENOSPC;
+        return false;
+      }
+      done += size_t(n);
+    }
+    return true;
+  }
+
+  int fd_;
+  std::vector<char> buffer_;
+  int error_ = 0;
+};
+
+AtomicFile::AtomicFile(fs::path target) : stream_(nullptr) {
   const Destination destination = destinationOf(target);
   target_ = destination.path;
   descriptor_ = destination.descriptor;
-  // A descriptor's file is written whole at the end, from a temporary in the system's folder.
-  if (descriptor_ >= 0)
-    temporary_ = temporaryBeside(fs::temp_directory_path() / target_.filename(), slot_);
-  else if (!destination.direct)
-    temporary_ = temporaryBeside(target_, slot_);
-  const fs::path& path = destination.direct && descriptor_ < 0 ? target_ : temporary_;
-  stream_.open(path, std::ios::binary | std::ios::trunc);
-  if (!stream_) {
-    const std::string reason = std::strerror(errno);
-    releaseTemporary(slot_);
-    throw IoError({target.string(), 0}, "cannot write: " + reason);
+  if (destination.direct && descriptor_ < 0) {
+    // A device or FIFO, written in place (it exists: nothing is created here).
+    fd_ = ::open(target_.c_str(), O_WRONLY | O_CLOEXEC);
+    if (fd_ < 0) throw IoError({target.string(), 0}, std::string("cannot write: ") + std::strerror(errno));
+  } else {
+    // A descriptor's file is written whole at the end, from a temporary in the system's folder.
+    Temporary t =
+        createTemporaryBeside(descriptor_ >= 0 ? fs::temp_directory_path() / target_.filename() : target_);
+    temporary_ = t.path;
+    fd_ = t.fd;
+    slot_ = t.slot;
   }
+  buffer_ = std::make_unique<Buffer>(fd_);
+  stream_.rdbuf(buffer_.get());
 }
 
 AtomicFile::~AtomicFile() {
+  if (fd_ >= 0) ::close(fd_);
   if (committed_) return;
-  stream_.close();
-  if (!temporary_.empty()) {
-    std::error_code ec;
-    fs::remove(temporary_, ec);
-  }
+  if (!temporary_.empty()) ::unlink(temporary_.c_str());  // the name this object created, never another
   releaseTemporary(slot_);
 }
 
 void AtomicFile::commit() {
   stream_.flush();
-  const bool ok = static_cast<bool>(stream_);
-  stream_.close();
-  if (!ok || stream_.fail())
-    throw IoError({target_.string(), 0}, "write failed (no space left on the device?)");
+  int error = stream_ ? 0 : buffer_->error();
+  const bool written = static_cast<bool>(stream_);
+  const Committed identity = temporary_.empty() ? Committed{} : identityOf(fd_, target_);
+  if (::close(fd_) != 0 && written) error = errno;  // NFS reports a full disk here
+  fd_ = -1;
+  if (!written || error != 0)
+    throw IoError(
+        {target_.string(), 0},
+        std::string("write failed: ") + (error ? std::strerror(error) : "(no space left on the device?)"));
   if (descriptor_ >= 0) {
     copyToDescriptor(temporary_, descriptor_, target_);
-    std::error_code ec;
-    fs::remove(temporary_, ec);
+    ::unlink(temporary_.c_str());
   } else if (!temporary_.empty()) {
     renameInto(temporary_, target_);
-    recordCommitted(target_);
+    recordCommitted(identity);
   }
   releaseTemporary(slot_);
   committed_ = true;
@@ -431,30 +559,34 @@ void AtomicFile::commit() {
 
 void writeThroughTemporary(const fs::path& target, const std::function<void(const fs::path&)>& write) {
   const Destination destination = destinationOf(target);
-  int slot = -1;
   // A device's folder (/dev) is no place for a temporary: the system's temporary folder is.
-  const fs::path temporary = destination.direct
-                                 ? temporaryBeside(fs::temp_directory_path() / target.filename(), slot)
-                                 : temporaryBeside(destination.path, slot);
+  const Temporary temporary = createTemporaryBeside(
+      destination.direct ? fs::temp_directory_path() / target.filename() : destination.path);
+  ::close(temporary.fd);  // the library opens it by name
   try {
-    write(temporary);
+    write(temporary.path);
     if (destination.descriptor >= 0) {
-      copyToDescriptor(temporary, destination.descriptor, destination.path);
-      fs::remove(temporary);
+      copyToDescriptor(temporary.path, destination.descriptor, destination.path);
+      ::unlink(temporary.path.c_str());
     } else if (destination.direct) {
-      copyInto(temporary, destination.path);
-      fs::remove(temporary);
+      copyInto(temporary.path, destination.path);
+      ::unlink(temporary.path.c_str());
     } else {
-      renameInto(temporary, destination.path);
-      recordCommitted(destination.path);
+      // The file the library left at the temporary's name (it may have made it anew) is what is
+      // renamed, and what a cleanup may remove.
+      struct stat st {};
+      if (::lstat(temporary.path.c_str(), &st) != 0 || !S_ISREG(st.st_mode))
+        throw IoError({target.string(), 0},
+                      "write failed: the temporary " + temporary.path.string() + " is gone");
+      renameInto(temporary.path, destination.path);
+      recordCommitted({destination.path, st.st_dev, st.st_ino});
     }
   } catch (...) {
-    std::error_code ec;
-    fs::remove(temporary, ec);
-    releaseTemporary(slot);
+    ::unlink(temporary.path.c_str());
+    releaseTemporary(temporary.slot);
     throw;
   }
-  releaseTemporary(slot);
+  releaseTemporary(temporary.slot);
 }
 
 void writeFileAtomic(const fs::path& target, const void* data, size_t size) {
@@ -479,21 +611,34 @@ void installInterruptCleanup() {
 
 void discardCommittedOutputs() {
   std::lock_guard<std::mutex> lock(gCommittedMutex);
-  for (const fs::path& path : gCommitted) {
-    std::error_code ec;
-    fs::remove(path, ec);
+  // Newest first, each only while its name still holds the very file this process made there: never a
+  // file that replaced it since, and never what a link there points to (unlink removes a link itself).
+  for (size_t i = gCommitted.size(); i > gKept; --i) {
+    const Committed& file = gCommitted[i - 1];
+    struct stat st {};
+    if (::lstat(file.path.c_str(), &st) == 0 && S_ISREG(st.st_mode) && st.st_dev == file.device &&
+        st.st_ino == file.inode)
+      ::unlink(file.path.c_str());
   }
-  gCommitted.clear();
+  gCommitted.resize(gKept);
+}
+
+void keepCommittedOutputs() {
+  std::lock_guard<std::mutex> lock(gCommittedMutex);
+  gKept = gCommitted.size();
 }
 
 std::vector<fs::path> committedOutputs() {
   std::lock_guard<std::mutex> lock(gCommittedMutex);
-  return std::vector<fs::path>(gCommitted.begin(), gCommitted.end());
+  std::vector<fs::path> paths;
+  for (const Committed& file : gCommitted) paths.push_back(file.path);
+  return paths;
 }
 
 void forgetCommittedOutputs() {
   std::lock_guard<std::mutex> lock(gCommittedMutex);
   gCommitted.clear();
+  gKept = 0;
 }
 
 }  // namespace hairgen

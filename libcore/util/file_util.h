@@ -3,21 +3,31 @@
 // Inputs: only regular files are read (a FIFO, device or directory named as an input is refused before
 // it is opened, so nothing waits on a pipe), and a file larger than the memory budget is refused.
 //
-// Outputs: a regular file (or a new name) is written to a temporary beside it, NAME.tmp-HOST-PID-N,
-// and renamed over it on commit. A symbolic link is followed: the file it points to is replaced, the link
-// stays. A device, FIFO or socket (`--stats /dev/stdout`, a pipe) is written directly and never
-// replaced. A directory is refused. Write errors (a full disk, /dev/full) are IoErrors (exit 1).
+// Outputs: a regular file (or a new name) is written to a temporary beside it, NAME.tmp-HOST-PID-N, that
+// this process creates itself (O_CREAT | O_EXCL | O_NOFOLLOW: never a name someone put there), and
+// renamed over the name on commit. A symbolic link named as an output is replaced by the file, as mv
+// replaces it: nothing is written through the link into the file it points to, and no folder is made
+// for a link that points nowhere. Folders on the way are made as needed, one by one, but never through
+// a dangling link: requireWritableOutput refuses one before the work (an InputError, exit 2), a write
+// that finds one fails (an IoError, exit 1), as it does where something on the way is not a folder.
+// A device, FIFO or socket (`--stats /dev/stdout`, a pipe), reached directly or through links, is
+// written directly and never replaced. A directory is refused.
+// Write errors (a full disk, /dev/full) are IoErrors (exit 1).
 //
 // Interruptions and failures: installInterruptCleanup() makes SIGINT, SIGTERM and SIGHUP remove the
 // temporaries of writes in flight and end the process with 128 + the signal; a later write beside the
-// same target removes temporaries that dead processes of this host left. A command that fails calls
-// discardCommittedOutputs(), which removes every file it had already committed.
+// same target removes temporaries (regular files) that dead processes of this host left. A command that
+// fails calls discardCommittedOutputs(), which removes the files it committed since the last
+// keepCommittedOutputs(): each only while its name still holds the file this process made there
+// (checked by device and inode), so a cleanup never removes a file it did not make.
 #pragma once
 
 #include <cstdint>
 #include <filesystem>
 #include <fstream>
 #include <functional>
+#include <memory>
+#include <ostream>
 #include <string>
 #include <vector>
 
@@ -61,6 +71,11 @@ std::string contentDigest(const std::filesystem::path& path);
 // command's own descriptors pass.
 void requireWritableOutput(const std::filesystem::path& target);
 
+// Makes `folder` and the folders above it that are missing, as an output's folders are made: never
+// through a dangling symbolic link. Throws InputError when something on the way is not a folder or is a
+// link to nothing, IoError when a folder cannot be made.
+void createOutputFolder(const std::filesystem::path& folder);
+
 // For inputs a library opens by name: an InputError unless `path` is a regular file.
 void requireRegularFile(const std::filesystem::path& path);
 
@@ -76,11 +91,14 @@ class AtomicFile {
   void commit();
 
  private:
-  std::filesystem::path target_;     // the file written: a symbolic link's destination
+  class Buffer;                      // the stream's bytes to fd_
+  std::filesystem::path target_;     // the name written (a link there is replaced, not followed)
   std::filesystem::path temporary_;  // empty when writing a device or FIFO directly
   int descriptor_ = -1;  // an open descriptor of this process the file goes to (/dev/stdout), or -1
+  int fd_ = -1;          // what the stream writes to: the temporary this object created, or the device
   int slot_ = -1;        // the temporary's entry in the interrupt cleanup table
-  std::ofstream stream_;
+  std::unique_ptr<Buffer> buffer_;
+  std::ostream stream_;
   bool committed_ = false;
 };
 
@@ -100,11 +118,15 @@ inline void writeFileAtomic(const std::filesystem::path& target, const std::stri
 // ignored).
 void installInterruptCleanup();
 
-// Removes every regular file committed since the last call of either (a failed command's outputs),
-// resp. forgets them (a command that succeeded).
+// discardCommittedOutputs: removes the files committed since the last keepCommittedOutputs() (or since
+// forgetCommittedOutputs()), each only while its name still holds the file this process made there
+// (a failed command's outputs). keepCommittedOutputs: the files committed so far are finished and stay
+// whatever happens later (a sequence's frames: a failed frame never costs the frames before it).
+// forgetCommittedOutputs: forgets every file (a command that succeeded, or one that starts).
 void discardCommittedOutputs();
+void keepCommittedOutputs();
 void forgetCommittedOutputs();
-// The files committed since the last call of either, in commit order (for --stats).
+// The files committed and not discarded since forgetCommittedOutputs, in commit order (for --stats).
 std::vector<std::filesystem::path> committedOutputs();
 
 }  // namespace hairgen

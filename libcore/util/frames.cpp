@@ -1,6 +1,7 @@
 #include "libcore/util/frames.h"
 
-#include <cstdio>
+#include <algorithm>
+#include <cstdint>
 
 #include "libcore/util/error.h"
 #include "libcore/util/text.h"
@@ -8,11 +9,14 @@
 namespace hairgen {
 namespace {
 
+// The longest file name Linux file systems hold (NAME_MAX), in bytes.
+constexpr size_t kMaxNameBytes = 255;
+
 // Where the placeholder is in the file name: [begin, end) and its width; begin == npos when absent.
 struct Placeholder {
   size_t begin = std::string::npos, end = 0;
-  int width = 0;
-  int count = 0;  // placeholders found
+  size_t width = 0;  // digits, at least
+  int count = 0;     // placeholders found
 };
 
 Placeholder findPlaceholder(const std::string& name) {
@@ -24,14 +28,15 @@ Placeholder findPlaceholder(const std::string& name) {
       if (p.count++ == 0) {
         p.begin = i;
         p.end = j;
-        p.width = int(j - i);
+        p.width = j - i;
       }
       i = j;
     } else if (name[i] == '%') {
       size_t j = i + 1;
-      int width = 0;
-      while (j < name.size() && name[j] >= '0' && name[j] <= '9') width = width * 10 + (name[j++] - '0');
-      if (j < name.size() && name[j] == 'd' && width <= 12) {
+      size_t width = 0;  // saturated: a width past any file name's length is refused by framePath
+      while (j < name.size() && name[j] >= '0' && name[j] <= '9')
+        width = std::min<size_t>(width * 10 + size_t(name[j++] - '0'), kMaxNameBytes + 1);
+      if (j < name.size() && name[j] == 'd') {
         if (p.count++ == 0) {
           p.begin = i;
           p.end = j + 1;
@@ -74,10 +79,19 @@ std::filesystem::path framePath(const std::filesystem::path& pattern, int frame)
     throw InputError({pattern.string(), 0},
                      "has no frame number in its name; write #### (or %04d) where it goes");
   if (p.count > 1) throw InputError({pattern.string(), 0}, "has more than one frame-number placeholder");
-  char digits[32];
-  std::snprintf(digits, sizeof digits, "%0*d", p.width, frame);
+  // The digits zero-padded to the placeholder's width, however wide: every frame its own name.
+  const std::string magnitude = std::to_string(frame < 0 ? -int64_t(frame) : int64_t(frame));
+  std::string digits = frame < 0 ? "-" : "";
+  if (p.width > magnitude.size() + digits.size())
+    digits.append(p.width - magnitude.size() - digits.size(), '0');
+  digits += magnitude;
+  const std::string file = name.substr(0, p.begin) + digits + name.substr(p.end);
+  if (file.size() > kMaxNameBytes)
+    throw InputError({pattern.string(), 0}, "makes frame file names of " + std::to_string(file.size()) +
+                                                " bytes, longer than the " + std::to_string(kMaxNameBytes) +
+                                                " a file name can have; write a shorter name or fewer #");
   std::filesystem::path out = pattern;
-  out.replace_filename(name.substr(0, p.begin) + digits + name.substr(p.end));
+  out.replace_filename(file);
   return out;
 }
 

@@ -17,12 +17,13 @@ struct FrameRange {
 FrameRange parseFrameRange(std::string_view text, const std::string& flag);
 
 // Whether `pattern` holds a frame-number placeholder: one run of '#' (its length the zero-padded
-// width) or one printf-style %0Nd / %d.
+// width, any length) or one printf-style %0Nd / %d (N any width).
 bool isFramePattern(const std::filesystem::path& pattern);
 
-// The pattern with `frame` in place of its placeholder, zero-padded to its width; a negative frame
-// keeps its sign in front of the padding. Throws InputError when there is no placeholder, or more
-// than one.
+// The pattern with `frame` in place of its placeholder, zero-padded to its width (the width counts a
+// negative frame's sign, which stays in front of the padding); wider numbers are written whole.
+// Throws InputError when there is no placeholder, more than one, or when the frame's file name would
+// be longer than the 255 bytes a file name can have.
 std::filesystem::path framePath(const std::filesystem::path& pattern, int frame);
 
 }  // namespace hairgen
