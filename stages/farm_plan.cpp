@@ -7,6 +7,7 @@
 #include <cmath>
 
 #include "libcore/util/error.h"
+#include "libcore/util/json.h"
 #include "libcore/util/text.h"
 #include "stages/estimate.h"
 #include "stages/shade.h"
@@ -237,9 +238,9 @@ FarmPlan farmPlanFromJson(const nlohmann::ordered_json& j, const std::string& na
   const FileLoc where{name, 0};
   if (!j.is_object() || j.value("format", "") != "hairgen-farm-plan")
     throw InputError(where, "is not a hairgen farm plan (no \"format\": \"hairgen-farm-plan\")");
-  if (j.value("version", 0) != 1)
-    throw InputError(where, "is a farm plan of version " +
-                                j.value("version", nlohmann::ordered_json()).dump() +
+  const nlohmann::ordered_json version = j.value("version", nlohmann::ordered_json());
+  if (version != nlohmann::ordered_json(1))  // any JSON, a string of any bytes included
+    throw InputError(where, "is a farm plan of version " + printableText(jsonText(version, -1)) +
                                 "; this hairgen reads version 1");
   try {
     FarmPlan plan;

@@ -195,6 +195,12 @@ EOF
       fail "TinyUSDZ cannot read the .usda: $(cat "$tmp/v")"
   fi
   ;;
+plan_version)
+  # A farm plan's version of another JSON type is a bad plan (exit 2), not an internal error.
+  printf '{"format": "hairgen-farm-plan", "version": "two\\u0000"}' > "$tmp/plan.json"
+  expect_rc 2 "$hairgen" farm submit "$tmp/plan.json" --scheduler slurm
+  expect_err 'plan.json: is a farm plan of version "two\u0000"; this hairgen reads version 1'
+  ;;
 shade_rest_frame)
   # shade --rest over a sequence names the frame whose strands are not the rest's.
   setup="$src/configs/default/setup.txt"
