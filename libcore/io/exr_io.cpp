@@ -112,6 +112,8 @@ void checkAgainstFile(exr_const_context_t context, int part, const FileLoc& wher
   if (chunks < 0 || uint64_t(chunks) * 16u > fileBytes)
     throw InputError(where, "declares " + std::to_string(chunks) + " chunks of pixels, more than the " +
                                 std::to_string(fileBytes) + "-byte file can hold");
+  // A deep part's pixels are sample counts and lists, whose sizes its chunks give, not its header.
+  if (storage == EXR_STORAGE_DEEP_SCANLINE || storage == EXR_STORAGE_DEEP_TILED) return;
   exr_compression_t compression = EXR_COMPRESSION_NONE;
   if (const exr_result_t r = exr_get_compression(context, part, &compression); r != EXR_ERR_SUCCESS)
     throw refuse(r);
@@ -182,11 +184,14 @@ void checkExrHeader(const fs::path& file, const FileLoc& where) {
     const int64_t width = int64_t(window.max.x) - window.min.x + 1,
                   height = int64_t(window.max.y) - window.min.y + 1;
     checkDeclaredSize(where, width, height, channels ? channels->num_channels : 0, chunkRows);
-    uint64_t pixelBytes = 0;  // one pixel of every channel, as stored
-    for (int c = 0; c < channels->num_channels; ++c)
-      pixelBytes += channels->entries[c].pixel_type == EXR_PIXEL_HALF ? 2 : 4;
-    checkAgainstFile(context, part, where, fileBytes, uint64_t(width) * uint64_t(height) * pixelBytes,
-                     storage, window, chunkRows, refuse);
+    uint64_t rawBytes = 0;  // every channel's samples as stored (a subsampled one has fewer)
+    for (int c = 0; c < channels->num_channels; ++c) {
+      const exr_attr_chlist_entry_t& channel = channels->entries[c];
+      const int64_t xs = std::max(channel.x_sampling, 1), ys = std::max(channel.y_sampling, 1);
+      rawBytes += uint64_t((width + xs - 1) / xs) * uint64_t((height + ys - 1) / ys) *
+                  (channel.pixel_type == EXR_PIXEL_HALF ? 2u : 4u);
+    }
+    checkAgainstFile(context, part, where, fileBytes, rawBytes, storage, window, chunkRows, refuse);
   }
 }
 
