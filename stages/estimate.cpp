@@ -192,7 +192,7 @@ WorkEstimate renderCost(const RenderSettings& r, size_t strands, size_t points, 
   e.seconds = 3.0 * double(points) * kSecondsPerVertex + (fragments + fine) * kSecondsPerFragment;
   const double focal = 0.5 * r.resolution.y / std::tan(0.5 * r.fieldOfView * M_PI / 180.0);
   const double widthPx = r.strandWidth * focal / std::max(distance, 1e-6);
-  e.timeKey = widthPx * block > 4.0 * block ? "Render.StrandWidth" : "Render.Resolution or Render.Samples";
+  e.timeKey = widthPx > 4.0 ? "Render.StrandWidth" : "Render.Resolution or Render.Samples";
   e.detail = std::to_string(r.resolution.x) + "x" + std::to_string(r.resolution.y) + " pixels at " +
              std::to_string(block * block) + " samples, " + std::to_string(strands) + " strands";
   const double side = double(std::min(r.resolution.x, r.resolution.y));

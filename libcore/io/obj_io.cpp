@@ -10,6 +10,7 @@
 
 #include <tiny_obj_loader.h>
 
+#include "libcore/io/hair_cache.h"
 #include "libcore/model/shape_fit.h"
 #include "libcore/util/error.h"
 #include "libcore/util/file_util.h"
@@ -170,21 +171,13 @@ std::string otherFormat(std::string_view text, const std::filesystem::path& file
   };
   for (const Magic& m : kMagics)
     if (text.substr(0, m.bytes.size()) == m.bytes) return m.format;
+  // Extensions: the hair formats' own table, and the other files a pipeline hands around.
+  if (const std::optional<HairFormat> hair = hairFormatFor(file))
+    return "a " + std::string(describe(*hair)) + " file (by its extension)";
   static constexpr std::pair<const char*, const char*> kExtensions[] = {
-      {".ply", "a PLY file"},
-      {".hair", "a cyHair .hair file"},
-      {".glb", "a binary glTF file"},
-      {".gltf", "a glTF file"},
-      {".data", "a USC-HairSalon .data file"},
-      {".usda", "a USD layer"},
-      {".usd", "a USD layer"},
-      {".usdc", "a USD crate file"},
-      {".usdz", "a USD package"},
-      {".exr", "an OpenEXR image"},
-      {".fbx", "an FBX file"},
-      {".abc", "an Alembic archive"},
-      {".stl", "an STL mesh"},
-      {".png", "a PNG image"},
+      {".usd", "a USD layer"},      {".usdc", "a USD crate file"}, {".usdz", "a USD package"},
+      {".exr", "an OpenEXR image"}, {".fbx", "an FBX file"},       {".abc", "an Alembic archive"},
+      {".stl", "an STL mesh"},      {".png", "a PNG image"},
   };
   const std::string extension = toLower(file.extension().string());
   for (const auto& [ext, format] : kExtensions)
