@@ -108,7 +108,8 @@ void registerShade(CLI::App& app, int& exitCode) {
           const std::string written = sequence ? framePath(options->output, f).string() : options->output;
           const Strands deformed = readStrandsAs(in, options->units);
           stats.add("read", clock.lap());
-          const Strands out = repose(rest, deformed);
+          // What repose refuses is this frame's: its file goes in the message.
+          const Strands out = namingFile(in, [&] { return repose(rest, deformed); });
           stats.add("repose", clock.lap());
           stats.counts()["strands"] = out.strandCount();
           stats.counts()["points"] = out.pointCount();

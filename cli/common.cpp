@@ -124,7 +124,7 @@ int runCommand(const std::string& command, const CommonOptions& options, const s
   gStatsWriteFailed = false;
   auto failed = [&](const std::string& message, ExitCode code) {
     discardCommittedOutputs();  // a failed command leaves none of its outputs but finished frames
-    std::cerr << "hairgen " << command << ": error: " << oneLine(message) << "\n";
+    std::cerr << "hairgen " << command << ": error: " << printableText(oneLine(message)) << "\n";
     if (!options.statsFile.empty() && !gStatsWriteFailed) {
       // A farm script reads why, even from a command that failed before it gathered anything.
       nlohmann::ordered_json stats =

@@ -11,17 +11,29 @@
 
 namespace hairgen::cli {
 
+namespace {
+
+// " (setup.txt:4)": where a config named a mesh, for the messages of its reading.
+std::string namedAt(const PathRef& ref) {
+  const std::string where = ref.where.str();
+  return where.empty() ? "" : " (" + where + ")";
+}
+
+}  // namespace
+
 Mesh readWick(const Config& config) {
   MeshReadOptions options;
   options.group = config.setup.wickGroup;
   options.allowPoints = true;
   options.conversion = config.setup.meshConversion;
+  options.role = "WickModel" + namedAt(config.setup.wickModel);
   return readObj(config.setup.wickModel.path, options);
 }
 
 Mesh readHead(const Config& config) {
   MeshReadOptions options;
   options.conversion = config.setup.meshConversion;
+  options.role = "HeadModel" + namedAt(config.setup.headModel);
   return readObj(config.setup.headModel.path, options);
 }
 

@@ -7,6 +7,7 @@
 #include <cmath>
 #include <thread>
 
+#include "libcore/render/views.h"
 #include "libcore/util/error.h"
 #include "libcore/util/resources.h"
 #include "libcore/util/text.h"
@@ -35,8 +36,9 @@ constexpr double kSecondsPerSegmentStep = 60e-9;
 // and its share of the frame's velocity smoothing (SimulateSprings: ~0.12 CPU s a frame for 310k
 // segments at 2 substeps).
 constexpr double kSecondsPerSpringStep = 200e-9;
-// llvmpipe: per vertex pushed through a pass, and per fragment of the shading pass with its shadow
-// look-ups and overdraw (render benchmarks; 1,000 strands 0.5 m wide at 640x640 took 113 s).
+// llvmpipe: per vertex pushed through a pass, and per fragment the ribbons cover (hairCoverage) with its
+// shadow look-ups, at its most: fragments a depth test rejects cost less (coupe 3's 759 guides 0.1 m wide
+// cover 4.3e9 sub-pixels of a 640x640 image in 12.8 s, 3 ns each; 0.02 m wide, 1.7e8 in 2.7 s).
 constexpr double kSecondsPerVertex = 150e-9, kSecondsPerFragment = 60e-9;
 
 double cores(size_t threads) {
@@ -69,6 +71,7 @@ void requireFits(const WorkEstimate& e, bool force) {
     throw InputError(e.stage + " would need about " + formatBytes(e.bytes) + " of memory (" + e.detail +
                      "), more than the " + formatBytes(budget) + " free on this machine; change " +
                      e.memoryKey);
+  if (!e.refusal.empty() && !force) throw InputError(e.refusal + ", or pass --force to run it anyway");
   if (e.seconds > kTimeLimitSeconds && !force)
     throw InputError(e.stage + " would take about " + seconds(e.seconds) + " (" + e.detail + "); change " +
                      e.timeKey + ", or pass --force to run it anyway");
@@ -156,12 +159,26 @@ WorkEstimate estimateShade(const RenderSettings& render, size_t strands, size_t 
   return e;
 }
 
-WorkEstimate estimateRender(const RenderSettings& r, size_t strands, size_t points, size_t headTriangles,
-                            double nearest, double hairLength, int maxTextureSize) {
-  WorkEstimate e;
-  e.stage = "render";
+namespace {
+
+// k for Samples = k² (k ≤ 8), lowered until the sub-pixel image fits the device's largest texture, as
+// the renderer chooses it.
+int subpixelBlock(const RenderSettings& r, int maxTextureSize) {
   int block = std::clamp(int(std::lround(std::sqrt(double(r.samples)))), 1, 8);
   while (block > 1 && std::max(r.resolution.x, r.resolution.y) * block > maxTextureSize) --block;
+  return block;
+}
+
+// A strand drawn wider than this share of the image's smaller side is a sheet, not a hair: 759 guides
+// 0.5 m wide filled a 640x640 coupe image 400 times over (40 s of llvmpipe for a grey wall).
+constexpr double kSheetShare = 0.25;
+
+// The render's memory and time, from `fragments`: the sub-pixel fragments the hair's ribbons cover.
+// `distance`: from the camera to the scene's centre, metres, where a strand's width is judged.
+WorkEstimate renderCost(const RenderSettings& r, size_t strands, size_t points, size_t headTriangles,
+                        double fragments, double distance, int block) {
+  WorkEstimate e;
+  e.stage = "render";
   const double pixels = double(r.resolution.x) * double(r.resolution.y);
   const double fine = pixels * double(block) * double(block);
   const int dom = std::clamp(std::max(r.resolution.x, r.resolution.y) / 2, 1024, 4096);
@@ -172,21 +189,123 @@ WorkEstimate estimateRender(const RenderSettings& r, size_t strands, size_t poin
   const double geometry = double(points) * 48.0 * 2.0 + double(strands) * 16.0 + double(headTriangles) * 36.0;
   e.bytes = bytesOf(framebuffers + geometry);
   e.memoryKey = framebuffers >= geometry ? "Render.Resolution or Render.Samples" : "the coupe's size";
-  // Fill: each strand is a ribbon at least a sub-pixel wide and as long as it looks from the nearest
-  // point of the scene.
-  const double focal = 0.5 * r.resolution.y * block / std::tan(0.5 * r.fieldOfView * M_PI / 180.0);
-  const double scale = focal / std::max(nearest, 1e-3);
-  const double widthPx = std::max(r.strandWidth * scale, double(block)), lengthPx = hairLength * scale;
-  const double fragments = double(strands) * lengthPx * widthPx + fine;
-  e.seconds = 3.0 * double(points) * kSecondsPerVertex + fragments * kSecondsPerFragment;
-  e.timeKey = widthPx > 4.0 * block ? "Render.StrandWidth" : "Render.Resolution or Render.Samples";
-  // Strands metres long are a file in other units (a groom in centimetres read as metres): say so, since
-  // no render setting is what is wrong.
+  e.seconds = 3.0 * double(points) * kSecondsPerVertex + (fragments + fine) * kSecondsPerFragment;
+  const double focal = 0.5 * r.resolution.y / std::tan(0.5 * r.fieldOfView * M_PI / 180.0);
+  const double widthPx = r.strandWidth * focal / std::max(distance, 1e-6);
+  e.timeKey = widthPx > 4.0 ? "Render.StrandWidth" : "Render.Resolution or Render.Samples";
+  e.detail = std::to_string(r.resolution.x) + "x" + std::to_string(r.resolution.y) + " pixels at " +
+             std::to_string(block * block) + " samples, " + std::to_string(strands) + " strands";
+  const double side = double(std::min(r.resolution.x, r.resolution.y));
+  if (widthPx > kSheetShare * side)
+    e.refusal = "Render.StrandWidth " + formatReal(r.strandWidth) + " m draws each strand about " +
+                formatReal(std::round(widthPx)) + " pixels wide at the hair's distance, on a " +
+                std::to_string(r.resolution.x) + "x" + std::to_string(r.resolution.y) +
+                " image: a sheet, not a hair; lower Render.StrandWidth (a hair is 5e-05 to 0.0001 m wide)";
+  return e;
+}
+
+// Strands metres long are a file in other units (a groom in centimetres read as metres): say so, since
+// no render setting is what is wrong.
+void blameUnits(WorkEstimate& e, double hairLength) {
   if (hairLength > 3.0)
     e.timeKey = "the hair's units: its strands are " + formatReal(std::round(hairLength * 10.0) / 10.0) +
                 " m long, so the file is in other units (render it with --units cm or mm, or --frame)";
-  e.detail = std::to_string(r.resolution.x) + "x" + std::to_string(r.resolution.y) + " pixels at " +
-             std::to_string(block * block) + " samples, " + std::to_string(strands) + " strands";
+}
+
+// Liang-Barsky: clips the segment a + t (b − a), t in [t0, t1], to lo <= x, y <= hi; false when nothing
+// is left.
+bool clipToBox(const glm::dvec2& a, const glm::dvec2& b, const glm::dvec2& lo, const glm::dvec2& hi,
+               double& t0, double& t1) {
+  const glm::dvec2 d = b - a;
+  for (int axis = 0; axis < 2; ++axis) {
+    const double p[2] = {-d[axis], d[axis]}, q[2] = {a[axis] - lo[axis], hi[axis] - a[axis]};
+    for (int side = 0; side < 2; ++side) {
+      if (p[side] == 0.0) {
+        if (q[side] < 0.0) return false;
+        continue;
+      }
+      const double t = q[side] / p[side];
+      if (p[side] < 0.0)
+        t0 = std::max(t0, t);
+      else
+        t1 = std::min(t1, t);
+      if (t0 > t1) return false;
+    }
+  }
+  return true;
+}
+
+}  // namespace
+
+double hairCoverage(const View& view, const Strands& hair, double strandWidth, double minWidthPx) {
+  const glm::dvec2 size(view.width, view.height);
+  const double screen = size.x * size.y;
+  // The near plane (glm::perspective's), before which the device clips.
+  const double nearDepth = std::max(view.proj[3][2] / (view.proj[2][2] - 1.0), 1e-9);
+  double fragments = 0.0;
+  for (size_t s = 0; s < hair.strandCount(); ++s) {
+    for (uint32_t i = hair.firstPoint[s]; i + 1 < hair.firstPoint[s + 1]; ++i) {
+      glm::dvec3 a = glm::dvec3(view.view * glm::dvec4(glm::dvec3(hair.points[i]), 1.0));
+      glm::dvec3 b = glm::dvec3(view.view * glm::dvec4(glm::dvec3(hair.points[i + 1]), 1.0));
+      // Depth along the view's −z; the part of the segment in front of the eye.
+      double da = -a.z, db = -b.z;
+      if (da < nearDepth && db < nearDepth) continue;
+      if (da < nearDepth) {
+        a += (b - a) * ((nearDepth - da) / (db - da));
+        da = nearDepth;
+      } else if (db < nearDepth) {
+        b += (a - b) * ((nearDepth - db) / (da - db));
+        db = nearDepth;
+      }
+      const double wa = std::max(strandWidth * view.focalPx / da, minWidthPx),
+                   wb = std::max(strandWidth * view.focalPx / db, minWidthPx);
+      const glm::dvec2 pa = 0.5 * size + view.focalPx * glm::dvec2(a.x, a.y) / da,
+                       pb = 0.5 * size + view.focalPx * glm::dvec2(b.x, b.y) / db;
+      // The ribbon reaches half its width beyond its centre line.
+      const double reach = 0.5 * std::max(wa, wb);
+      double t0 = 0.0, t1 = 1.0;
+      if (!clipToBox(pa, pb, glm::dvec2(-reach), size + reach, t0, t1)) continue;
+      const double length = glm::length(pb - pa) * (t1 - t0);
+      const double width = wa + (wb - wa) * 0.5 * (t0 + t1);
+      // A quad at least its width long (the joins), and never more than the image.
+      fragments += std::min(std::max(length, width) * width, screen);
+    }
+  }
+  return fragments;
+}
+
+WorkEstimate estimateRender(const RenderSettings& r, const Strands& hair, const Mesh* head,
+                            int maxTextureSize) {
+  const int block = subpixelBlock(r, maxTextureSize);
+  const BoundingSphere sphere = boundingSphere(hair, head);
+  const View fine = subpixelView(cameraView(r, sphere), block);
+  const double fragments = hairCoverage(fine, hair, r.strandWidth, double(block));
+  WorkEstimate e = renderCost(r, hair.strandCount(), hair.pointCount(), head ? head->triangleCount() : 0,
+                              fragments, glm::length(sphere.centre - r.cameraPosition), block);
+  double longest = 0.0;
+  for (size_t s = 0; s < hair.strandCount(); ++s) {
+    double length = 0.0;
+    for (uint32_t p = hair.firstPoint[s] + 1; p < hair.firstPoint[s + 1]; ++p)
+      length += glm::length(glm::dvec3(hair.points[p]) - glm::dvec3(hair.points[p - 1]));
+    longest = std::max(longest, length);
+  }
+  blameUnits(e, longest);
+  return e;
+}
+
+WorkEstimate estimateRender(const RenderSettings& r, size_t strands, size_t points, size_t headTriangles,
+                            double distance, double radius, double hairLength, int maxTextureSize) {
+  const int block = subpixelBlock(r, maxTextureSize);
+  const double fine = double(r.resolution.x) * r.resolution.y * block * block;
+  // Each strand a ribbon at least a sub-pixel wide and as long as it looks from the scene's nearest
+  // point, covering at most the image.
+  const double nearest = std::max(distance - radius, 1e-3);
+  const double focal = 0.5 * r.resolution.y * block / std::tan(0.5 * r.fieldOfView * M_PI / 180.0);
+  const double scale = focal / nearest;
+  const double widthPx = std::max(r.strandWidth * scale, double(block)), lengthPx = hairLength * scale;
+  const double fragments = double(strands) * std::min(std::max(lengthPx, widthPx) * widthPx, fine);
+  WorkEstimate e = renderCost(r, strands, points, headTriangles, fragments, distance, block);
+  blameUnits(e, hairLength);
   return e;
 }
 
@@ -229,9 +348,9 @@ std::vector<WorkEstimate> estimateRun(const Config& config, const Mesh& wick, bo
   if (shade) out.push_back(estimateShade(config.render, size_t(strands), size_t(coupePoints), span));
   if (render) {
     const glm::dvec3 centre = 0.5 * (glm::dvec3(box.min) + glm::dvec3(box.max));
-    const double nearest = glm::length(config.render.cameraPosition - centre) - 0.5 * glm::length(span);
     out.push_back(estimateRender(config.render, size_t(strands), size_t(coupePoints), 0,
-                                 std::max(nearest, 1e-3), length, 16384));
+                                 glm::length(config.render.cameraPosition - centre), 0.5 * glm::length(span),
+                                 length, 16384));
   }
   return out;
 }

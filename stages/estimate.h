@@ -13,6 +13,7 @@
 #include "libcore/config/params.h"
 #include "libcore/model/mesh.h"
 #include "libcore/model/strands.h"
+#include "libcore/render/views.h"
 #include "libcore/util/frames.h"
 
 namespace hairgen {
@@ -24,6 +25,7 @@ struct WorkEstimate {
   std::string memoryKey;  // the key that drives the memory, e.g. "Hairstyle.VisualityStep"
   std::string timeKey;    // the key that drives the time
   std::string detail;     // what the figures come from: "759 guides x 65 points"
+  std::string refusal;    // work that is wrong whatever it costs, naming the key; --force overrides it
 };
 
 // Beyond this a stage is stopped before it starts unless --force: an hour is far past any coupe or
@@ -43,10 +45,20 @@ WorkEstimate estimateInterpolate(const Hairstyle& style, double wickAreaCm2, siz
 // `span`: the coupe's bounding box size, metres.
 WorkEstimate estimateShade(const RenderSettings& render, size_t strands, size_t points,
                            const glm::dvec3& span);
-// `nearest`: the distance from the camera to the nearest point of the scene, metres; `hairLength`: the
-// longest strand, metres.
+// The sub-pixel fragments `hair`'s ribbons cover in `view` (the camera at its sub-pixels), what the
+// render's time grows with: each segment clipped to the near plane and to the image (widened by half the
+// ribbon), its length in pixels times its width (`strandWidth` metres, at least `minWidthPx`), at most
+// the image's pixels a segment. Off-screen hair costs nothing.
+double hairCoverage(const View& view, const Strands& hair, double strandWidth, double minWidthPx);
+
+// The render of `hair` (and `head`, may be null) with `render`'s camera as framed, its time from
+// hairCoverage. A strand drawn wider than a quarter of the image is a refusal naming Render.StrandWidth.
+WorkEstimate estimateRender(const RenderSettings& render, const Strands& hair, const Mesh* head,
+                            int maxTextureSize);
+// The same predicted before there is hair: `distance` from the camera to the scene's centre, `radius`
+// the scene's, `hairLength` the longest strand, metres; each strand covers at most the image.
 WorkEstimate estimateRender(const RenderSettings& render, size_t strands, size_t points, size_t headTriangles,
-                            double nearest, double hairLength, int maxTextureSize);
+                            double distance, double radius, double hairLength, int maxTextureSize);
 
 // `segments`: the guides' segments (points − strands); `frames`: the frames to simulate.
 WorkEstimate estimateSimulate(const Dynamics& dynamics, size_t segments, const FrameRange& frames,

@@ -7,6 +7,7 @@
 #include <cmath>
 
 #include "libcore/util/error.h"
+#include "libcore/util/json.h"
 #include "libcore/util/text.h"
 #include "stages/estimate.h"
 #include "stages/shade.h"

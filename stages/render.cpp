@@ -44,17 +44,6 @@ bool colorsInRange(const Strands& hair) {
   return true;
 }
 
-double longestStrand(const Strands& hair) {
-  double longest = 0.0;
-  for (size_t s = 0; s < hair.strandCount(); ++s) {
-    double length = 0.0;
-    for (uint32_t p = hair.firstPoint[s] + 1; p < hair.firstPoint[s + 1]; ++p)
-      length += glm::length(glm::dvec3(hair.points[p]) - glm::dvec3(hair.points[p - 1]));
-    longest = std::max(longest, length);
-  }
-  return longest;
-}
-
 // A rendered image must hold numbers: a non-finite pixel is a bug (or an input the checks missed),
 // never something to write into an EXR.
 void requireFinite(const Image& image) {
@@ -139,13 +128,7 @@ RenderOutput render(GlContext& gl, const Strands& hair, const Mesh* head, const 
     copyFraming.reset();
     if (options.uploaded) options.uploaded();
   };
-  const BoundingSphere scene = boundingSphere(*input.hair, head);
-  const double nearest =
-      std::max(glm::length(scene.centre - input.settings.cameraPosition) - scene.radius, 1e-3);
-  requireFits(estimateRender(input.settings, input.hair->strandCount(), input.hair->pointCount(),
-                             head ? head->triangleCount() : 0, nearest, longestStrand(*input.hair),
-                             gl.maxTextureSize()),
-              options.force);
+  requireFits(estimateRender(input.settings, *input.hair, head, gl.maxTextureSize()), options.force);
   RenderOutput out = renderHair(gl, input);
   requireFinite(out.beauty);
   return out;

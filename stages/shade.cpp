@@ -1,5 +1,6 @@
 #include "stages/shade.h"
 
+#include <algorithm>
 #include <cmath>
 
 #include <tbb/blocked_range.h>
@@ -75,10 +76,18 @@ ShadeResult shade(Strands coupe, const Visuality& visuality, const RenderSetting
 }
 
 Strands repose(const Strands& rest, const Strands& deformed) {
-  if (!rest.strandId.empty() && !deformed.strandId.empty() && rest.strandId != deformed.strandId)
-    throw InputError(
-        "the rest coupe and the coupe to re-pose hold different strand ids; both must come from the "
-        "same interpolate run");
+  if (!rest.strandId.empty() && !deformed.strandId.empty() && rest.strandId != deformed.strandId) {
+    const size_t common = std::min(rest.strandId.size(), deformed.strandId.size());
+    size_t i = 0;
+    while (i < common && rest.strandId[i] == deformed.strandId[i]) ++i;
+    throw InputError("the coupe's strand ids differ from the rest coupe's (" +
+                     (i < common
+                          ? "strand " + std::to_string(i) + " is id " + std::to_string(deformed.strandId[i]) +
+                                " here and " + std::to_string(rest.strandId[i]) + " at rest"
+                          : std::to_string(deformed.strandId.size()) + " strands here, " +
+                                std::to_string(rest.strandId.size()) + " at rest") +
+                     "); both must come from the same interpolate run");
+  }
   Strands out = deformed;
   out.normals = reposeNormals(rest, deformed);
   if (out.colors.empty()) out.colors = rest.colors;

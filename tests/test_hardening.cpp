@@ -290,7 +290,7 @@ TEST(Hardening, AbsurdConfigsAreRefusedBeforeTheWork) {
   render = {};
   render.resolution = {16384, 16384};
   render.samples = 4;
-  EXPECT_THROW(requireFits(estimateRender(render, 50000, 3200000, 31696, 0.3, 0.16, 16384), true),
+  EXPECT_THROW(requireFits(estimateRender(render, 50000, 3200000, 31696, 0.5, 0.2, 0.16, 16384), true),
                InputError);
   // A float-to-integer conversion before the overflow guard used to give a bald coupe.
   EXPECT_EQ(strandsInTriangle(1.0, 1e20, 0.5), std::numeric_limits<uint32_t>::max());

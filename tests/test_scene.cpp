@@ -51,13 +51,13 @@ const char* kGrouped =
     "g skin\nf 1 2 3\ng scalp\nf 2 5 3\nusemtl hair\nf 1 3 4\n";
 
 TEST(MeshRead, WickGroupKeepsItsFacesAndNamesTheOthersWhenWrong) {
-  const Mesh skin = parseObj(kGrouped, "g.obj", MeshReadOptions{"skin", false, {}});
+  const Mesh skin = parseObj(kGrouped, "g.obj", MeshReadOptions{"skin", false, {}, {}});
   EXPECT_EQ(skin.triangleCount(), 1u);
   EXPECT_EQ(skin.vertexCount(), 3u);  // only the vertices its faces use
-  EXPECT_EQ(parseObj(kGrouped, "g.obj", MeshReadOptions{"scalp", false, {}}).triangleCount(), 2u);
-  EXPECT_EQ(parseObj(kGrouped, "g.obj", MeshReadOptions{"hair", false, {}}).triangleCount(), 1u);
+  EXPECT_EQ(parseObj(kGrouped, "g.obj", MeshReadOptions{"scalp", false, {}, {}}).triangleCount(), 2u);
+  EXPECT_EQ(parseObj(kGrouped, "g.obj", MeshReadOptions{"hair", false, {}, {}}).triangleCount(), 1u);
   try {
-    parseObj(kGrouped, "g.obj", MeshReadOptions{"Scalp", false, {}});
+    parseObj(kGrouped, "g.obj", MeshReadOptions{"Scalp", false, {}, {}});
     FAIL() << "a wrong group was accepted";
   } catch (const InputError& e) {
     EXPECT_NE(std::string(e.what()).find("skin, scalp, hair"), std::string::npos) << e.what();
@@ -67,7 +67,7 @@ TEST(MeshRead, WickGroupKeepsItsFacesAndNamesTheOthersWhenWrong) {
 TEST(MeshRead, UnitsAndUpAxisAreAppliedOnReading) {
   UnitConversion cmZUp{0.01, UpAxis::kZ};
   const Mesh m =
-      parseObj("v 0 0 0\nv 100 0 0\nv 0 0 100\nf 1 2 3\n", "z.obj", MeshReadOptions{"", false, cmZUp});
+      parseObj("v 0 0 0\nv 100 0 0\nv 0 0 100\nf 1 2 3\n", "z.obj", MeshReadOptions{"", false, cmZUp, {}});
   EXPECT_EQ(m.positions[2], glm::vec3(0, 1, 0));  // z-up, centimetres: 1 m up
   EXPECT_NEAR(m.normals[0].z, 1.0f, 1e-6f);       // the file's −y (its normal here) is +z
 }
@@ -77,7 +77,7 @@ TEST(MeshRead, PointsAloneAreFolliclesFacingAwayFromTheirSphere) {
   for (const glm::vec3& p : onEllipsoid({0, 1.7, 0}, glm::dvec3(0.1), 0.4))
     text += "v " + std::to_string(p.x) + " " + std::to_string(p.y) + " " + std::to_string(p.z) + "\n";
   EXPECT_THROW(parseObj(text, "roots.obj"), InputError);  // a mesh needs faces unless points are allowed
-  const Mesh roots = parseObj(text, "roots.obj", MeshReadOptions{"", true, {}});
+  const Mesh roots = parseObj(text, "roots.obj", MeshReadOptions{"", true, {}, {}});
   EXPECT_EQ(roots.triangleCount(), 0u);
   for (size_t i = 0; i < roots.vertexCount(); ++i) {
     const glm::vec3 out = glm::normalize(roots.positions[i] - glm::vec3(0, 1.7f, 0));

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <functional>
 #include <mutex>
 #include <string_view>
 
@@ -69,6 +70,75 @@ void checkDeclaredSize(const FileLoc& where, int64_t width, int64_t height, int6
                    ", more than the " + formatBytes(memoryBudget()) + " this machine has free");
 }
 
+// The most raw pixel bytes one byte of a chunk can decode to under each compression, generously: a
+// header whose image would need more than this of its file is a lie told to make the reader allocate
+// (a 12 kB file declaring 16384x16384 pixels). NONE stores the pixels; RLE's longest run is 128 bytes
+// in two; deflate (ZIP, ZIPS, and PXR24 after its 32-to-24-bit step) expands at most 1032 times; PIZ's
+// Huffman codes runs of 255 values in a few bits; B44 stores a 4x4 block of halves in 14 bytes (B44A a
+// flat one in 3); DWA keeps one DC value per 8x8 block and deflates those. Unknown: no bound.
+double maxExpansion(exr_compression_t compression) {
+  switch (compression) {
+    case EXR_COMPRESSION_NONE:
+      return 1.0;
+    case EXR_COMPRESSION_RLE:
+      return 64.0;
+    case EXR_COMPRESSION_ZIPS:
+    case EXR_COMPRESSION_ZIP:
+    case EXR_COMPRESSION_PIZ:
+      return 1100.0;
+    case EXR_COMPRESSION_PXR24:
+      return 1400.0;
+    case EXR_COMPRESSION_B44:
+    case EXR_COMPRESSION_B44A:
+      return 12.0;
+    case EXR_COMPRESSION_DWAA:
+    case EXR_COMPRESSION_DWAB:
+      return 64.0 * 1100.0;
+    default:
+      return 1e300;
+  }
+}
+
+// Sizes a part's declared pixels against the file that holds them, before anything is allocated: its
+// chunks' offset table must fit in the file, its raw pixels must be what the file's bytes can decode
+// to, and (for scanlines) every chunk's leader must be in the file, its packed bytes too.
+void checkAgainstFile(exr_const_context_t context, int part, const FileLoc& where, uint64_t fileBytes,
+                      uint64_t rawBytes, exr_storage_t storage, const exr_attr_box2i_t& window,
+                      int32_t chunkRows, const std::function<InputError(exr_result_t)>& refuse) {
+  int32_t chunks = 0;
+  if (const exr_result_t r = exr_get_chunk_count(context, part, &chunks); r != EXR_ERR_SUCCESS)
+    throw refuse(r);
+  // Per chunk: its 8-byte entry in the offset table and a leader of at least 8 bytes.
+  if (chunks < 0 || uint64_t(chunks) * 16u > fileBytes)
+    throw InputError(where, "declares " + std::to_string(chunks) + " chunks of pixels, more than the " +
+                                std::to_string(fileBytes) + "-byte file can hold");
+  // A deep part's pixels are sample counts and lists, whose sizes its chunks give, not its header.
+  if (storage == EXR_STORAGE_DEEP_SCANLINE || storage == EXR_STORAGE_DEEP_TILED) return;
+  exr_compression_t compression = EXR_COMPRESSION_NONE;
+  if (const exr_result_t r = exr_get_compression(context, part, &compression); r != EXR_ERR_SUCCESS)
+    throw refuse(r);
+  if (double(rawBytes) > double(fileBytes) * maxExpansion(compression))
+    throw InputError(where, "declares " + formatBytes(rawBytes) + " of pixels, more than its " +
+                                std::to_string(fileBytes) +
+                                " bytes can hold under its compression; the "
+                                "header's data window does not match the file");
+  if (storage != EXR_STORAGE_SCANLINE) return;
+  uint64_t packed = 0;
+  for (int64_t y = window.min.y; y <= window.max.y; y += std::max(chunkRows, 1)) {
+    exr_chunk_info_t chunk{};
+    if (const exr_result_t r = exr_read_scanline_chunk_info(context, part, int(y), &chunk);
+        r != EXR_ERR_SUCCESS)
+      throw InputError(where, "cannot locate the chunk of scanline " + std::to_string(y) +
+                                  ": its offset table or leader is broken (a truncated file, or a header "
+                                  "whose data window does not match the file)");
+    packed += chunk.packed_size;
+    if (chunk.data_offset > fileBytes || chunk.packed_size > fileBytes - chunk.data_offset ||
+        packed > fileBytes)
+      throw InputError(where, "the chunk of scanline " + std::to_string(y) + " lies past the end of the " +
+                                  std::to_string(fileBytes) + "-byte file");
+  }
+}
+
 // OpenEXR 3.1's C++ reader, which OpenImageIO uses, allocates what a header declares before it reads
 // it: a 300-byte file made it zero 1.9 GB for one string attribute, and a 6-million-pixel-wide data
 // window made it allocate 1.9 GB of line buffers when the file was opened (found by tests/fuzz/fuzz_exr).
@@ -94,6 +164,9 @@ void checkExrHeader(const fs::path& file, const FileLoc& where) {
                                  oneLine(message.empty() ? exr_get_default_error_message(result) : message));
   };
   if (started != EXR_ERR_SUCCESS) throw refuse(started);
+  std::error_code sizeError;
+  const uint64_t fileBytes = fs::file_size(file, sizeError);
+  if (sizeError) throw IoError(where, "cannot read: " + sizeError.message());
   int parts = 0;
   if (const exr_result_t r = exr_get_count(context, &parts); r != EXR_ERR_SUCCESS) throw refuse(r);
   for (int part = 0; part < parts; ++part) {
@@ -108,9 +181,17 @@ void checkExrHeader(const fs::path& file, const FileLoc& where) {
     if (exr_get_storage(context, part, &storage) == EXR_ERR_SUCCESS && storage == EXR_STORAGE_SCANLINE &&
         exr_get_scanlines_per_chunk(context, part, &chunkRows) != EXR_ERR_SUCCESS)
       chunkRows = 1;
-    checkDeclaredSize(where, int64_t(window.max.x) - window.min.x + 1,
-                      int64_t(window.max.y) - window.min.y + 1, channels ? channels->num_channels : 0,
-                      chunkRows);
+    const int64_t width = int64_t(window.max.x) - window.min.x + 1,
+                  height = int64_t(window.max.y) - window.min.y + 1;
+    checkDeclaredSize(where, width, height, channels ? channels->num_channels : 0, chunkRows);
+    uint64_t rawBytes = 0;  // every channel's samples as stored (a subsampled one has fewer)
+    for (int c = 0; c < channels->num_channels; ++c) {
+      const exr_attr_chlist_entry_t& channel = channels->entries[c];
+      const int64_t xs = std::max(channel.x_sampling, 1), ys = std::max(channel.y_sampling, 1);
+      rawBytes += uint64_t((width + xs - 1) / xs) * uint64_t((height + ys - 1) / ys) *
+                  (channel.pixel_type == EXR_PIXEL_HALF ? 2u : 4u);
+    }
+    checkAgainstFile(context, part, where, fileBytes, rawBytes, storage, window, chunkRows, refuse);
   }
 }
 

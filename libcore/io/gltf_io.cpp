@@ -412,14 +412,17 @@ std::vector<uint8_t> encodeGltf(const Strands& s, bool binary) {
   m.defaultScene = 0;
   m.asset.version = "2.0";
   m.asset.generator = "hairgen " HAIRGEN_VERSION;
+  // Text from the strands' files goes through printableText: JSON must be UTF-8 (tinygltf's writer throws
+  // on anything else) and a control character has no business in it.
+  const auto text = [](const std::string& value) { return Value(printableText(value)); };
   Value::Object extras;
   extras["producer"] =
-      Value(s.provenance.producer.empty() ? std::string("hairgen " HAIRGEN_VERSION) : s.provenance.producer);
+      text(s.provenance.producer.empty() ? std::string("hairgen " HAIRGEN_VERSION) : s.provenance.producer);
   extras["strands"] = Value(static_cast<double>(s.strandCount()));
   extras["points"] = Value(static_cast<double>(s.pointCount()));
-  extras["stage"] = Value(s.provenance.stage);
+  extras["stage"] = text(s.provenance.stage);
   extras["seed"] = Value(std::to_string(s.provenance.seed));
-  extras["configDigest"] = Value(s.provenance.configDigest);
+  extras["configDigest"] = text(s.provenance.configDigest);
   extras["defaultThickness"] = Value(static_cast<double>(s.defaultThickness));
   extras["defaultTransparency"] = Value(static_cast<double>(s.defaultTransparency));
   extras["defaultColor"] = vec3Value(s.defaultColor);
@@ -429,9 +432,9 @@ std::vector<uint8_t> encodeGltf(const Strands& s, bool binary) {
   extras["upAxis"] = Value(std::string(p.yUp ? "+y" : "unknown: the source file's own"));
   extras["thickness"] = Value(std::string("_THICKNESS is each vertex's diameter, in the units above"));
   extras["thicknessFromDefault"] = Value(s.thickness.empty());
-  if (!p.source.empty()) extras["source"] = Value(p.source);
-  if (!p.sourceInfo.empty()) extras["sourceInfo"] = Value(p.sourceInfo);
-  if (!p.conversion.empty()) extras["conversion"] = Value(p.conversion);
+  if (!p.source.empty()) extras["source"] = text(p.source);
+  if (!p.sourceInfo.empty()) extras["sourceInfo"] = text(p.sourceInfo);
+  if (!p.conversion.empty()) extras["conversion"] = text(p.conversion);
   m.asset.extras = Value(std::move(extras));
 
   tinygltf::TinyGLTF writer;
@@ -612,7 +615,7 @@ Strands readGltf(const std::filesystem::path& file) {
 }
 
 void writeGltf(const std::filesystem::path& file, const Strands& strands, bool binary) {
-  std::vector<uint8_t> bytes = encodeGltf(strands, binary);
+  std::vector<uint8_t> bytes = namingFile(file.string(), [&] { return encodeGltf(strands, binary); });
   writeFileAtomic(file, bytes.data(), bytes.size());
 }
 

@@ -30,10 +30,15 @@ std::string hairExtensionList() {
   return known;
 }
 
-HairFormat hairFormatOf(const std::filesystem::path& file) {
+std::optional<HairFormat> hairFormatFor(const std::filesystem::path& file) {
   const std::string ext = toLower(file.extension().string());
   for (const FormatEntry& f : kFormats)
     if (ext == f.extension) return f.format;
+  return std::nullopt;
+}
+
+HairFormat hairFormatOf(const std::filesystem::path& file) {
+  if (const std::optional<HairFormat> format = hairFormatFor(file)) return *format;
   throw InputError({file.string(), 0}, "unknown hair file extension '" + file.extension().string() +
                                            "'; use " + hairExtensionList());
 }

@@ -7,6 +7,7 @@
 #pragma once
 
 #include <filesystem>
+#include <optional>
 #include <string>
 
 #include "libcore/model/strands.h"
@@ -18,6 +19,8 @@ enum class HairFormat { kHair, kGltf, kGlb, kPly, kData, kUsda };
 
 // The format a path's extension names (case-insensitive). Throws InputError for any other extension.
 HairFormat hairFormatOf(const std::filesystem::path& file);
+// The same, or nullopt for an extension that names no hair format.
+std::optional<HairFormat> hairFormatFor(const std::filesystem::path& file);
 // The extensions hairFormatOf knows, in its order: ".hair, .gltf, .glb, .ply, .data, .usda".
 std::string hairExtensionList();
 

@@ -233,16 +233,12 @@ void parseShard(const std::string& key, const std::string& value, Provenance& p,
 }  // namespace
 
 std::string provenanceText(const Provenance& p) {
-  std::string text = "producer=" + p.producer + "\nstage=" + p.stage + "\nseed=" + std::to_string(p.seed) +
-                     "\nconfig=" + p.configDigest + "\n";
+  // Each value one line of printable text (a PLY header carries these lines as comments).
+  const auto line = [](const std::string& value) { return printableText(value); };
+  std::string text = "producer=" + line(p.producer) + "\nstage=" + line(p.stage) +
+                     "\nseed=" + std::to_string(p.seed) + "\nconfig=" + line(p.configDigest) + "\n";
   if (p.frame) text += "frame=" + std::to_string(*p.frame) + "\ntime=" + formatReal(p.time) + "\n";
   // A file made elsewhere: written only when set, so hairgen's own files keep their bytes.
-  auto line = [](const std::string& value) {
-    std::string out = value;
-    for (char& c : out)
-      if (c == '\n' || c == '\r') c = ' ';
-    return out;
-  };
   if (!p.source.empty()) text += "source=" + line(p.source) + "\n";
   if (!p.sourceInfo.empty()) text += "sourceInfo=" + line(p.sourceInfo) + "\n";
   if (!p.conversion.empty()) text += "conversion=" + line(p.conversion) + "\n";
@@ -522,12 +518,14 @@ Strands readHair(const std::filesystem::path& file, HairHeader* header) {
 }
 
 void writeHair(const std::filesystem::path& file, const Strands& strands) {
-  AtomicFile out(file);
-  Writer w([&](const uint8_t* p, size_t n) {
-    out.stream().write(reinterpret_cast<const char*>(p), std::streamsize(n));
+  namingFile(file.string(), [&] {
+    AtomicFile out(file);
+    Writer w([&](const uint8_t* p, size_t n) {
+      out.stream().write(reinterpret_cast<const char*>(p), std::streamsize(n));
+    });
+    encodeHairTo(strands, w);
+    out.commit();
   });
-  encodeHairTo(strands, w);
-  out.commit();
 }
 
 Provenance readHairProvenance(const std::filesystem::path& file) {

@@ -44,8 +44,9 @@ Strands decodeHairSalon(const uint8_t* data, size_t size, const std::string& nam
   if (size < 4) throw fail("truncated: a .data file starts with a 4-byte strand count");
   const int32_t strands = static_cast<int32_t>(getU32(data));
   // Every strand needs at least its 4-byte point count.
-  std::optional<uint64_t> least = checkedMul(uint64_t(strands < 0 ? 0 : strands), 4);
-  if (strands < 0 || !least || *least > size - 4)
+  if (strands < 0) throw fail("the header's strand count is " + std::to_string(strands) + ", negative");
+  std::optional<uint64_t> least = checkedMul(uint64_t(strands), 4);
+  if (!least || *least > size - 4)
     throw fail("the header declares " + std::to_string(strands) + " strands, which the " +
                std::to_string(size) + "-byte file cannot hold");
   Strands s;
@@ -56,8 +57,11 @@ Strands decodeHairSalon(const uint8_t* data, size_t size, const std::string& nam
     if (size - pos < 4) throw fail("truncated: strand " + std::to_string(i) + " has no point count");
     const int32_t points = static_cast<int32_t>(getU32(data + pos));
     pos += 4;
-    std::optional<uint64_t> bytes = checkedMul(uint64_t(points < 0 ? 0 : points), 12);
-    if (points < 0 || !bytes || *bytes > size - pos)
+    if (points < 0)
+      throw fail("strand " + std::to_string(i) + "'s point count is " + std::to_string(points) +
+                 ", negative (at byte " + std::to_string(pos - 4) + ")");
+    std::optional<uint64_t> bytes = checkedMul(uint64_t(points), 12);
+    if (!bytes || *bytes > size - pos)
       throw fail("strand " + std::to_string(i) + " declares " + std::to_string(points) +
                  " points, more than the " + std::to_string(size - pos) + " bytes left hold");
     total += uint64_t(points);
@@ -86,7 +90,7 @@ Strands readHairSalon(const std::filesystem::path& file) {
 }
 
 void writeHairSalon(const std::filesystem::path& file, const Strands& strands) {
-  std::vector<uint8_t> bytes = encodeHairSalon(strands);
+  std::vector<uint8_t> bytes = namingFile(file.string(), [&] { return encodeHairSalon(strands); });
   writeFileAtomic(file, bytes.data(), bytes.size());
 }
 

@@ -98,7 +98,9 @@ nlohmann::ordered_json describeStrands(const Strands& s) {
 
 }  // namespace
 
-nlohmann::ordered_json describeFile(const std::filesystem::path& file) {
+namespace {
+
+nlohmann::ordered_json describeFileAsRead(const std::filesystem::path& file) {
   std::string ext = toLower(file.extension().string());
   nlohmann::ordered_json j;
   j["file"] = file.string();
@@ -178,6 +180,12 @@ nlohmann::ordered_json describeFile(const std::filesystem::path& file) {
   j.update(describeStrands(s));
   j.update(details);
   return j;
+}
+
+}  // namespace
+
+nlohmann::ordered_json describeFile(const std::filesystem::path& file) {
+  return printableJson(describeFileAsRead(file));
 }
 
 std::string formatDescription(const nlohmann::ordered_json& j) {

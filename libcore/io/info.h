@@ -11,7 +11,7 @@
 namespace hairgen {
 
 // Describes a .hair, .gltf, .glb or .obj file as JSON (counts, bounds, arrays present, provenance).
-// Throws InputError for unreadable or unknown files.
+// Every string in it is printableText (text.h). Throws InputError for unreadable or unknown files.
 nlohmann::ordered_json describeFile(const std::filesystem::path& file);
 
 // The same description as a few human-readable lines.

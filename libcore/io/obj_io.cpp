@@ -6,9 +6,11 @@
 #include <algorithm>
 #include <cmath>
 #include <sstream>
+#include <unordered_set>
 
 #include <tiny_obj_loader.h>
 
+#include "libcore/io/hair_cache.h"
 #include "libcore/model/shape_fit.h"
 #include "libcore/util/error.h"
 #include "libcore/util/file_util.h"
@@ -61,11 +63,13 @@ void checkCorner(std::string_view corner, const FileLoc& where, const size_t cou
 // tinyobjloader's parsers of them are lenient to the point of undefined behaviour: a 'vw' joint id of
 // 7e32 was converted to int (found by tests/fuzz/fuzz_obj).
 // With a `group`, only the faces under a g, o or usemtl line naming it are kept; `names` collects every
-// name those lines give, for the error when none matches.
+// distinct name those lines give, in file order, for the error when none matches (a set beside it keeps
+// the collection linear in the file however many names it has).
 std::string validate(std::string_view text, const std::string& name, const std::string& group = "",
                      std::vector<std::string>* names = nullptr) {
   std::string checked;
-  size_t counts[3] = {0, 0, 0};  // v, vt, vn
+  std::unordered_set<std::string_view> seen;  // views into `text`
+  size_t counts[3] = {0, 0, 0};               // v, vt, vn
   bool inGroup = false, inMaterial = false;
   forEachLine(text, [&](std::string_view line, int lineNumber) {
     FileLoc where{name, lineNumber};
@@ -78,8 +82,7 @@ std::string validate(std::string_view text, const std::string& name, const std::
       bool match = false;
       for (size_t i = 1; i < words.size(); ++i) {
         match = match || words[i] == group;
-        if (names && std::find(names->begin(), names->end(), words[i]) == names->end())
-          names->push_back(std::string(words[i]));
+        if (names && seen.insert(words[i]).second) names->push_back(std::string(words[i]));
       }
       // A face belongs to its group (g or o) and to its material; either may select it.
       (tag == "usemtl" ? inMaterial : inGroup) = match;
@@ -153,6 +156,43 @@ void applyConversion(Mesh& mesh, const UnitConversion& conversion) {
   for (glm::vec3& n : mesh.normals) n = conversion.direction(n);
 }
 
+// What a file is when it is not an OBJ: by its first bytes, then by an extension that names another
+// format; "" when it may be one.
+std::string otherFormat(std::string_view text, const std::filesystem::path& file) {
+  struct Magic {
+    std::string_view bytes;
+    const char* format;
+  };
+  static constexpr Magic kMagics[] = {
+      {"ply\n", "a PLY file"},          {"ply\r", "a PLY file"},         {"HAIR", "a cyHair .hair file"},
+      {"glTF", "a binary glTF file"},   {"v/1\x01", "an OpenEXR image"}, {"#usda", "a USD layer"},
+      {"PXR-USDC", "a USD crate file"}, {"\x89PNG", "a PNG image"},      {"Kaydara FBX", "an FBX file"},
+      {"\xFF\xD8\xFF", "a JPEG image"},
+  };
+  for (const Magic& m : kMagics)
+    if (text.substr(0, m.bytes.size()) == m.bytes) return m.format;
+  // Extensions: the hair formats' own table, and the other files a pipeline hands around.
+  if (const std::optional<HairFormat> hair = hairFormatFor(file))
+    return "a " + std::string(describe(*hair)) + " file (by its extension)";
+  static constexpr std::pair<const char*, const char*> kExtensions[] = {
+      {".usd", "a USD layer"},      {".usdc", "a USD crate file"}, {".usdz", "a USD package"},
+      {".exr", "an OpenEXR image"}, {".fbx", "an FBX file"},       {".abc", "an Alembic archive"},
+      {".stl", "an STL mesh"},      {".png", "a PNG image"},
+  };
+  const std::string extension = toLower(file.extension().string());
+  for (const auto& [ext, format] : kExtensions)
+    if (extension == ext) return std::string(format) + " (by its extension)";
+  return "";
+}
+
+void requireObj(std::string_view text, const std::filesystem::path& file, const std::string& role) {
+  const std::string format = otherFormat(text, file);
+  if (format.empty()) return;
+  throw InputError({file.string(), 0}, (role.empty() ? std::string("a mesh") : role) +
+                                           " must be an OBJ mesh (.obj), and this is " + format +
+                                           "; export it as OBJ");
+}
+
 }  // namespace
 
 Mesh parseObj(std::string_view text, const std::string& name, MeshReadStats* statsOut) {
@@ -165,8 +205,12 @@ Mesh parseObj(std::string_view text, const std::string& name, const MeshReadOpti
   std::vector<std::string> names;
   const std::string checked = validate(text, name, options.group, &names);
   if (!options.group.empty() && std::find(names.begin(), names.end(), options.group) == names.end()) {
+    // The first few names, as an error is one line.
+    constexpr size_t kNamesListed = 20;
     std::string list;
-    for (const std::string& n : names) list += (list.empty() ? "" : ", ") + n;
+    for (size_t i = 0; i < std::min(names.size(), kNamesListed); ++i)
+      list += (list.empty() ? "" : ", ") + oneLine(names[i]);
+    if (names.size() > kNamesListed) list += " and " + std::to_string(names.size() - kNamesListed) + " more";
     throw InputError(
         {name, 0},
         "WickGroup '" + options.group + "' is not a group, object or material of this mesh; " +
@@ -309,11 +353,13 @@ Mesh parseObj(std::string_view text, const std::string& name, const MeshReadOpti
 }
 
 Mesh readObj(const std::filesystem::path& file, MeshReadStats* stats) {
-  return parseObj(readFileText(file), file.string(), stats);
+  return readObj(file, MeshReadOptions{}, stats);
 }
 
 Mesh readObj(const std::filesystem::path& file, const MeshReadOptions& options, MeshReadStats* stats) {
-  return parseObj(readFileText(file), file.string(), options, stats);
+  const std::string text = readFileText(file);
+  requireObj(text, file, options.role);
+  return parseObj(text, file.string(), options, stats);
 }
 
 void writeObj(const Mesh& mesh, std::ostream& out, const std::string& headerComment) {

@@ -27,16 +27,18 @@ struct MeshReadOptions {
   bool allowPoints =
       false;  // a file of vertices and no faces is a point cloud (a wick of roots), not an error
   UnitConversion conversion;  // applied to positions and normals on reading
+  std::string role;           // the key that names the mesh ("HeadModel", "WickModel"), for messages
 };
 
-// Reads an OBJ: triangles and polygons (triangulated), normals and UVs indexed apart from positions
-// (averaged, resp. first seen, per position, so each position stays one follicle), missing normals
-// computed area-weighted. Malformed numbers, out-of-range indices and meshes with no vertices or no
-// faces are InputErrors naming file:line.
-// With `options.group`, vertices no kept face uses are dropped, and a name that no g, o or usemtl line
-// gives is an InputError listing the names that exist. With `options.allowPoints`, a file with no faces
-// gives a mesh with no triangles, its normals from the file's `vn` lines (one per vertex, in order) or,
-// without them, pointing away from the points' least-squares sphere.
+// Reads an OBJ: a file that is another format (by its first bytes, or an extension such as .ply, .glb,
+// .exr) is an InputError naming the file and `options.role` before anything is parsed. Then triangles and
+// polygons (triangulated), normals and UVs indexed apart from positions (averaged, resp. first seen, per
+// position, so each position stays one follicle), missing normals computed area-weighted. Malformed numbers,
+// out-of-range indices and meshes with no vertices or no faces are InputErrors naming file:line. With
+// `options.group`, vertices no kept face uses are dropped, and a name that no g, o or usemtl line gives is an
+// InputError listing the names that exist. With `options.allowPoints`, a file with no faces gives a mesh with
+// no triangles, its normals from the file's `vn` lines (one per vertex, in order) or, without them, pointing
+// away from the points' least-squares sphere.
 Mesh readObj(const std::filesystem::path& file, MeshReadStats* stats = nullptr);
 Mesh readObj(const std::filesystem::path& file, const MeshReadOptions& options,
              MeshReadStats* stats = nullptr);

@@ -7,6 +7,7 @@
 #include <cstring>
 #include <limits>
 #include <optional>
+#include <unordered_map>
 
 #include "libcore/io/hair_io.h"
 #include "libcore/util/checked.h"
@@ -64,10 +65,17 @@ struct Element {
   std::string name;
   uint64_t count = 0;
   std::vector<Property> properties;
+  std::unordered_map<std::string, int> byName;  // property name -> index: a header of a million
+                                                // properties is read in linear time
   int find(const std::string& property) const {
-    for (size_t i = 0; i < properties.size(); ++i)
-      if (properties[i].name == property) return static_cast<int>(i);
-    return -1;
+    const auto it = byName.find(property);
+    return it == byName.end() ? -1 : it->second;
+  }
+  // Adds `p`; false when the element already has a property of that name.
+  bool add(Property p) {
+    if (!byName.try_emplace(p.name, static_cast<int>(properties.size())).second) return false;
+    properties.push_back(std::move(p));
+    return true;
   }
 };
 
@@ -167,7 +175,7 @@ Header parseHeader(const uint8_t* data, size_t size, const std::string& name) {
     } else if (key == "element") {
       std::optional<uint64_t> count = words.size() == 3 ? parseUInt(words[2]) : std::nullopt;
       if (!count) throw fail(number, "expected 'element NAME COUNT' with a non-negative count");
-      h.elements.push_back({words[1], *count, {}});
+      h.elements.push_back({words[1], *count, {}, {}});
     } else if (key == "property") {
       if (h.elements.empty()) throw fail(number, "a property before any element");
       Property p;
@@ -181,10 +189,10 @@ Header parseHeader(const uint8_t* data, size_t size, const std::string& name) {
       } else {
         throw fail(number, "expected 'property TYPE NAME' or 'property list COUNT-TYPE TYPE NAME'");
       }
-      if (h.elements.back().find(p.name) >= 0)
-        throw fail(number, "property '" + oneLine(p.name) + "' appears twice in element '" +
+      const std::string propertyName = p.name;
+      if (!h.elements.back().add(std::move(p)))
+        throw fail(number, "property '" + oneLine(propertyName) + "' appears twice in element '" +
                                oneLine(h.elements.back().name) + "'");
-      h.elements.back().properties.push_back(p);
     } else if (key == "end_header") {
       ended = true;
     } else {
@@ -476,10 +484,11 @@ Strands decodePly(const uint8_t* data, size_t size, const std::string& name, Ply
                                : &e == edge && byEdges  ? &edgeSinks
                                                         : nullptr;
     if (e.properties.empty()) continue;
+    const std::string element = "element '" + oneLine(e.name) + "' record ";
     for (uint64_t r = 0; r < e.count; ++r) {
+      const std::string what = element + std::to_string(r);  // once a record, not once a value
       for (size_t p = 0; p < e.properties.size(); ++p) {
         const Property& prop = e.properties[p];
-        const std::string what = "element '" + oneLine(e.name) + "' record " + std::to_string(r);
         if (prop.list) {
           const uint32_t count = wholeNumber(body.value(prop.countType, what), what + " list count", name);
           // A list's items must fit in what is left before they are read one by one.
@@ -739,7 +748,7 @@ Strands readPly(const std::filesystem::path& file, PlyHeader* header) {
 }
 
 void writePly(const std::filesystem::path& file, const Strands& strands, bool ascii) {
-  std::vector<uint8_t> bytes = encodePly(strands, ascii);
+  std::vector<uint8_t> bytes = namingFile(file.string(), [&] { return encodePly(strands, ascii); });
   writeFileAtomic(file, bytes.data(), bytes.size());
 }
 

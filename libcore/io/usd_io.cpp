@@ -15,9 +15,9 @@ constexpr int kPerLine = 8;  // array items per line, for a file a person can sc
 
 std::string quoted(const std::string& text) {
   std::string out = "\"";
-  for (char c : text) {
+  for (char c : printableText(text)) {
     if (c == '"' || c == '\\') out += '\\';
-    out += c == '\n' || c == '\r' ? ' ' : c;
+    out += c;
   }
   return out + "\"";
 }
@@ -179,9 +179,11 @@ std::vector<std::pair<std::string, std::string>> readUsdaSummary(const std::file
 }
 
 void writeUsda(const std::filesystem::path& file, const Strands& strands) {
-  AtomicFile out(file);
-  encodeUsda(out.stream(), strands);
-  out.commit();
+  namingFile(file.string(), [&] {
+    AtomicFile out(file);
+    encodeUsda(out.stream(), strands);
+    out.commit();
+  });
 }
 
 }  // namespace hairgen

@@ -68,7 +68,23 @@ Strands mergeShards(std::vector<ShardPart> parts) {
                                         " of " + std::to_string(r.total) + " " + unit + ", but " + lead.name +
                                         " is of " + std::to_string(leadRange.count) + " shards of " +
                                         std::to_string(leadRange.total));
+    if (r != shardRange(r.index, r.count, r.total))
+      throw InputError({p.name, 0}, "declares shard " + std::to_string(r.index) + "/" +
+                                        std::to_string(r.count) + " as " + unit + " " + rangeText(r) +
+                                        " of " + std::to_string(r.total) + ", but that shard is " + unit +
+                                        " " + rangeText(shardRange(r.index, r.count, r.total)));
     const Strands& s = p.strands;
+    // What the part holds must be what its range declares: a guide a strand, and a coupe's strands rooted
+    // on the range's triangles.
+    if (whole.stage == "grow" && s.strandCount() != r.end - r.first)
+      throw InputError({p.name, 0}, "holds " + std::to_string(s.strandCount()) + " strands, but its range " +
+                                        rangeText(r) + " declares " + std::to_string(r.end - r.first) +
+                                        " guides");
+    for (size_t i = 0; i < s.rootTriangle.size(); ++i)
+      if (s.rootTriangle[i] < r.first || s.rootTriangle[i] >= r.end)
+        throw InputError({p.name, 0}, "strand " + std::to_string(i) + " is rooted on triangle " +
+                                          std::to_string(s.rootTriangle[i]) + ", outside its range " +
+                                          rangeText(r));
     if (s.defaultThickness != lead.strands.defaultThickness ||
         s.defaultTransparency != lead.strands.defaultTransparency ||
         s.defaultColor != lead.strands.defaultColor)

@@ -87,4 +87,20 @@ class DeviceError : public Error {
   explicit DeviceError(const std::string& message) : Error(ExitCode::kNoDevice, {}, message) {}
 };
 
+// Runs `work` and returns what it returns; an InputError or IoError it throws that names no file is
+// thrown again naming `file` (what a writer refuses names the file it would have written, what a stage
+// refuses in a sequence names the frame's file). Errors that name a file pass unchanged.
+template <class Work>
+decltype(auto) namingFile(const std::string& file, Work&& work) {
+  try {
+    return work();
+  } catch (const InputError& e) {
+    if (!e.where().file.empty()) throw;
+    throw InputError({file, 0}, e.message());
+  } catch (const IoError& e) {
+    if (!e.where().file.empty()) throw;
+    throw IoError({file, 0}, e.message());
+  }
+}
+
 }  // namespace hairgen

@@ -33,6 +33,14 @@ std::string formatFloat(float value);  // shortest text that parses back to the 
 // warnings) in hairgen's one-line errors.
 std::string oneLine(std::string text);
 
+// `text` as it may appear in any text hairgen writes (a .usda string, glTF's JSON, a PLY header's
+// comment, `info`'s lines and JSON), the one escaping every text writer applies to text that came from
+// a file: valid UTF-8 is kept; a byte that does not begin a valid UTF-8 sequence (an overlong form, a
+// surrogate, past U+10FFFF, cut short) becomes U+FFFD; a control character (U+0000-U+001F and U+007F,
+// line ends and tabs included) becomes the four characters \xNN and one of U+0080-U+009F the six
+// characters \u00NN, so NUL, line ends and terminal controls never reach a format's syntax.
+std::string printableText(std::string_view text);
+
 // `text` without a leading UTF-8 byte-order mark (editors on Windows write one).
 std::string_view withoutBom(std::string_view text);
 
