@@ -10,7 +10,7 @@ cd "$(dirname "$0")/.."
 group="${1:-all}"
 [[ $# -gt 0 ]] && shift
 bash scripts/setup.sh --no-build
-cmake -S . -B build -G Ninja -DCMAKE_BUILD_TYPE=Release >/dev/null
+cmake -S . -B build -G Ninja -DCMAKE_BUILD_TYPE=Release -DHAIRGEN_BUILD_TESTS=ON >/dev/null  # hairgen_bench is a test target
 if [ "$group" = farm ]; then
   cmake --build build --target hairgen
   exec bash scripts/bench-farm.sh "$@"

@@ -1,23 +1,34 @@
 #!/usr/bin/env bash
-# Installs every Debian package hairgen's build, tests and tools need, then configures and builds.
-# Idempotent: when everything is present it only (re)builds, and `apt-get update` runs only when a
-# package is missing. Usage: scripts/setup.sh [--no-build]
+# Installs every Debian package hairgen's build, tests and tools need, then configures build/ with the
+# tests on and builds everything. Idempotent: when everything is present it only (re)builds, and
+# `apt-get update` runs only when a package is missing.
+# Usage: scripts/setup.sh [--no-build]   everything, for the tests (scripts/test.sh)
+#        scripts/setup.sh --program-only   only the packages the hairgen program needs to build and
+#                                          run; configures and builds nothing (scripts/demo.sh)
 set -euo pipefail
 cd "$(dirname "$0")/.."
+mode="${1:-}"
 
+# What the hairgen program needs to build and run.
 packages=(
-  build-essential cmake ninja-build pkg-config git clang-format
+  build-essential cmake ninja-build pkg-config
   libglm-dev libcli11-dev libtinyobjloader-dev libtinygltf-dev nlohmann-json3-dev libstb-dev
   libopenexr-dev openexr libopenimageio-dev openimageio-tools libpng-dev libtbb-dev zlib1g-dev
   libopenvdb-dev libopenvdb-tools libboost-dev  # OpenVDB's headers include Boost's; its package does not pull them
   libegl-dev libgl-dev libopengl-dev libegl1 libopengl0 libegl-mesa0 libgl1-mesa-dri libgbm1
-  libgtest-dev libgmock-dev libbenchmark-dev
-  clang libclang-rt-14-dev llvm  # the fuzz build (scripts/fuzz.sh): libFuzzer, ASan, UBSan, llvm-symbolizer
-  ffmpeg  # a shot's preview movie (beauty.mp4, beauty.gif)
-  slurm-wlm munge  # the farm's scheduler: a one-node Slurm for the tests (scripts/slurm-local.sh)
 )
-# Node.js with npm runs the glTF validator; the image may ship its own Node (then Debian's npm conflicts).
-command -v npm >/dev/null 2>&1 || packages+=(nodejs npm)
+# What the tests, benchmarks and tools add.
+if [ "$mode" != --program-only ]; then
+  packages+=(
+    git clang-format
+    libgtest-dev libgmock-dev libbenchmark-dev
+    clang libclang-rt-14-dev llvm  # the fuzz build (scripts/fuzz.sh): libFuzzer, ASan, UBSan, llvm-symbolizer
+    ffmpeg  # a shot's preview movie (beauty.mp4, beauty.gif); without it `run` writes the frames alone
+    slurm-wlm munge  # the farm's scheduler: a one-node Slurm for the tests (scripts/slurm-local.sh)
+  )
+  # Node.js with npm runs the glTF validator; the image may ship its own Node (then Debian's npm conflicts).
+  command -v npm >/dev/null 2>&1 || packages+=(nodejs npm)
+fi
 
 missing=()
 for p in "${packages[@]}"; do
@@ -31,6 +42,8 @@ if ((${#missing[@]})); then
   $sudo apt-get update -qq
   $sudo apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
 fi
+
+[ "$mode" = --program-only ] && exit 0
 
 # The Khronos glTF validator (npm package gltf-validator), used by the test suite.
 if [ ! -f tools/node_modules/gltf-validator/package.json ]; then
@@ -54,6 +67,8 @@ if [ ! -f tools/node_modules/tinyusdz/tinyusdz.wasm ]; then
   npm install --silent --no-audit --no-fund --prefix tools tinyusdz@0.9.0-rc10 >/dev/null
 fi
 
-[ "${1:-}" = "--no-build" ] && exit 0
-cmake -S . -B build -G Ninja -DCMAKE_BUILD_TYPE=Release >/dev/null
+[ "$mode" = --no-build ] && exit 0
+# The tests on, explicitly: build/ is shared with scripts/demo.sh, which configures a fresh build/ with
+# them off, and a plain configure would keep that cached choice.
+cmake -S . -B build -G Ninja -DCMAKE_BUILD_TYPE=Release -DHAIRGEN_BUILD_TESTS=ON -DHAIRGEN_SANITIZER_TESTS=ON >/dev/null
 cmake --build build
