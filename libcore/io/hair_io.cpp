@@ -236,6 +236,7 @@ std::string provenanceText(const Provenance& p) {
   std::string text = "producer=" + p.producer + "\nstage=" + p.stage + "\nseed=" + std::to_string(p.seed) +
                      "\nconfig=" + p.configDigest + "\n";
   if (p.frame) text += "frame=" + std::to_string(*p.frame) + "\ntime=" + formatReal(p.time) + "\n";
+  if (!p.restDigest.empty()) text += "rest=" + p.restDigest + "\n";
   // A file made elsewhere: written only when set, so hairgen's own files keep their bytes.
   auto line = [](const std::string& value) {
     std::string out = value;
@@ -272,6 +273,8 @@ Provenance parseProvenance(const std::string& text, const std::string& name) {
       p.stage = value;
     else if (key == "config")
       p.configDigest = value;
+    else if (key == "rest")
+      p.restDigest = value;
     else if (key == "frame" || key == "time") {
       std::optional<double> v = parseReal(value);
       if (!v || !std::isfinite(*v) || (key == "frame" && (*v != std::floor(*v) || std::abs(*v) > 1e9)))
