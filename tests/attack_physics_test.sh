@@ -111,6 +111,21 @@ diverge_springs)
   frame=$(failed_frame)
   [ -n "$frame" ] && [ ! -e "$tmp/t/g.$(printf %04d "$frame").hair" ] || fail "density: $(cat "$tmp/err")"
   ;;
+diverge_anjyo)
+  # Anjyo's gust under a 10000 m/s² wind in steps of a second: the recurrences overflow (a turn past
+  # 1000 rad a substep). It wrote those frames with exit 0, frames a restart then refused; now it stops
+  # at the first, naming the wind, the step's keys, the frame and the strand.
+  small=(--quiet --set Hairstyle.HairDensity=5 --set "Dynamics.Frames=1 4")
+  expect_rc 0 "$hairgen" grow "$anjyo" -o "$tmp/g.hair" "${small[@]}"
+  expect_rc 2 "$hairgen" simulate "$anjyo" --guides "$tmp/g.hair" -o "$tmp/a/g.####.hair" "${small[@]}" \
+    --set Dynamics.Substeps=1 --set Dynamics.FrameRate=1 --set "Dynamics.Wind=1 10000 0 0"
+  for word in "Dynamics.Wind 10000" "Dynamics.FrameRate 1" "Dynamics.Substeps 1" "left its validity"; do
+    expect_err "$word"
+  done
+  grep -q "strand [0-9]" "$tmp/err" || fail "no strand named: $(cat "$tmp/err")"
+  frame=$(failed_frame)
+  [ -n "$frame" ] && [ ! -e "$tmp/a/g.$(printf %04d "$frame").hair" ] || fail "frame ${frame:-?}: $(cat "$tmp/err")"
+  ;;
 ranges)
   # Out of physical range, refused before any work with the unit: FrameRate (frames/s), MeshUnits
   # (metres per unit), DensitySpacings (m).
