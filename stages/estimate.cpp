@@ -35,6 +35,9 @@ constexpr double kSecondsPerSegmentStep = 60e-9;
 // and its share of the frame's velocity smoothing (SimulateSprings: ~0.12 CPU s a frame for 310k
 // segments at 2 substeps).
 constexpr double kSecondsPerSpringStep = 200e-9;
+// Density targeting: per node of the eight grids of the level in use, per substep (configs/pixar/target
+// at DensitySpacings 0.002: 16 substeps over 8 grids of ~5e6 nodes took 4.4 CPU s more than at 0.12).
+constexpr double kSecondsPerDensityNode = 7e-9;
 // llvmpipe: per vertex pushed through a pass, and per fragment of the shading pass with its shadow
 // look-ups and overdraw (render benchmarks; 1,000 strands 0.5 m wide at 640x640 took 113 s).
 constexpr double kSecondsPerVertex = 150e-9, kSecondsPerFragment = 60e-9;
@@ -220,10 +223,15 @@ WorkEstimate estimateSimulate(const Dynamics& d, size_t segments, const FrameRan
       springs && d.velocitySmoothing > 0.0 ? 2.0 * 32.0 * std::min(nodes(d.smoothingSpacing, 1.5), 2e7) : 0.0;
   e.bytes = bytesOf(hair + density + smoothing);
   const double perStep = springs ? kSecondsPerSpringStep : kSecondsPerSegmentStep;
-  e.seconds = double(segments) * steps * perStep / cores(threads);
+  const double hairSeconds = double(segments) * steps * perStep / cores(threads);
+  // Every substep with a target copies and negates the eight grids of D_t at its level and splats the
+  // hair into them, on one core.
+  const double densitySeconds = steps * 8.0 * finest * kSecondsPerDensityNode;
+  e.seconds = hairSeconds + densitySeconds;
   e.memoryKey = density > hair + smoothing ? "Dynamics.DensitySpacings (its finest spacing, in metres)"
                                            : "the guides' size";
-  e.timeKey = "Dynamics.Substeps or Dynamics.Frames";
+  e.timeKey = densitySeconds > hairSeconds ? "Dynamics.DensitySpacings (its finest spacing, in metres)"
+                                           : "Dynamics.Substeps or Dynamics.Frames";
   e.detail = std::to_string(segments) + " segments, " + formatReal(steps) + " steps";
   if (density > 0.0)
     e.detail += ", density grids of " + formatReal(std::round(finest)) + " nodes at the finest spacing";
