@@ -189,8 +189,10 @@ void addUnitFlags(CLI::App& command, UnitOptions& options, const std::string& fi
       ->type_name("UNIT")
       ->check(CLI::Validator(
           [](std::string& text) -> std::string {
-            return parseLengthUnit(text) ? std::string()
-                                         : "'" + text + "' is not m, cm, mm, in or a positive number";
+            return parseLengthUnit(text)
+                       ? std::string()
+                       : "'" + text + "' is not m, cm, mm, in or a number of metres " + "per unit in [" +
+                             formatReal(kMinMetresPerUnit) + ", " + formatReal(kMaxMetresPerUnit) + "]";
           },
           "UNIT"));
   command

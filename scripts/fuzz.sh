@@ -22,8 +22,8 @@ esac
 seconds="${SECONDS_PER_TARGET:-60}"
 parallel=2  # targets at a time: each fuzzer is one process on one core
 # Per target, the longest input the fuzzer makes: a little above the largest seed, so a seed is never cut.
-declare -A max_len=([fuzz_hair]=16384 [fuzz_gltf]=32768 [fuzz_obj]=4096 [fuzz_config]=4096 [fuzz_exr]=8192 [fuzz_ply]=8192 [fuzz_data]=8192 [fuzz_farm_plan]=12288)
-targets=(fuzz_hair fuzz_gltf fuzz_obj fuzz_config fuzz_exr fuzz_ply fuzz_data fuzz_farm_plan)
+declare -A max_len=([fuzz_hair]=16384 [fuzz_gltf]=32768 [fuzz_obj]=4096 [fuzz_config]=4096 [fuzz_exr]=8192 [fuzz_ply]=8192 [fuzz_data]=8192 [fuzz_farm_plan]=12288 [fuzz_restart]=20480)
+targets=(fuzz_hair fuzz_gltf fuzz_obj fuzz_config fuzz_exr fuzz_ply fuzz_data fuzz_farm_plan fuzz_restart)
 # The readers take milliseconds; 10 s on one input is a hang. Memory: libFuzzer's default, made explicit
 # (fuzz_exr gives readImage a quarter of it as its budget).
 limits=(-timeout=10 -rss_limit_mb=2048)

@@ -36,6 +36,9 @@ constexpr double kSecondsPerSegmentStep = 60e-9;
 // and its share of the frame's velocity smoothing (SimulateSprings: ~0.12 CPU s a frame for 310k
 // segments at 2 substeps).
 constexpr double kSecondsPerSpringStep = 200e-9;
+// Density targeting: per node of the eight grids of the level in use, per substep (configs/pixar/target
+// at DensitySpacings 0.002: 16 substeps over 8 grids of ~5e6 nodes took 4.4 CPU s more than at 0.12).
+constexpr double kSecondsPerDensityNode = 7e-9;
 // llvmpipe: per vertex pushed through a pass, and per fragment the ribbons cover (hairCoverage) with its
 // shadow look-ups, at its most: fragments a depth test rejects cost less (coupe 3's 759 guides 0.1 m wide
 // cover 4.3e9 sub-pixels of a 640x640 image in 12.8 s, 3 ns each; 0.02 m wide, 1.7e8 in 2.7 s).
@@ -309,7 +312,8 @@ WorkEstimate estimateRender(const RenderSettings& r, size_t strands, size_t poin
   return e;
 }
 
-WorkEstimate estimateSimulate(const Dynamics& d, size_t segments, const FrameRange& frames, size_t threads) {
+WorkEstimate estimateSimulate(const Dynamics& d, size_t segments, const FrameRange& frames, size_t threads,
+                              const glm::dvec3& span) {
   WorkEstimate e;
   e.stage = "simulate";
   const double steps = double(frames.count()) * double(d.substeps);
@@ -318,12 +322,38 @@ WorkEstimate estimateSimulate(const Dynamics& d, size_t segments, const FrameRan
   // and the factored matrix 112, rest directions and tangents 36, a collision shape's rest depths 8,
   // the vector kernel's lane-by-lane copy of its constants 112, the smoothing's point lists 120, the
   // posed copy and the restart state 72.
-  e.bytes = bytesOf(double(segments) * (d.model == DynamicsModel::kSprings ? 532.0 : 200.0));
-  const double perStep = d.model == DynamicsModel::kSprings ? kSecondsPerSpringStep : kSecondsPerSegmentStep;
-  e.seconds = double(segments) * steps * perStep / cores(threads);
-  e.memoryKey = "the guides' size";
-  e.timeKey = "Dynamics.Substeps or Dynamics.Frames";
+  const bool springs = d.model == DynamicsModel::kSprings;
+  const double hair = double(segments) * (springs ? 532.0 : 200.0);
+  // Model springs' grids over the hair (and the target): per density spacing eight float grids of the
+  // target, and at the finest two sets of eight more (the substep's D_s − D_t and the level choice's);
+  // the velocity grid (dvec4 nodes, at most kMaxGridNodes of spring_dynamics.cpp) and its splat lists.
+  auto nodes = [&](double h, double padding) {
+    const glm::dvec3 n = glm::ceil(span / h) + 1.0 + 2.0 * padding;
+    return n.x * n.y * n.z;
+  };
+  double density = 0.0, finest = 0.0;
+  if (springs && d.densityTarget.given())
+    for (double h : d.densitySpacings) {
+      density += 8.0 * 4.0 * nodes(h, 3.5);
+      finest = std::max(finest, nodes(h, 3.5));
+    }
+  density += 2.0 * 8.0 * 4.0 * finest;
+  const double smoothing =
+      springs && d.velocitySmoothing > 0.0 ? 2.0 * 32.0 * std::min(nodes(d.smoothingSpacing, 1.5), 2e7) : 0.0;
+  e.bytes = bytesOf(hair + density + smoothing);
+  const double perStep = springs ? kSecondsPerSpringStep : kSecondsPerSegmentStep;
+  const double hairSeconds = double(segments) * steps * perStep / cores(threads);
+  // Every substep with a target copies and negates the eight grids of D_t at its level and splats the
+  // hair into them, on one core.
+  const double densitySeconds = steps * 8.0 * finest * kSecondsPerDensityNode;
+  e.seconds = hairSeconds + densitySeconds;
+  e.memoryKey = density > hair + smoothing ? "Dynamics.DensitySpacings (its finest spacing, in metres)"
+                                           : "the guides' size";
+  e.timeKey = densitySeconds > hairSeconds ? "Dynamics.DensitySpacings (its finest spacing, in metres)"
+                                           : "Dynamics.Substeps or Dynamics.Frames";
   e.detail = std::to_string(segments) + " segments, " + formatReal(steps) + " steps";
+  if (density > 0.0)
+    e.detail += ", density grids of " + formatReal(std::round(finest)) + " nodes at the finest spacing";
   return e;
 }
 

@@ -60,9 +60,11 @@ WorkEstimate estimateRender(const RenderSettings& render, const Strands& hair, c
 WorkEstimate estimateRender(const RenderSettings& render, size_t strands, size_t points, size_t headTriangles,
                             double distance, double radius, double hairLength, int maxTextureSize);
 
-// `segments`: the guides' segments (points − strands); `frames`: the frames to simulate.
+// `segments`: the guides' segments (points − strands); `frames`: the frames to simulate; `span`: the
+// size of the box that holds the rest guides and Model springs' DensityTarget (metres), which sizes
+// the springs' density grids (Dynamics.DensitySpacings) and velocity-smoothing grid; 0 when unknown.
 WorkEstimate estimateSimulate(const Dynamics& dynamics, size_t segments, const FrameRange& frames,
-                              size_t threads);
+                              size_t threads, const glm::dvec3& span = glm::dvec3(0.0));
 
 // The points a grown guide has: one every VisualityStep (Super-Helix), or Segments + 1 (cantilever).
 size_t pointsPerGuide(const Hairstyle& style);

@@ -34,8 +34,14 @@ struct SimulateOptions {
 };
 
 // Calls `frameDone(frame, guides)` for every frame of options.frames, in order; `guides` is valid until
-// the call returns (one buffer serves every frame). Throws InputError for frames outside Dynamics
-// Frames, a missing or foreign restart cache, or guides that cannot move.
+// the call returns (one buffer serves every frame). Every frame's provenance records the rest guides'
+// digest, and its state is one a restart accepts (libcore/io/restart_state.h). Throws InputError for
+// frames outside Dynamics Frames, guides that cannot move, or a restart cache checkRestartState refuses
+// (missing, of another configuration or other rest guides, from an older hairgen, or with values no
+// simulation writes); SimulationDiverged (exit 2) when the hair leaves its validity at a frame (a step
+// that overflowed, a stretch solve that did not converge: a segment more than kMaxSpringStretch off its
+// rest length, a point faster than kMaxSpringSpeed), naming the keys that drove it and their values, the
+// frame and the strand; that frame is not delivered, the frames before it were.
 void simulate(const Strands& restGuides, const Config& config, const SimulateOptions& options,
               const std::function<void(int frame, const Strands& guides)>& frameDone);
 

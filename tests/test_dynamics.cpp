@@ -404,6 +404,23 @@ Strands someGuides(const Config& config, size_t every) {
   return grow(few, config.hairstyle, config.collision, GrowOptions{}).guides;
 }
 
+// A step that overflows leaves angles that are not finite: fault() names the first strand and
+// segment whose state is past the bounds a restart state keeps, and nothing while none is.
+TEST(AnjyoDynamics, AStateThatLeftItsBoundsIsAFault) {
+  const Config config = dynamicJob({}, {}, 4);
+  const Strands rest = someGuides(config, 7);
+  AnjyoHair hair(rest, config.hairstyle, config.dynamics, config.collision, 1);
+  EXPECT_FALSE(hair.fault());
+  ASSERT_GT(rest.strandCount(), 20u);
+  hair.setSegmentState(19, 2, {0.0, 0.0, 0.0, std::nan("")});
+  hair.setSegmentState(17, 1, {5.0, 0.0, 0.0, 0.0});
+  const std::optional<AnjyoHair::Fault> fault = hair.fault();
+  ASSERT_TRUE(fault);
+  EXPECT_EQ(fault->strand, 17u);
+  EXPECT_EQ(fault->segment, 1u);
+  EXPECT_TRUE(fault->angle);
+}
+
 TEST(Simulate, StillHairStaysStill) {
   const Config config = dynamicJob({}, {}, 240);
   const Strands rest = someGuides(config, 7);
@@ -465,6 +482,15 @@ TEST(Simulate, ThreadsAndRestartsChangeNoBit) {
     std::memcpy(reinterpret_cast<char*>(v.data() + AnjyoHair::kStateHeader) + i * sizeof(float), &value,
                 sizeof(float));
   };
+  // Another rest guides' state with the same strand layout, and one whose writer did not record them.
+  Strands other = rest;
+  other.points[other.firstPoint[1] + 2].y += 1e-4f;
+  EXPECT_THROW(
+      simulate(other, fluctuating, frames(fluctuating, {9, 16}, &one[7]), [](int, const Strands&) {}),
+      InputError);
+  Strands older = one[7];
+  older.provenance.restDigest.clear();
+  EXPECT_THROW(run(1, {9, 16}, &older), InputError);
   const size_t lastTurn = (one[7].simulationState.size() - AnjyoHair::kStateHeader) * 2 - 1;
   for (auto spoil : std::vector<std::function<void(std::vector<double>&)>>{
            [](std::vector<double>& v) { v[0] = 0x414e4a34; },

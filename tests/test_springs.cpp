@@ -7,10 +7,12 @@
 #include <tbb/global_control.h>
 #include <cmath>
 #include <cstring>
+#include <functional>
 #include <random>
 
 #include "libcore/config/setup.h"
 #include "libcore/io/hair_cache.h"
+#include "libcore/io/restart_state.h"
 #include "libcore/physics/head_motion.h"
 #include "libcore/physics/spring_dynamics.h"
 #include "libcore/util/cpu.h"
@@ -450,6 +452,75 @@ TEST(Springs, ThreadsAndRestartsChangeNoBit) {
   const std::vector<Strands> second = run(2, {9, 16}, &one[7]);  // resumed from frame 8
   ASSERT_EQ(second.size(), 8u);
   for (size_t i = 0; i < 8; ++i) EXPECT_TRUE(second[i] == one[8 + i]) << "frame " << 9 + i;
+}
+
+// A restart state is an input: every state a simulation could not have written is refused before a step
+// (a position 1e200 m or 1e30 m away crashed the process or resumed into strands 1e16 m long), and so is
+// the state of other rest guides with the same strand layout, or of a hairgen that did not record them.
+TEST(Springs, ARestartStateNoSimulationWritesIsRefused) {
+  HeadKey start, turned;
+  turned.frame = 6;
+  turned.rotation = {0.0, 40.0, 0.0};
+  const Config config = springJob({start, turned}, {}, 8);
+  const Strands rest = someGuides(config, 13);
+  std::vector<Strands> one;
+  simulate(rest, config, frames(config, {1, 4}), [&](int, const Strands& guides) { one.push_back(guides); });
+  const Strands& frame4 = one.back();
+  auto resume = [&](const Strands& restGuides, const Strands& cache) {
+    int written = 0;
+    simulate(restGuides, config, frames(config, {5, 8}, &cache), [&](int, const Strands&) { ++written; });
+    return written;
+  };
+  EXPECT_EQ(resume(rest, frame4), 4);
+  const size_t n = frame4.simulationState.size();
+  const double nan = std::nan("");
+  for (auto spoil : std::vector<std::function<void(Strands&)>>{
+           [](Strands& c) { c.simulationState[0] = 1e200; },       // a position far away
+           [](Strands& c) { c.simulationState[1] = 1e30; },        // not so far
+           [&](Strands& c) { c.simulationState[n - 1] = nan; },    // a velocity that is no number
+           [&](Strands& c) { c.simulationState[n - 2] = 1e5; },    // a velocity past any hair's
+           [&](Strands& c) { c.simulationState[n - 6] += 1e-2; },  // the last tip 1 cm off
+           [](Strands& c) { c.simulationState.resize(c.simulationState.size() - 6); },  // a segment short
+           [](Strands& c) { c.provenance.restDigest.clear(); }}) {                      // an older hairgen's
+    Strands spoiled = frame4;
+    spoil(spoiled);
+    EXPECT_THROW(resume(rest, spoiled), InputError);
+  }
+  // Other rest guides with the same strand layout: one point moved by a tenth of a millimetre.
+  Strands other = rest;
+  other.points[other.firstPoint[1] + 2].x += 1e-4f;
+  try {
+    resume(other, frame4);
+    ADD_FAILURE() << "resumed from the state of other rest guides";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("other rest guides"), std::string::npos) << e.what();
+  }
+}
+
+// DESIGN §2: a simulation that leaves its validity stops with an error, never a frame of nonsense. A
+// wind of 100 m/s² at one frame a second stretched the hair by a quarter with exit 0; now the frame it
+// happens at is not delivered, the ones before are, and the error names the wind, the step's keys,
+// the frame and the strand. Every frame delivered is a state a restart accepts.
+TEST(Springs, AStepThatLeavesItsValidityStopsNamingKeyFrameAndStrand) {
+  Config config = springJob({}, {{1, {100.0, 0.0, 0.0}, false, {}}}, 12);
+  config.dynamics.frameRate = 1.0;
+  const Strands rest = someGuides(config, 13);
+  std::vector<int> delivered;
+  try {
+    simulate(rest, config, frames(config, {1, 12}), [&](int frame, const Strands& guides) {
+      delivered.push_back(frame);
+      EXPECT_NO_THROW(checkStateValues(rest, guides.simulationState, DynamicsModel::kSprings, "frame"));
+    });
+    ADD_FAILURE() << "a quarter's stretch was delivered as hair";
+  } catch (const SimulationDiverged& e) {
+    const std::string message = e.what();
+    for (const char* word : {"Dynamics.Wind 100", "Dynamics.FrameRate 1", "Dynamics.Substeps", "strand "})
+      EXPECT_NE(message.find(word), std::string::npos) << word << " in: " << message;
+    ASSERT_FALSE(delivered.empty());
+    EXPECT_NE(message.find("frame " + std::to_string(delivered.back() + 1) + ":"), std::string::npos)
+        << message;
+    EXPECT_EQ(e.code(), ExitCode::kBadInput);
+  }
 }
 
 // The memo's Fig. 5 settings (configs/pixar/target's Dynamics: strength, damping, smoothing, grids,

@@ -137,14 +137,16 @@ ForceField readForce(const SectionReader& r, const ConfigLine& line) {
 Key<Setup> meshUnitsKey() {
   return customKey<Setup>(
       {"MeshUnits", "", "the length unit of the wick and head OBJs: m, cm, mm, in, or metres per unit"},
-      "m | cm | mm | in | factor", "factor > 0",
+      "m | cm | mm | in | factor", "[1e-06, 1000] metres per unit",
       [](SectionReader& r, Setup& s) {
         const ConfigLine* line = r.line("MeshUnits");
         if (!line) return;
         std::optional<double> unit =
             line->values.size() == 1 ? parseLengthUnit(line->values[0]) : std::nullopt;
         if (!unit)
-          throw r.error(*line, "MeshUnits takes m, cm, mm, in or a positive number of metres per unit");
+          throw r.error(*line, "MeshUnits takes m, cm, mm, in or a number of metres per unit from " +
+                                   formatReal(kMinMetresPerUnit) + " m (a micrometre) to " +
+                                   formatReal(kMaxMetresPerUnit) + " m (a kilometre)");
         s.meshConversion.metresPerUnit = unit;
       },
       [](const Setup& s) {
@@ -805,10 +807,12 @@ Key<Dynamics> densitySpacingsKey() {
       {"DensitySpacings", "m",
        "springs: the density grids' spacings, coarse to fine; the next takes over when the energy at this "
        "one falls to DensityRefine of its start"},
-      "h1 [h2 ...]", "(0, 10], not increasing",
+      "h1 [h2 ...]", "[0.0001, 1], not increasing",
       [](SectionReader& r, Dynamics& d) {
         if (!r.has("DensitySpacings")) return;
-        d.densitySpacings = r.realList("DensitySpacings", {0.0, 10.0, true, false});
+        // From a tenth of a millimetre (a few hair widths; finer grids resolve single hairs, not a
+        // density) to a metre (a whole head in one cell). Their memory is simulate's estimate's.
+        d.densitySpacings = r.realList("DensitySpacings", Range::closed(1e-4, 1.0));
         for (size_t i = 1; i < d.densitySpacings.size(); ++i)
           if (d.densitySpacings[i] > d.densitySpacings[i - 1])
             throw InputError(r.where("DensitySpacings"),
@@ -859,20 +863,17 @@ Section<Dynamics> makeDynamics() {
       {choiceKey<D, DynamicsModel>({"Model", "", "anjyo (Anjyo et al. §3) or springs (Petrovic et al. §5)"},
                                    &D::model, {std::begin(kDynamicsModels), std::end(kDynamicsModels)}),
        framesKey(),
-       realKey<D>({"FrameRate", "1/s", "frames per second"}, &D::frameRate, {0.0, 10000.0, true, false}),
+       // From a frame a second (a time-lapse) to 10000 (high-speed footage): a step of more than a second
+       // is no shot's, and 1e-20 frames/s overflows the step.
+       realKey<D>({"FrameRate", "frames/s", "frames per second"}, &D::frameRate, Range::closed(1.0, 10000.0)),
        integerKey<D>({"Substeps", "", "integration steps per frame"}, &D::substeps, 1, 1000),
        realKey<D>({"Damping", "1/s", "the rate at which motion dies away (air, hair on hair)"}, &D::damping,
                   Range::closed(0.0, 1000.0)),
-       windKey(),
-       headKeyKey(),
-       headCentreKey(),
+       windKey(), headKeyKey(), headCentreKey(),
        autoRealKey(
            {"Gravity", "N/kg", "the gravity the moving hair feels, along -y; auto = Hairstyle's Gravity"},
            "N/kg", &D::gravityAuto, &D::gravity, Range::closed(0.0, 1000.0)),
-       inertiaKey(),
-       pseudoForceKey(),
-       fluctuationKey(),
-       restFrequencyKey(),
+       inertiaKey(), pseudoForceKey(), fluctuationKey(), restFrequencyKey(),
        autoRealKey({"StretchStiffness", "N",
                     "springs: a segment's force per unit strain, E·A; auto = Young × π a b (effectively "
                     "inextensible)"},

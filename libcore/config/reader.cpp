@@ -238,8 +238,12 @@ double SectionReader::checkReal(const ConfigLine& line, size_t index, Range rang
   std::string label = what.empty() ? "'" + line.key + "'" : "'" + line.key + "' " + std::string(what);
   if (!value) throw InputError(line.where, label + ": '" + token + "' is not a number");
   if (!std::isfinite(*value)) throw InputError(line.where, label + ": '" + token + "' is not finite");
-  if (!range.contains(*value))
-    throw InputError(line.where, label + " = " + token + " is out of range; it must be " + range.describe());
+  if (!range.contains(*value)) {
+    const KeySpec* key = section_.find(line.key);
+    const std::string unit = key ? key->unit : std::string();
+    throw InputError(line.where, label + " = " + token + " is out of range; it must be " + range.describe() +
+                                     (unit.empty() ? "" : " " + unit));
+  }
   return *value;
 }
 

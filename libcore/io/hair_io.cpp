@@ -238,6 +238,7 @@ std::string provenanceText(const Provenance& p) {
   std::string text = "producer=" + line(p.producer) + "\nstage=" + line(p.stage) +
                      "\nseed=" + std::to_string(p.seed) + "\nconfig=" + line(p.configDigest) + "\n";
   if (p.frame) text += "frame=" + std::to_string(*p.frame) + "\ntime=" + formatReal(p.time) + "\n";
+  if (!p.restDigest.empty()) text += "rest=" + p.restDigest + "\n";
   // A file made elsewhere: written only when set, so hairgen's own files keep their bytes.
   if (!p.source.empty()) text += "source=" + line(p.source) + "\n";
   if (!p.sourceInfo.empty()) text += "sourceInfo=" + line(p.sourceInfo) + "\n";
@@ -268,6 +269,8 @@ Provenance parseProvenance(const std::string& text, const std::string& name) {
       p.stage = value;
     else if (key == "config")
       p.configDigest = value;
+    else if (key == "rest")
+      p.restDigest = value;
     else if (key == "frame" || key == "time") {
       std::optional<double> v = parseReal(value);
       if (!v || !std::isfinite(*v) || (key == "frame" && (*v != std::floor(*v) || std::abs(*v) > 1e9)))

@@ -31,6 +31,8 @@ struct Provenance {
   std::string stage;     // "grow", "interpolate", "shade", "convert", ...
   uint64_t seed = 0;
   std::string configDigest;  // hex digest of the effective configuration, or ""
+  std::string restDigest;    // a simulated frame: the digest of the rest guides it started from
+                             // (restGuidesDigest, libcore/io/restart_state.h), or ""
   std::optional<int> frame;  // the frame of a sequence this cache is (DESIGN §8); none for a still
   double time = 0.0;         // seconds from the sequence's first frame, when `frame` is set
   // A file made elsewhere: what it was, what it said of itself and what hairgen did to it.
@@ -42,8 +44,8 @@ struct Provenance {
   std::optional<ShardRange> shard;  // a shard of a split stage; none for a whole file
 
   bool empty() const {
-    return producer.empty() && stage.empty() && configDigest.empty() && seed == 0 && source.empty() &&
-           sourceInfo.empty() && conversion.empty() && metres && yUp && !shard;
+    return producer.empty() && stage.empty() && configDigest.empty() && restDigest.empty() && seed == 0 &&
+           source.empty() && sourceInfo.empty() && conversion.empty() && metres && yUp && !shard;
   }
   bool operator==(const Provenance&) const = default;
 };

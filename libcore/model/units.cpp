@@ -44,7 +44,7 @@ std::optional<double> parseLengthUnit(std::string_view text) {
   for (const NamedUnit& u : kNamedUnits)
     if (lower == u.name) return u.metres;
   std::optional<double> factor = parseReal(text);
-  if (!factor || !std::isfinite(*factor) || !(*factor > 0.0)) return std::nullopt;
+  if (!factor || !(*factor >= kMinMetresPerUnit && *factor <= kMaxMetresPerUnit)) return std::nullopt;
   return factor;
 }
 

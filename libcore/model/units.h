@@ -29,8 +29,12 @@ struct UnitConversion {
   std::string describe() const;
 };
 
-// Metres per unit for `text`: m, cm, mm, in (inches) or a positive finite number (metres per unit,
-// "0.01"). nullopt for anything else.
+// The metres per unit a file's unit may be: a micrometre to a kilometre. A head modelled in anything
+// outside is a wrong unit, and 1e-300 or 1e300 would turn every length into 0 or infinity.
+inline constexpr double kMinMetresPerUnit = 1e-6, kMaxMetresPerUnit = 1e3;
+
+// Metres per unit for `text`: m, cm, mm, in (inches) or a number of metres per unit ("0.01") in
+// [kMinMetresPerUnit, kMaxMetresPerUnit]. nullopt for anything else.
 std::optional<double> parseLengthUnit(std::string_view text);
 
 // "y" or "z" (case-insensitive); nullopt otherwise.

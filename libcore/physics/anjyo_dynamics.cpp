@@ -258,33 +258,38 @@ void AnjyoHair::setSegmentState(size_t s, uint32_t j, const std::array<double, k
 }
 
 void AnjyoHair::restore(const std::vector<double>& state, const std::string& source) {
-  if (state.size() < kStateHeader || state[0] != kStateTag || state[1] != double(kLanes) ||
-      state[2] != double(kStateValues))
-    throw InputError({source, 0},
-                     "its simulation state is not in the layout this hairgen keeps (an earlier "
-                     "version, or another model's); simulate from the first frame");
-  if (state.size() != state_.size())
-    throw InputError({source, 0}, "its simulation state is for other guides (" +
-                                      std::to_string(state.size()) + " values, these need " +
-                                      std::to_string(state_.size()) +
-                                      "); restart from a frame of the same guides");
-  // The step keeps its angles within half a turn of 0, and a turn of more than kMaxTurn in a substep is
-  // no shot's.
-  const size_t values = (state.size() - kStateHeader) * 2;
-  for (size_t i = 0; i < values; ++i) {
-    float value;
-    std::memcpy(&value, reinterpret_cast<const char*>(state.data() + kStateHeader) + i * sizeof(float),
-                sizeof(float));
-    const bool angle = (i / kLanes) % kStateValues < 2;
-    if (!(std::abs(value) <= (angle ? kMaxAngle : kMaxTurn)))
-      throw InputError({source, 0}, std::string("its simulation state holds ") +
-                                        (angle ? "an angle" : "a turn") + " that is not finite or beyond " +
-                                        std::to_string(int(angle ? kMaxAngle : kMaxTurn)) +
-                                        " rad; simulate from the first frame");
-  }
+  checkStateValues(rest_, state, DynamicsModel::kAnjyo, source);  // rest_ keeps the strand layout
   state_ = state;
   const Kernel kernel = available(Kernel::kFastest);
   tbb::parallel_for(size_t(0), blockCount(), [&](size_t b) { Kernels::angleTrig(*this, b, kernel); });
+}
+
+std::optional<AnjyoHair::Fault> AnjyoHair::fault() const {
+  requireState();
+  // A block's first faulty strand (in strand order, then segment order); the lowest such block of all,
+  // found on every core. A lane past its strand's end is not the hair's and is not read.
+  const size_t strands = rest_.strandCount();
+  auto blockFault = [&](size_t b) -> std::optional<Fault> {
+    for (size_t l = 0; l < kLanes && b * kLanes + l < strands; ++l) {
+      const size_t s = b * kLanes + l;
+      for (uint32_t j = 0; j < firstSegment_[s + 1] - firstSegment_[s]; ++j) {
+        const float* values = stateAt(blockFirst_[b] + j) + l;
+        for (size_t v = 0; v < kStateValues; ++v)
+          if (!(std::abs(values[v * kLanes]) <= (v < 2 ? float(kMaxAngle) : float(kMaxTurn))))
+            return Fault{s, j, v < 2, double(values[v * kLanes])};
+      }
+    }
+    return std::nullopt;
+  };
+  std::atomic<size_t> first{blockCount()};
+  tbb::parallel_for(size_t(0), blockCount(), [&](size_t b) {
+    if (b >= first.load(std::memory_order_relaxed) || !blockFault(b)) return;
+    size_t seen = first.load();
+    while (b < seen && !first.compare_exchange_weak(seen, b)) {
+    }
+  });
+  if (first == blockCount()) return std::nullopt;
+  return blockFault(first);
 }
 
 }  // namespace hairgen

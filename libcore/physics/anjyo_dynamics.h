@@ -39,11 +39,13 @@
 #include <array>
 #include <atomic>
 #include <cstdint>
+#include <optional>
 #include <vector>
 
 #include <glm/glm.hpp>
 
 #include "libcore/config/params.h"
+#include "libcore/io/restart_state.h"
 #include "libcore/model/strands.h"
 #include "libcore/physics/head_motion.h"
 #include "libcore/util/uninitialised.h"
@@ -62,6 +64,7 @@ class AnjyoHair {
   // where the processor has AVX-512 (else kPortable). kFastest: the fastest this processor runs.
   enum class Kernel { kFastest, kPortable, kAvx512 };
   static constexpr size_t kLanes = 16;  // strands a step takes at once
+  static_assert(kLanes == kAnjyoLanes, "the restart layout's lanes are the step's");
 
   // One substep of `dt` seconds for every strand (in parallel; the result depends on neither the thread
   // count nor the kernel). `frame` and `firstSubstep` key the fluctuations, drawn at the first substep of
@@ -87,13 +90,26 @@ class AnjyoHair {
   // to a double (a lane past its strand's end holds the rest state, zeros). The hair keeps its state in
   // this layout, so `swapState` lends it to a frame's cache without a copy: swap it out, write the
   // cache, swap it back (stepping in between is an error).
-  static constexpr size_t kStateValues = 4, kStateHeader = 8;
-  static constexpr double kStateTag = 0x414e4a35;  // "ANJ5": a state of this layout
-  static constexpr double kMaxAngle = 4.0;         // radians: the most an angle of a restart state may be
-  static constexpr double kMaxTurn = 1e3;          // radians: the most its turn in a substep may be
+  // (The layout and its bounds are declared once, in libcore/io/restart_state.h.)
+  static constexpr size_t kStateValues = kAnjyoStateValues, kStateHeader = kAnjyoStateHeader;
+  static constexpr double kStateTag = kAnjyoStateTag;  // "ANJ5": a state of this layout
+  static constexpr double kMaxAngle = kMaxAnjyoAngle;  // radians: the most an angle of a state may be
+  static constexpr double kMaxTurn = kMaxAnjyoTurn;    // radians: the most its turn in a substep may be
   std::vector<double> state() const { return state_; }
   void swapState(std::vector<double>& other) { state_.swap(other); }
+  // Throws InputError naming `source` for a state of another layout or size, or a value past the bounds.
   void restore(const std::vector<double>& state, const std::string& source);
+
+  // How the state left its validity (a step that overflowed): strand `strand`'s segment `segment`
+  // (0 = the root's) holds an angle or a turn (`angle`) of `value` rad that is not finite or past
+  // kMaxAngle / kMaxTurn. The first such strand in strand order, or none while the state is valid.
+  struct Fault {
+    size_t strand = 0;
+    uint32_t segment = 0;
+    bool angle = true;
+    double value = 0.0;
+  };
+  std::optional<Fault> fault() const;
   // One segment's values (θ, φ, and their turns over the last substep), and setting them: segment j < the
   // strand's segments, strand < the guides'.
   std::array<double, kStateValues> segmentState(size_t strand, uint32_t j) const;

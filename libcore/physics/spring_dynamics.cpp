@@ -10,9 +10,11 @@
 #include <tbb/parallel_for.h>
 #include <tbb/parallel_reduce.h>
 
+#include "libcore/io/restart_state.h"
 #include "libcore/physics/strand_energy.h"
 #include "libcore/physics/tridiagonal.h"
 #include "libcore/util/error.h"
+#include "libcore/util/text.h"
 
 namespace hairgen {
 namespace {
@@ -24,6 +26,9 @@ SpringHair::Kernel available(SpringHair::Kernel asked) {
 
 // Density targeting: the grids of a spacing, shifted by half a cell along each combination of axes.
 constexpr int kDensityShifts = 8;
+
+// The most nodes a density grid may have (gridAround's limit).
+constexpr double kMaxDensityNodes = 4e8;
 
 // The most nodes a velocity grid may have: past it the spacing is coarsened (doubled) until it fits.
 constexpr double kMaxGridNodes = 2e7;
@@ -212,7 +217,17 @@ SpringHair::SpringHair(const Strands& rest, const Hairstyle& style, const Dynami
     both.insert(both.end(), densityTarget->points.begin(), densityTarget->points.end());
     const double scale =
         densityTarget->points.empty() ? 0.0 : double(rest.pointCount()) / double(densityTarget->pointCount());
+    const Bounds box = boundsInParallel(both);
+    const glm::dvec3 span = glm::dvec3(box.max) - glm::dvec3(box.min);
     for (double h : dynamics.densitySpacings) {
+      // gridAround's grid with its padding, and one more node: refused here, naming the key, before
+      // gridAround refuses it for the renderer's.
+      const glm::dvec3 n = glm::ceil(span / h) + 8.0;
+      if (!(n.x * n.y * n.z <= kMaxDensityNodes))
+        throw InputError("Dynamics.DensitySpacings " + formatReal(h) + " m makes density grids of " +
+                         formatReal(n.x * n.y * n.z) + " nodes over the hair and its target (" +
+                         formatReal(span.x) + " x " + formatReal(span.y) + " x " + formatReal(span.z) +
+                         " m; " + formatReal(kMaxDensityNodes) + " at most); raise it");
       // Eight copies of the level's grid, shifted by half a cell along every combination of axes: the
       // energy of one grid depends on where its cell walls fall (a surplus of hair may sit one cell
       // away from the place it lacks, or in the same cell), the mean of the eight much less.
@@ -385,6 +400,7 @@ void SpringHair::buildLanePoints() {
 
 void SpringHair::step(const AccelerationField& field, double dt, bool firstSubstep, bool lastSubstep,
                       Kernel kernel) {
+  if (fault_) return;  // the state left its validity: nothing more is computed from it
   if (dt != dt_) factor(dt);
   if (!targets_.empty() && densityStrength_ > 0.0) {
     if (firstSubstep) {
@@ -395,12 +411,73 @@ void SpringHair::step(const AccelerationField& field, double dt, bool firstSubst
     }
     difference_ = densityDifference(level_);
   }
+  // Each strand checked as soon as it has stepped, while its points are in cache.
+  const size_t strands = rest_.strandCount();
+  std::atomic<size_t> first{strands};
   if (available(kernel) == Kernel::kLanes)
-    tbb::parallel_for(size_t(0), (rest_.strandCount() + kLanes - 1) / kLanes,
-                      [&](size_t b) { stepBlock(b * kLanes, field, dt); });
+    tbb::parallel_for(size_t(0), (strands + kLanes - 1) / kLanes, [&](size_t b) {
+      stepBlock(b * kLanes, field, dt);
+      checkStrands(b * kLanes, std::min(strands, (b + 1) * kLanes), first);
+    });
   else
-    tbb::parallel_for(size_t(0), rest_.strandCount(), [&](size_t s) { stepStrand(s, field, dt); });
+    tbb::parallel_for(size_t(0), strands, [&](size_t s) {
+      stepStrand(s, field, dt);
+      checkStrands(s, s + 1, first);
+    });
+  if (first < strands) {
+    fault_ = checkStrand(first);
+    return;
+  }
   if (lastSubstep && smoothing_ > 0.0) smoothVelocities(smoothing_);
+}
+
+std::optional<SpringHair::Fault> SpringHair::checkStrand(size_t s) const {
+  const uint32_t p0 = rest_.firstPoint[s], count = rest_.pointsOf(s);
+  // First a quick pass in squares (no root, no division) with bounds 1% inside the true ones: every
+  // substep runs it, and a strand it passes is well within them (a NaN fails every comparison).
+  constexpr double kLow = (1.0 - 0.99 * kMaxSpringStretch) * (1.0 - 0.99 * kMaxSpringStretch),
+                   kHigh = (1.0 + 0.99 * kMaxSpringStretch) * (1.0 + 0.99 * kMaxSpringStretch),
+                   kSpeed2 = 0.99 * kMaxSpringSpeed * 0.99 * kMaxSpringSpeed;
+  bool within = true;
+  for (uint32_t p = p0 + 1; p < p0 + count; ++p) {
+    const glm::dvec3 e = x_[p] - x_[p - 1];
+    const double length2 = glm::dot(e, e), rest2 = length_[p] * length_[p];
+    within &= length2 >= kLow * rest2 && length2 <= kHigh * rest2 && glm::dot(v_[p], v_[p]) <= kSpeed2;
+  }
+  if (within) return std::nullopt;
+  // restart_state.h's bounds, in the same arithmetic as checkRestartState's (the rest lengths are the
+  // same doubles), so a state that passes here passes there.
+  for (uint32_t j = 1; j < count; ++j) {
+    const uint32_t p = p0 + j;
+    Fault f;
+    f.strand = s;
+    f.point = j;
+    const glm::dvec3 &x = x_[p], &v = v_[p];
+    if (!std::isfinite(x.x) || !std::isfinite(x.y) || !std::isfinite(x.z) || !std::isfinite(v.x) ||
+        !std::isfinite(v.y) || !std::isfinite(v.z))
+      return f;
+    f.value = glm::length(x - x_[p - 1]) / length_[p] - 1.0;
+    if (!(std::abs(f.value) <= kMaxSpringStretch)) {
+      f.kind = Fault::kStretch;
+      return f;
+    }
+    f.value = glm::length(v);
+    if (!(f.value <= kMaxSpringSpeed)) {
+      f.kind = Fault::kSpeed;
+      return f;
+    }
+  }
+  return std::nullopt;
+}
+
+void SpringHair::checkStrands(size_t s0, size_t s1, std::atomic<size_t>& first) const {
+  for (size_t s = s0; s < s1 && s < first.load(std::memory_order_relaxed); ++s)
+    if (checkStrand(s)) {
+      size_t seen = first.load();
+      while (s < seen && !first.compare_exchange_weak(seen, s)) {
+      }
+      return;
+    }
 }
 
 void SpringHair::projectStretch(size_t s, double dt, int iterations, std::vector<double>& lambda) {
@@ -699,8 +776,6 @@ void SpringHair::restore(const std::vector<double>& state, const std::string& so
     throw InputError({source, 0}, "its simulation state has " + std::to_string(state.size() / kStateValues) +
                                       " segments, the guides " + std::to_string(segments) +
                                       "; restart from a frame of the same guides (and the same Model)");
-  for (double value : state)
-    if (!std::isfinite(value)) throw InputError({source, 0}, "its simulation state holds a non-finite value");
   size_t k = 0;
   for (size_t p = 0; p < x_.size(); ++p) {
     if (length_[p] == 0.0) {
@@ -712,6 +787,17 @@ void SpringHair::restore(const std::vector<double>& state, const std::string& so
     x_[p] = glm::dvec3(v[0], v[1], v[2]);
     v_[p] = glm::dvec3(v[3], v[4], v[5]);
   }
+  // The bounds every step keeps (and checkRestartState checks, with the rest guides' points).
+  fault_.reset();
+  for (size_t s = 0; s < rest_.strandCount(); ++s)
+    if (const std::optional<Fault> f = checkStrand(s)) {
+      x_ = xRest_;
+      v_.assign(v_.size(), glm::dvec3(0.0));
+      throw InputError({source, 0}, "its simulation state's strand " + std::to_string(s) + ", point " +
+                                        std::to_string(f->point) +
+                                        " is not a state a simulation writes (not finite, stretched past " +
+                                        "its bound, or too fast); simulate from the first frame");
+    }
 }
 
 }  // namespace hairgen

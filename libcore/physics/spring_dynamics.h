@@ -52,7 +52,9 @@
 // thread count, and a run resumed from state() is the same bits as one that never stopped.
 #pragma once
 
+#include <atomic>
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -92,8 +94,26 @@ class SpringHair {
   enum class Kernel { kFastest, kStrands, kLanes };
   static constexpr size_t kLanes = 8;
   static constexpr uint32_t kMaxLaneSegments = 128;  // longer strands step on their own
+  // After the substep every strand's state is checked against the bounds of a valid state
+  // (libcore/io/restart_state.h: finite, every segment within kMaxSpringStretch of its rest length,
+  // every point slower than kMaxSpringSpeed); the first strand that left them is kept as fault(), and
+  // from then on step() does nothing (nothing computes on nonsense) until restore().
   void step(const AccelerationField& field, double dt, bool firstSubstep, bool lastSubstep,
             Kernel kernel = Kernel::kFastest);
+
+  // How a state left its validity: at strand `strand`, point `point` (of the strand, 1 = the end of its
+  // first segment), a value that is not finite, a segment stretched by `value` (length / rest − 1), or
+  // a point moving at `value` m/s.
+  struct Fault {
+    enum Kind { kNotFinite, kStretch, kSpeed };
+    Kind kind = kNotFinite;
+    size_t strand = 0;
+    uint32_t point = 0;
+    double value = 0.0;
+  };
+  // The first strand (in strand order, whatever the threads) whose state a step left invalid; none while
+  // the hair is valid.
+  const std::optional<Fault>& fault() const { return fault_; }
 
   // §5.1 on the current velocities: every free particle moves `fraction` of the way to the smoothed
   // grid velocity at its place. Never raises the kinetic energy.
@@ -107,6 +127,8 @@ class SpringHair {
 
   // What a restart needs: per segment, its end point's position and velocity in the head's frame
   // (kStateValues doubles; the roots are the head's); and the inverse.
+  // restore() throws InputError naming `source` for a state of another size, or one whose values leave
+  // the bounds step() keeps (fault()).
   static constexpr size_t kStateValues = 6;
   std::vector<double> state() const;
   void stateInto(std::vector<double>& out) const;
@@ -133,6 +155,10 @@ class SpringHair {
   // positions into `before`, n + 1 of them), projectStretch, constrain (twist springs and collisions;
   // whether they moved a point), projectStretch again where they did, finish (the velocities).
   void stepStrand(size_t strand, const AccelerationField& field, double dt);
+  // Strand s's state against the bounds of fault(): the first point that leaves them, if any.
+  std::optional<Fault> checkStrand(size_t strand) const;
+  // The first strand of [s0, s1) whose checkStrand fails, into `first` (the lowest of all callers).
+  void checkStrands(size_t s0, size_t s1, std::atomic<size_t>& first) const;
   void predict(size_t strand, const AccelerationField& field, double dt, glm::dvec3* before);
   bool constrain(size_t strand, double dt);
   // Point p at `x` out of collision shape c to the depth it sat at in the rest shape; whether it moved.
@@ -205,6 +231,7 @@ class SpringHair {
   double densityStrength_ = 0.0, densityRefine_ = 0.5;
   size_t level_ = 0;
   std::vector<Grid> difference_;  // D_s − D_t of the current substep, at level_
+  std::optional<Fault> fault_;
   // Velocity smoothing's grid and point lists, kept between frames so their memory is reused.
   GridOf<glm::dvec4> velocityGrid_;
   std::vector<glm::dvec3> smoothWhere_;

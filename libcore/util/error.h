@@ -67,6 +67,14 @@ class InputError : public Error {
       : Error(ExitCode::kBadInput, std::move(where), message) {}
 };
 
+// A simulation left its validity (DESIGN §2): a step that overflowed, a constraint solve that did not
+// converge, a hair stretched past its bound. The settings drove it there, so it is the input's fault:
+// exit code 2, and the message names the keys, their values, the frame and the strand.
+class SimulationDiverged : public InputError {
+ public:
+  explicit SimulationDiverged(const std::string& message) : InputError(message) {}
+};
+
 // Reading or writing failed for a reason outside the input's content (disk full, permissions). Exit 1.
 class IoError : public Error {
  public:
