@@ -103,6 +103,10 @@ diverge_springs)
     frame=$(failed_frame)
     [ -n "$frame" ] || fail "$set: no frame named: $(cat "$tmp/err")"
     [ ! -e "$tmp/$run/g.$(printf %04d "$frame").hair" ] || fail "$set: frame $frame was written"
+    # A failed frame never costs the frames that succeeded: every frame before it is kept.
+    for ((f = 1; f < frame; f++)); do
+      [ -s "$tmp/$run/g.$(printf %04d "$f").hair" ] || fail "$set: frame $f, before the divergence, is gone"
+    done
   done
   # The Fig. 5 shot's density force at 1e9 m/s².
   expect_rc 2 "$hairgen" simulate "$src/configs/pixar/target/setup.txt" --guides "$tmp/g.hair" -o "$tmp/t/g.####.hair" \
