@@ -196,22 +196,22 @@ Section<Setup> makeSetup() {
        pathKey<Setup>({"WickModel", "", "the wick OBJ: every vertex a follicle", {"HairModel"}},
                       &Setup::wickModel),
        pathKey<Setup>({"HeadModel", "", "the head OBJ: rendered, and shadows the hair"}, &Setup::headModel),
-       pathKey<Setup>(
-           {"HairVert", "",
-            "GLSL hair vertex stage of every pass, in place of hairgen's (README, Custom shaders)"},
-           &Setup::hairVert),
-       pathKey<Setup>(
-           {"HairFrag", "",
-            "GLSL fragment stage shading the hair, in place of hairgen's (README, Custom shaders)"},
-           &Setup::hairFrag),
-       pathKey<Setup>(
-           {"HeadVert", "",
-            "GLSL head vertex stage of every pass, in place of hairgen's (README, Custom shaders)"},
-           &Setup::headVert),
-       pathKey<Setup>(
-           {"HeadFrag", "",
-            "GLSL fragment stage shading the head, in place of hairgen's (README, Custom shaders)"},
-           &Setup::headFrag),
+       pathKey<Setup>({"HairVert", "",
+                       "GLSL hair vertex stage of every pass, in place of hairgen's (docs/rendering.md, "
+                       "Custom shaders)"},
+                      &Setup::hairVert),
+       pathKey<Setup>({"HairFrag", "",
+                       "GLSL fragment stage shading the hair, in place of hairgen's (docs/rendering.md, "
+                       "Custom shaders)"},
+                      &Setup::hairFrag),
+       pathKey<Setup>({"HeadVert", "",
+                       "GLSL head vertex stage of every pass, in place of hairgen's (docs/rendering.md, "
+                       "Custom shaders)"},
+                      &Setup::headVert),
+       pathKey<Setup>({"HeadFrag", "",
+                       "GLSL fragment stage shading the head, in place of hairgen's (docs/rendering.md, "
+                       "Custom shaders)"},
+                      &Setup::headFrag),
        meshUnitsKey(), meshUpAxisKey(),
        customKey<Setup>(
            {"WickGroup", "",
@@ -343,7 +343,7 @@ Key<Hairstyle> rootFlowKey() {
   return customKey<Hairstyle>(
       {"RootFlow", "m",
        "the direction follicles lean toward: down, a vector x y z, away-from x y z (a point, e.g. the "
-       "whorl), or away-from auto (the whorl of the head read, README Real heads)"},
+       "whorl), or away-from auto (the whorl of the head read, docs/real-heads.md)"},
       "down | x y z | away-from x y z | away-from auto", "",
       [](SectionReader& r, Hairstyle& h) {
         const ConfigLine* line = r.line("RootFlow");
@@ -550,7 +550,7 @@ Section<RenderSettings> makeRender() {
        realKey<R>({"StrandOpacity", "", "opacity of one strand"}, &R::strandOpacity, Range::closed(0.0, 1.0)),
        realKey<R>({"StrandWidth", "m", "on-screen diameter of a strand"}, &R::strandWidth,
                   {0.0, 1.0, true, false}),
-       choiceKey<R, ShadingModel>({"ShadingModel", "", "how strands are lit (README, Rendering)"},
+       choiceKey<R, ShadingModel>({"ShadingModel", "", "how strands are lit (docs/rendering.md)"},
                                   &R::shadingModel, {std::begin(kShadingModels), std::end(kShadingModels)}),
        vectorKey<R, 3>({"Background", "", "the preview's background colour"}, &R::background, "r g b",
                        colorRange),
