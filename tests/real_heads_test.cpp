@@ -124,7 +124,7 @@ int main(int argc, char** argv) {
     const Mesh scalp = readObj(config.setup.wickModel.path, options);
     std::optional<Mesh> head;
     if (config.setup.headModel.given())
-      head = readObj(config.setup.headModel.path, {"", false, options.conversion});
+      head = readObj(config.setup.headModel.path, {"", false, options.conversion, "HeadModel"});
     const Figures f = measure(argv[3], scalp, head ? &*head : nullptr);
     std::printf(
         "roots within %.3f mm of the scalp, %.2f%% of points past 1 cm inside the fitted head, hair "
