@@ -281,9 +281,21 @@ std::optional<AnjyoHair::Fault> AnjyoHair::fault() const {
     }
     return std::nullopt;
   };
+  // Every frame checks the whole state, so the common case, a block wholly within bounds, is one
+  // branch-free pass over its contiguous rows (padding lanes included: one out of bounds only sends the
+  // block to the exact search above, which skips them).
+  auto blockWithinBounds = [&](size_t b) {
+    const float* values = stateAt(blockFirst_[b]);
+    const size_t rows = blockFirst_[b + 1] - blockFirst_[b];
+    bool within = true;
+    for (size_t r = 0; r < rows; ++r, values += kStateValues * kLanes)
+      for (size_t i = 0; i < kStateValues * kLanes; ++i)
+        within &= std::abs(values[i]) <= (i < 2 * kLanes ? float(kMaxAngle) : float(kMaxTurn));
+    return within;
+  };
   std::atomic<size_t> first{blockCount()};
   tbb::parallel_for(size_t(0), blockCount(), [&](size_t b) {
-    if (b >= first.load(std::memory_order_relaxed) || !blockFault(b)) return;
+    if (b >= first.load(std::memory_order_relaxed) || blockWithinBounds(b) || !blockFault(b)) return;
     size_t seen = first.load();
     while (b < seen && !first.compare_exchange_weak(seen, b)) {
     }
