@@ -396,5 +396,25 @@ TEST(ConfigKeys, EveryDigestKeyIsInTheCanonicalText) {
     }
 }
 
+// The one rule for which collision shape is the head (params.h, docs/configs.md#the-head-shape): a
+// shape fitted to the head, else the first Ellipsoid, else none; a Sphere by hand never.
+TEST(Config, TheHeadShapeIsTheFittedOneElseTheFirstEllipsoidElseNone) {
+  CollisionShape sphere, ellipsoid, fitted;
+  sphere.kind = ShapeKind::kSphere;
+  ellipsoid.kind = ShapeKind::kEllipsoid;
+  fitted.kind = ShapeKind::kEllipsoid;
+  fitted.fitted = true;
+  Collision c;
+  c.shapes = {sphere, ellipsoid, fitted};
+  EXPECT_EQ(headShape(c), &c.shapes[2]);
+  c.shapes[2].kind = ShapeKind::kSphere;  // `Sphere v k auto` is fitted to the head too
+  EXPECT_EQ(headShape(c), &c.shapes[2]);
+  c.shapes = {sphere, ellipsoid, ellipsoid};
+  EXPECT_EQ(headShape(c), &c.shapes[1]);
+  c.shapes = {sphere, sphere};
+  EXPECT_EQ(headShape(c), nullptr);
+  EXPECT_EQ(headShape(Collision{}), nullptr);
+}
+
 }  // namespace
 }  // namespace hairgen

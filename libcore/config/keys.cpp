@@ -679,7 +679,7 @@ Key<Dynamics> headKeyKey() {
 Key<Dynamics> headCentreKey() {
   return customKey<Dynamics>(
       {"HeadCentre", "m",
-       "the point the head turns about; auto = the first Ellipsoid's centre (else the origin)"},
+       "the point the head turns about; auto = the head shape's centre (docs/configs.md; else the origin)"},
       "auto | x y z", "",
       [](SectionReader& r, Dynamics& d) {
         const ConfigLine* line = r.line("HeadCentre");
@@ -725,7 +725,7 @@ Key<Dynamics> inertiaKey() {
 Key<Dynamics> pseudoForceKey() {
   return customKey<Dynamics>(
       {"PseudoForce", "-, -, m",
-       "anjyo: within reach of the head ellipsoid, a force with D·F < α|D||F| (into the head) is scaled by "
+       "anjyo: within reach of the head shape, a force with D·F < α|D||F| (into the head) is scaled by "
        "ε"},
       "alpha epsilon reach", "α in [-1, 1], ε in [0, 1], reach >= 0",
       [](SectionReader& r, Dynamics& d) {

@@ -215,7 +215,7 @@ class AnjyoHair {
   std::vector<double> state_;           // kStateValues per segment (the restart layout): all 0 at rest
   std::vector<float, UninitialisedAllocator<float>> trig_;  // kTrigValues per segment: of state_'s angles
   glm::dvec3 origin_{0.0};                                  // the centre of the rest hair's bounds
-  int head_ = -1;  // the first ellipsoid (the pseudo-force head), an index into shapes
+  int head_ = -1;  // headShape (the pseudo-force head), an index into shapes; -1 for none
   glm::dvec3 restAcceleration_;
   double damping_ = 0.0;
   double pseudoAlpha_, pseudoEpsilon_;
