@@ -286,6 +286,17 @@ TEST(Overrides, MultiValueAndRepeatableKeys) {
   EXPECT_EQ(readHairstyle(text("HairLengths 0.1\n"), o).hairLengths, (std::vector<double>{0.02, 0.03}));
 }
 
+// HeadModel none (any case) is no head, as "" was; a file named `none` is then out of reach, as it should be.
+TEST(Overrides, HeadModelNoneMeansNoHead) {
+  const std::filesystem::path setup = thesis("coupe1/setup.txt");
+  ASSERT_TRUE(loadConfig(setup, {}, SetupUse::kCheck).setup.headModel.given());
+  for (const char* none : {"Setup.HeadModel=none", "Setup.HeadModel=NONE", "Setup.HeadModel=\"\""}) {
+    const Config c = loadConfig(setup, {parseOverride(none)}, SetupUse::kCheck);
+    EXPECT_FALSE(c.setup.headModel.given()) << none;
+    for (const auto& [key, digest] : c.inputContent) EXPECT_NE(key, "HeadModel") << none;
+  }
+}
+
 TEST(Overrides, BadOverridesAreInputErrors) {
   EXPECT_NE(inputError([] { parseOverride("HairDensity=3"); }).find("Section.Key=VALUE"), std::string::npos);
   EXPECT_NE(inputError([] { parseOverride("Hairstyl.HairDensity=3"); }).find("did you mean 'Hairstyle'"),

@@ -173,6 +173,20 @@ Key<Setup> meshUpAxisKey() {
       });
 }
 
+// HeadModel none (any case) or "" is no head, as when the Setup names none.
+Key<Setup> headModelKey() {
+  Key<Setup> key = pathKey<Setup>(
+      {"HeadModel", "", "the head OBJ: rendered, and shadows the hair; none (or \"\") for no head"},
+      &Setup::headModel);
+  key.spec.value = "path | none";
+  key.read = [path = key.read](SectionReader& r, Setup& s) {
+    const ConfigLine* line = r.line("HeadModel");
+    if (line && line->values.size() == 1 && toLower(line->values[0]) == "none") return;
+    path(r, s);
+  };
+  return key;
+}
+
 Section<Setup> makeSetup() {
   auto notInDigest = [](Key<Setup> key) {
     key.spec.inDigest = false;
@@ -195,7 +209,7 @@ Section<Setup> makeSetup() {
                       &Setup::dynamicsInfo),
        pathKey<Setup>({"WickModel", "", "the wick OBJ: every vertex a follicle", {"HairModel"}},
                       &Setup::wickModel),
-       pathKey<Setup>({"HeadModel", "", "the head OBJ: rendered, and shadows the hair"}, &Setup::headModel),
+       headModelKey(),
        pathKey<Setup>({"HairVert", "",
                        "GLSL hair vertex stage of every pass, in place of hairgen's (docs/rendering.md, "
                        "Custom shaders)"},
