@@ -143,6 +143,32 @@ TEST(ConfigErrors, UnknownKeyNamesLineAndSuggestsClosest) {
   EXPECT_NE(m.find("did you mean 'HairDensity'"), std::string::npos) << m;
 }
 
+// Every Dynamics key declared for some models (keys.cpp's `only`) is refused under each other model, at
+// its line, with the message naming both; the cases come from the declarations.
+TEST(ConfigErrors, EveryModelKeyIsRefusedUnderAnotherModel) {
+  int refused = 0;
+  for (const KeySpec& key : dynamicsKeys().spec.keys) {
+    if (key.models.empty()) continue;
+    ASSERT_EQ(key.models.size(), 1u) << key.name;  // the message below names one
+    EXPECT_EQ(key.help.rfind(key.models[0] + ": ", 0), 0u) << key.name << "'s help does not name its model";
+    for (DynamicsModel model : kDynamicsModels) {
+      const std::string other = name(model);
+      if (other == key.models[0]) continue;
+      // The key's default is a value it reads; DensityTarget's is none.
+      const std::string value = key.defaultText.empty() ? "target.hair" : key.defaultText;
+      const std::string m = inputError(
+          [&] { readDynamics(text("Model " + other + "\n" + key.name + " " + value + "\n", "d.txt"), {}); });
+      EXPECT_NE(m.find("d.txt:2"), std::string::npos) << m;
+      EXPECT_NE(m.find(key.name + " is a key of Model " + key.models[0] +
+                       ", and this Dynamics Info is Model " + other + "; remove it or change the Model"),
+                std::string::npos)
+          << m;
+      ++refused;
+    }
+  }
+  EXPECT_GE(refused, 2);
+}
+
 TEST(ConfigErrors, KeyOfAnotherSectionSaysWhereItBelongs) {
   std::string m = inputError([] { readHairstyle(text("HairLengths 0.1\nGlossiness 60\n", "h.txt"), {}); });
   EXPECT_NE(m.find("h.txt:2:"), std::string::npos) << m;

@@ -7,7 +7,6 @@
 #include <algorithm>
 #include <cmath>
 #include <iterator>
-#include <span>
 
 #include "libcore/util/text.h"
 
@@ -712,7 +711,7 @@ Key<Dynamics> headCentreKey() {
 Key<Dynamics> inertiaKey() {
   return customKey<Dynamics>(
       {"Inertia", "",
-       "anjyo: segment i of k has (k/i)^p the inertia of its mass at the hair's length, times f for the "
+       "segment i of k has (k/i)^p the inertia of its mass at the hair's length, times f for the "
        "first n "
        "segments"},
       "p [f n]", "p in [0, 4], f > 0, n >= 0",
@@ -739,7 +738,7 @@ Key<Dynamics> inertiaKey() {
 Key<Dynamics> pseudoForceKey() {
   return customKey<Dynamics>(
       {"PseudoForce", "-, -, m",
-       "anjyo: within reach of the head shape, a force with D·F < α|D||F| (into the head) is scaled by "
+       "within reach of the head shape, a force with D·F < α|D||F| (into the head) is scaled by "
        "ε"},
       "alpha epsilon reach", "α in [-1, 1], ε in [0, 1], reach >= 0",
       [](SectionReader& r, Dynamics& d) {
@@ -759,7 +758,7 @@ Key<Dynamics> pseudoForceKey() {
 Key<Dynamics> fluctuationKey() {
   return customKey<Dynamics>(
       {"Fluctuation", "radians, frames",
-       "anjyo: random turns of each segment up to the amplitude (the most at the tip), drawn once every N "
+       "random turns of each segment up to the amplitude (the most at the tip), drawn once every N "
        "frames"},
       "amplitude N", "amplitude in [0, 1], N >= 1",
       [](SectionReader& r, Dynamics& d) {
@@ -780,7 +779,7 @@ Key<Dynamics> fluctuationKey() {
 Key<Dynamics> restFrequencyKey() {
   return customKey<Dynamics>(
       {"RestFrequency", "Hz",
-       "anjyo: the angular spring that holds the styled shape (0 = none); auto = the hair's first bending "
+       "the angular spring that holds the styled shape (0 = none); auto = the hair's first bending "
        "mode"},
       "auto | Hz", "[0, 1000]",
       [](SectionReader& r, Dynamics& d) {
@@ -819,7 +818,7 @@ Key<Dynamics> autoRealKey(KeyText t, std::string what, bool Dynamics::*isAuto, d
 Key<Dynamics> densitySpacingsKey() {
   return customKey<Dynamics>(
       {"DensitySpacings", "m",
-       "springs: the density grids' spacings, coarse to fine; the next takes over when the energy at this "
+       "the density grids' spacings, coarse to fine; the next takes over when the energy at this "
        "one falls to DensityRefine of its start"},
       "h1 [h2 ...]", "[0.0001, 1], not increasing",
       [](SectionReader& r, Dynamics& d) {
@@ -840,20 +839,19 @@ Key<Dynamics> densitySpacingsKey() {
       });
 }
 
-// The keys only one model reads: naming one for the other model is an error (a key that is read is
-// used).
+// The keys only one model reads (declared with `only`): naming one for the other model is an error (a key
+// that is read is used).
 void checkModelKeys(SectionReader& r, const Dynamics& d) {
-  static const char* anjyoOnly[] = {"Inertia", "PseudoForce", "Fluctuation", "RestFrequency"};
-  static const char* springsOnly[] = {
-      "Gravity",          "StretchStiffness", "BendStiffness",   "TwistStiffness",  "VelocitySmoothing",
-      "SmoothingSpacing", "DensityTarget",    "DensityStrength", "DensitySpacings", "DensityRefine"};
-  const bool springs = d.model == DynamicsModel::kSprings;
-  for (const char* key : springs ? std::span<const char*>(anjyoOnly) : std::span<const char*>(springsOnly))
-    if (r.has(key))
-      throw InputError(r.where(key), std::string(key) + " is a key of Model " +
-                                         (springs ? "anjyo" : "springs") +
-                                         ", and this Dynamics Info is Model " + name(d.model) +
-                                         "; remove it or change the Model");
+  for (const KeySpec& key : dynamicsKeys().spec.keys) {
+    if (key.models.empty() || !r.has(key.name) ||
+        std::find(key.models.begin(), key.models.end(), name(d.model)) != key.models.end())
+      continue;
+    std::string models;
+    for (const std::string& model : key.models) models += (models.empty() ? "" : " or ") + model;
+    throw InputError(r.where(key.name), key.name + " is a key of Model " + models +
+                                            ", and this Dynamics Info is Model " + name(d.model) +
+                                            "; remove it or change the Model");
+  }
   for (const char* key : {"DensitySpacings", "DensityRefine"})
     if (r.has(key) && !d.densityTarget.given())
       throw InputError(r.where(key),
@@ -870,6 +868,11 @@ void checkModelKeys(SectionReader& r, const Dynamics& d) {
                      "`DensityTarget FILE` (a hair cache)");
 }
 
+// A Dynamics key that only `model` reads.
+Key<Dynamics> only(DynamicsModel model, Key<Dynamics> key) {
+  return onlyFor<Dynamics>({name(model)}, std::move(key));
+}
+
 Section<Dynamics> makeDynamics() {
   using D = Dynamics;
   return makeSection<D>(
@@ -884,37 +887,45 @@ Section<Dynamics> makeDynamics() {
        realKey<D>({"Damping", "1/s", "the rate at which motion dies away (air, hair on hair)"}, &D::damping,
                   Range::closed(0.0, 1000.0)),
        windKey(), headKeyKey(), headCentreKey(),
-       autoRealKey(
-           {"Gravity", "N/kg", "the gravity the moving hair feels, along -y; auto = Hairstyle's Gravity"},
-           "N/kg", &D::gravityAuto, &D::gravity, Range::closed(0.0, 1000.0)),
-       inertiaKey(), pseudoForceKey(), fluctuationKey(), restFrequencyKey(),
-       autoRealKey({"StretchStiffness", "N",
-                    "springs: a segment's force per unit strain, E·A; auto = Young × π a b (effectively "
-                    "inextensible)"},
-                   "N", &D::stretchStiffnessAuto, &D::stretchStiffness, Range::positive()),
-       autoRealKey({"BendStiffness", "N·m²", "springs: E·I; auto = Young × π a b³/4"}, "N·m²",
-                   &D::bendStiffnessAuto, &D::bendStiffness, Range::nonNegative()),
-       autoRealKey(
-           {"TwistStiffness", "N·m²", "springs: μ·J; auto = Young/(2(1 + Poisson)) × π a b (a² + b²)/4"},
-           "N·m²", &D::twistStiffnessAuto, &D::twistStiffness, Range::nonNegative()),
-       realKey<D>({"VelocitySmoothing", "",
-                   "springs: the fraction of each particle's departure from the smoothed grid velocity "
-                   "removed per frame (Petrovic et al. §5.1)"},
-                  &D::velocitySmoothing, Range::closed(0.0, 1.0)),
-       realKey<D>({"SmoothingSpacing", "m", "springs: the velocity grid's spacing"}, &D::smoothingSpacing,
-                  {0.0, 10.0, true, false}),
-       pathKey<D>({"DensityTarget", "",
-                   "springs: a hair cache whose density the hair is pushed toward (Petrovic et al. §5.2)"},
-                  &D::densityTarget),
-       realKey<D>({"DensityStrength", "m/s²",
-                   "springs: the density force (Petrovic et al. §5.2) as a point's acceleration where the "
-                   "density differs from the target's by its mean from one node to the next; 0 = none"},
-                  &D::densityStrength, Range::closed(0.0, 1e9)),
-       densitySpacingsKey(),
-       realKey<D>({"DensityRefine", "",
-                   "springs: a density spacing hands over to the next finer one when its energy falls "
-                   "to this fraction of its start"},
-                  &D::densityRefine, {0.0, 1.0, true, false})},
+       only(DynamicsModel::kSprings,
+            autoRealKey({"Gravity", "N/kg",
+                         "the gravity the moving hair feels, along -y; auto = Hairstyle's Gravity"},
+                        "N/kg", &D::gravityAuto, &D::gravity, Range::closed(0.0, 1000.0))),
+       only(DynamicsModel::kAnjyo, inertiaKey()), only(DynamicsModel::kAnjyo, pseudoForceKey()),
+       only(DynamicsModel::kAnjyo, fluctuationKey()), only(DynamicsModel::kAnjyo, restFrequencyKey()),
+       only(DynamicsModel::kSprings,
+            autoRealKey({"StretchStiffness", "N",
+                         "a segment's force per unit strain, E·A; auto = Young × π a b (effectively "
+                         "inextensible)"},
+                        "N", &D::stretchStiffnessAuto, &D::stretchStiffness, Range::positive())),
+       only(DynamicsModel::kSprings,
+            autoRealKey({"BendStiffness", "N·m²", "E·I; auto = Young × π a b³/4"}, "N·m²",
+                        &D::bendStiffnessAuto, &D::bendStiffness, Range::nonNegative())),
+       only(DynamicsModel::kSprings,
+            autoRealKey({"TwistStiffness", "N·m²", "μ·J; auto = Young/(2(1 + Poisson)) × π a b (a² + b²)/4"},
+                        "N·m²", &D::twistStiffnessAuto, &D::twistStiffness, Range::nonNegative())),
+       only(DynamicsModel::kSprings,
+            realKey<D>({"VelocitySmoothing", "",
+                        "the fraction of each particle's departure from the smoothed grid velocity "
+                        "removed per frame (Petrovic et al. §5.1)"},
+                       &D::velocitySmoothing, Range::closed(0.0, 1.0))),
+       only(DynamicsModel::kSprings, realKey<D>({"SmoothingSpacing", "m", "the velocity grid's spacing"},
+                                                &D::smoothingSpacing, {0.0, 10.0, true, false})),
+       only(DynamicsModel::kSprings,
+            pathKey<D>({"DensityTarget", "",
+                        "a hair cache whose density the hair is pushed toward (Petrovic et al. §5.2)"},
+                       &D::densityTarget)),
+       only(DynamicsModel::kSprings,
+            realKey<D>({"DensityStrength", "m/s²",
+                        "the density force (Petrovic et al. §5.2) as a point's acceleration where the "
+                        "density differs from the target's by its mean from one node to the next; 0 = none"},
+                       &D::densityStrength, Range::closed(0.0, 1e9))),
+       only(DynamicsModel::kSprings, densitySpacingsKey()),
+       only(DynamicsModel::kSprings,
+            realKey<D>({"DensityRefine", "",
+                        "a density spacing hands over to the next finer one when its energy falls "
+                        "to this fraction of its start"},
+                       &D::densityRefine, {0.0, 1.0, true, false}))},
       checkModelKeys);
 }
 

@@ -208,6 +208,17 @@ Key<S> customKey(KeyText t, std::string value, std::string range,
   return {detail::spec(t, std::move(value), std::move(range)), std::move(read), std::move(write)};
 }
 
+// Marks a key that only some values of the section's Model read (Dynamics Info's anjyo or springs): its
+// help is prefixed with them ("anjyo: ...") and the section's check refuses it under any other Model.
+template <class S>
+Key<S> onlyFor(std::vector<std::string> models, Key<S> key) {
+  std::string prefix;
+  for (const std::string& model : models) prefix += (prefix.empty() ? "" : ", ") + model;
+  key.spec.help = prefix + ": " + key.spec.help;
+  key.spec.models = std::move(models);
+  return key;
+}
+
 // Marks a key: required (no default), or repeatable (any number of lines, in file order).
 template <class S>
 Key<S> required(Key<S> key) {
