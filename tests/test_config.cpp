@@ -143,8 +143,8 @@ TEST(ConfigErrors, UnknownKeyNamesLineAndSuggestsClosest) {
   EXPECT_NE(m.find("did you mean 'HairDensity'"), std::string::npos) << m;
 }
 
-// Every Dynamics key declared for some models (keys.cpp's `only`) is refused under each other model, at
-// its line, with the message naming both; the cases come from the declarations.
+// Every Dynamics key declared for some models (keys_dynamics.cpp's `only`) is refused under each other
+// model, at its line, with the message naming both; the cases come from the declarations.
 TEST(ConfigErrors, EveryModelKeyIsRefusedUnderAnotherModel) {
   int refused = 0;
   for (const KeySpec& key : dynamicsKeys().spec.keys) {

@@ -52,7 +52,7 @@ Section<S> makeSection(std::string name, std::string title, std::string file, st
   section.spec.name = std::move(name);
   section.spec.title = std::move(title);
   section.spec.file = std::move(file);
-  const S defaults{};
+  const S defaults = S();  // not `S defaults{}`: GCC 12 then sees a maybe-uninitialised string
   for (Key<S>& key : keys) {
     if (!key.spec.required) {
       std::string text;
