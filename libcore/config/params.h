@@ -212,7 +212,7 @@ struct Dynamics {
   double inertiaExponent = 1.0;
   double rootInertia = 1.0;
   int rootSegments = 0;
-  // §3.2.2, the pseudo-force field: near the head (within pseudoReach of the head ellipsoid) a force
+  // §3.2.2, the pseudo-force field: near the head (within pseudoReach of headShape) a force
   // pointing into it (D·F < α|D||F|) is scaled by ε.
   double pseudoAlpha = -0.75, pseudoEpsilon = 0.1, pseudoReach = 0.01;
   // §3.2.3: random turns of up to `fluctuation` radians, drawn once every fluctuationEvery frames.
