@@ -138,12 +138,7 @@ GrowResult growCantilever(const Mesh& wick, const Hairstyle& style, const Collis
   const size_t count = wick.vertexCount();
   const size_t first = options.shard ? options.shard->first : 0,
                end = options.shard ? options.shard->end : count;
-  const CollisionShape* head = nullptr;
-  for (const CollisionShape& s : collision.shapes)
-    if (s.kind == ShapeKind::kEllipsoid) {
-      head = &s;
-      break;
-    }
+  const CollisionShape* head = headShape(collision);  // a Sphere head is an ellipsoid of equal semi-axes
   std::vector<std::vector<glm::dvec3>> hairs(end - first);
   tbb::parallel_for(first, end, [&](size_t i) {
     std::vector<glm::dvec3>& hair = hairs[i - first];

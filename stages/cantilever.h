@@ -1,6 +1,6 @@
 // Anjyo et al. 1992 §2 and §3.2.3 as a second styling model for `hairgen grow` (Model cantilever):
 // each hair a chain of equal segments from its pore, bent node by node by the segment-constant
-// moments of a cantilever beam under gravity and force fields, kept out of the head ellipsoid, its
+// moments of a cantilever beam under gravity and force fields, kept out of the head (headShape), its
 // joint angles limited, and cut by pore position and height.
 #pragma once
 

@@ -194,11 +194,8 @@ void TriangleBlend::blend(const glm::dvec3& root, const glm::dvec3& tip, glm::ve
 }
 
 glm::dvec3 strayCentre(const Collision& collision) {
-  for (const CollisionShape& s : collision.shapes)  // a shape fitted to the head is the head
-    if (s.fitted) return s.centre;
-  for (const CollisionShape& s : collision.shapes)
-    if (s.kind == ShapeKind::kEllipsoid) return s.centre;
-  return glm::dvec3(0.0);
+  const CollisionShape* head = headShape(collision);
+  return head ? head->centre : glm::dvec3(0.0);
 }
 
 Strands interpolate(const Mesh& wick, const Strands& guides, const Hairstyle& style,

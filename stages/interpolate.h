@@ -88,7 +88,7 @@ class TriangleBlend {
   std::vector<double> lengths_;  // |t| of the strand's vertices, before renormalising
 };
 
-// The head centre the stray hairs scale about: the centre of the first Ellipsoid of Collision Info,
+// The head centre the stray hairs scale about: the centre of headShape(collision) (params.h),
 // or the origin (the thesis puts its origin at the head centre).
 glm::dvec3 strayCentre(const Collision& collision);
 

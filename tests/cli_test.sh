@@ -223,6 +223,18 @@ render_diff)
   # An EXR header's sizes are checked against the file before OpenEXR allocates what they declare.
   expect_rc 2 "$hairgen" diff "$src/tests/fuzz/corpus/fuzz_exr/string-attribute-declares-1.9GB.exr" "$tmp/a.exr"
   grep -q "not a readable OpenEXR file: .*Invalid size" "$tmp/err" || fail "bad EXR header: $(cat "$tmp/err")"
+  # HeadModel none (any case) draws no head: the image of HeadModel "" (no head), whose alpha differs from
+  # the image with the head; and check names no head.
+  expect_rc 0 "$hairgen" render "$src/configs/default/setup.txt" --hair "$tmp/g.hair" -o "$tmp/none.exr" "${small[@]}" \
+    --set Setup.HeadModel=NONE
+  expect_rc 0 "$hairgen" render "$src/configs/default/setup.txt" --hair "$tmp/g.hair" -o "$tmp/empty.exr" "${small[@]}" \
+    --set 'Setup.HeadModel=""'
+  expect_rc 0 "$hairgen" diff "$tmp/none.exr" "$tmp/empty.exr"
+  expect_rc 4 "$hairgen" diff "$tmp/a.exr" "$tmp/none.exr" --channels A
+  expect_rc 0 "$hairgen" check "$src/configs/default/setup.txt"
+  grep -q "^  head .*head.obj" "$tmp/out" || fail "check names no head with one: $(cat "$tmp/out")"
+  expect_rc 0 "$hairgen" check "$src/configs/default/setup.txt" --set Setup.HeadModel=none
+  ! grep -q "^  head " "$tmp/out" || fail "check names a head with HeadModel none: $(cat "$tmp/out")"
   ;;
 run_default)
   # With no Setup, run finds configs/default beside an installed executable, or through HAIRGEN_DATA.

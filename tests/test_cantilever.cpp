@@ -1,6 +1,7 @@
 // Anjyo's cantilever styling and per-strand ambient: properties the beam model and the configs promise.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 
 #include "libcore/config/setup.h"
@@ -88,6 +89,28 @@ TEST(Cantilever, SegmentsKeepTheirLengthAndNoNodeOfTheBobEntersTheHead) {
   }
   EXPECT_LT(worstLength, 1e-9);
   EXPECT_GE(innermost, 1.0 - 1e-9) << "a node lies inside the head ellipsoid";
+}
+
+// The cantilever turns hair out of headShape (params.h): behind a decoy Ellipsoid far away, the bob's head
+// fitted to the head mesh shapes the guides exactly as when it is alone.
+TEST(Cantilever, GrowTurnsHairOutOfTheHeadShape) {
+  const Bob& b = bob();
+  Hairstyle h = b.config.hairstyle;
+  h.cuts.clear();
+  Collision alone, decoyFirst;
+  alone.shapes = {*b.head()};
+  decoyFirst.shapes = {*b.head(), *b.head()};
+  decoyFirst.shapes[0].centre = glm::dvec3(1000.0, 0.0, 0.0);
+  decoyFirst.shapes[1].fitted = true;
+  const Strands expected = growCantilever(b.wick, h, alone, GrowOptions{}).guides;
+  Collision decoyAlone;
+  decoyAlone.shapes = {decoyFirst.shapes[0]};
+  const Strands unturned = growCantilever(b.wick, h, decoyAlone, GrowOptions{}).guides;
+  ASSERT_FALSE(std::equal(unturned.points.begin(), unturned.points.end(), expected.points.begin()))
+      << "the head must turn some hair for the test to mean anything";
+  const Strands got = growCantilever(b.wick, h, decoyFirst, GrowOptions{}).guides;
+  ASSERT_EQ(got.points.size(), expected.points.size());
+  EXPECT_TRUE(std::equal(got.points.begin(), got.points.end(), expected.points.begin()));
 }
 
 TEST(Cantilever, ACutRemovesExactlyTheSegmentsBelowItsHeightForItsPores) {

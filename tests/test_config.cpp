@@ -143,6 +143,32 @@ TEST(ConfigErrors, UnknownKeyNamesLineAndSuggestsClosest) {
   EXPECT_NE(m.find("did you mean 'HairDensity'"), std::string::npos) << m;
 }
 
+// Every Dynamics key declared for some models (keys_dynamics.cpp's `only`) is refused under each other
+// model, at its line, with the message naming both; the cases come from the declarations.
+TEST(ConfigErrors, EveryModelKeyIsRefusedUnderAnotherModel) {
+  int refused = 0;
+  for (const KeySpec& key : dynamicsKeys().spec.keys) {
+    if (key.models.empty()) continue;
+    ASSERT_EQ(key.models.size(), 1u) << key.name;  // the message below names one
+    EXPECT_EQ(key.help.rfind(key.models[0] + ": ", 0), 0u) << key.name << "'s help does not name its model";
+    for (DynamicsModel model : kDynamicsModels) {
+      const std::string other = name(model);
+      if (other == key.models[0]) continue;
+      // The key's default is a value it reads; DensityTarget's is none.
+      const std::string value = key.defaultText.empty() ? "target.hair" : key.defaultText;
+      const std::string m = inputError(
+          [&] { readDynamics(text("Model " + other + "\n" + key.name + " " + value + "\n", "d.txt"), {}); });
+      EXPECT_NE(m.find("d.txt:2"), std::string::npos) << m;
+      EXPECT_NE(m.find(key.name + " is a key of Model " + key.models[0] +
+                       ", and this Dynamics Info is Model " + other + "; remove it or change the Model"),
+                std::string::npos)
+          << m;
+      ++refused;
+    }
+  }
+  EXPECT_GE(refused, 2);
+}
+
 TEST(ConfigErrors, KeyOfAnotherSectionSaysWhereItBelongs) {
   std::string m = inputError([] { readHairstyle(text("HairLengths 0.1\nGlossiness 60\n", "h.txt"), {}); });
   EXPECT_NE(m.find("h.txt:2:"), std::string::npos) << m;
@@ -286,6 +312,17 @@ TEST(Overrides, MultiValueAndRepeatableKeys) {
   EXPECT_EQ(readHairstyle(text("HairLengths 0.1\n"), o).hairLengths, (std::vector<double>{0.02, 0.03}));
 }
 
+// HeadModel none (any case) is no head, as "" was; a file named `none` is then out of reach, as it should be.
+TEST(Overrides, HeadModelNoneMeansNoHead) {
+  const std::filesystem::path setup = thesis("coupe1/setup.txt");
+  ASSERT_TRUE(loadConfig(setup, {}, SetupUse::kCheck).setup.headModel.given());
+  for (const char* none : {"Setup.HeadModel=none", "Setup.HeadModel=NONE", "Setup.HeadModel=\"\""}) {
+    const Config c = loadConfig(setup, {parseOverride(none)}, SetupUse::kCheck);
+    EXPECT_FALSE(c.setup.headModel.given()) << none;
+    for (const auto& [key, digest] : c.inputContent) EXPECT_NE(key, "HeadModel") << none;
+  }
+}
+
 TEST(Overrides, BadOverridesAreInputErrors) {
   EXPECT_NE(inputError([] { parseOverride("HairDensity=3"); }).find("Section.Key=VALUE"), std::string::npos);
   EXPECT_NE(inputError([] { parseOverride("Hairstyl.HairDensity=3"); }).find("did you mean 'Hairstyle'"),
@@ -394,6 +431,26 @@ TEST(ConfigKeys, EveryDigestKeyIsInTheCanonicalText) {
       bool found = canonical.find(section->name + "." + key.name + " ") != std::string::npos;
       EXPECT_EQ(found, key.inDigest) << section->name << "." << key.name;
     }
+}
+
+// The one rule for which collision shape is the head (params.h, docs/configs.md#the-head-shape): a
+// shape fitted to the head, else the first Ellipsoid, else none; a Sphere by hand never.
+TEST(Config, TheHeadShapeIsTheFittedOneElseTheFirstEllipsoidElseNone) {
+  CollisionShape sphere, ellipsoid, fitted;
+  sphere.kind = ShapeKind::kSphere;
+  ellipsoid.kind = ShapeKind::kEllipsoid;
+  fitted.kind = ShapeKind::kEllipsoid;
+  fitted.fitted = true;
+  Collision c;
+  c.shapes = {sphere, ellipsoid, fitted};
+  EXPECT_EQ(headShape(c), &c.shapes[2]);
+  c.shapes[2].kind = ShapeKind::kSphere;  // `Sphere v k auto` is fitted to the head too
+  EXPECT_EQ(headShape(c), &c.shapes[2]);
+  c.shapes = {sphere, ellipsoid, ellipsoid};
+  EXPECT_EQ(headShape(c), &c.shapes[1]);
+  c.shapes = {sphere, sphere};
+  EXPECT_EQ(headShape(c), nullptr);
+  EXPECT_EQ(headShape(Collision{}), nullptr);
 }
 
 }  // namespace

@@ -85,9 +85,10 @@ TEST(AnjyoDynamics, ASingleSegmentSwingsWithTheCompoundPendulumsPeriodAndKeepsIt
 struct Fig11 {
   Strands hair;
   Collision head;
+  size_t headIndex = 0;  // which of head.shapes is the head
   int inside(const Dynamics& dynamics, bool collide, int frames) const {
     Collision shapes = head;
-    shapes.shapes[0].penalty = collide ? 1.0 : 0.0;  // without penalty a shape does not collide
+    shapes.shapes[headIndex].penalty = collide ? 1.0 : 0.0;  // without penalty a shape does not collide
     Hairstyle style;
     style.gravity = 0.0;
     AnjyoHair dynamicHair(hair, style, dynamics, shapes, 0);
@@ -96,7 +97,8 @@ struct Fig11 {
     int entered = 0;
     for (int n = 0; n < frames; ++n) {
       dynamicHair.step(push, 0.1, 2, false);
-      for (const glm::dvec3& p : dynamicHair.nodes()) entered += penetration(head.shapes[0], p) > 1e-6;
+      for (const glm::dvec3& p : dynamicHair.nodes())
+        entered += penetration(head.shapes[headIndex], p) > 1e-6;
     }
     return entered;
   }
@@ -144,6 +146,44 @@ TEST(AnjyoDynamics, ThePseudoForceFieldKeepsHairOutOfTheHead) {
   EXPECT_LE(pseudo * 10, free) << pseudo << " nodes entered with the pseudo-force, " << free << " without";
   EXPECT_EQ(f.inside(with, true, 30), 0) << "with hairgen's collision handling on top";
   EXPECT_EQ(f.inside(without, true, 30), 0);
+}
+
+// The pseudo-force acts near headShape (params.h): behind a decoy Ellipsoid far away, the head fitted to the
+// head mesh keeps the hair out exactly as when it is alone.
+TEST(AnjyoDynamics, ThePseudoForceActsNearTheHeadShape) {
+  Fig11 f = fig11();
+  Dynamics with = paperUnits();
+  with.pseudoAlpha = -0.75;
+  with.pseudoEpsilon = 0.1;
+  with.pseudoReach = 2.0;
+  const int alone = f.inside(with, false, 5);
+  CollisionShape decoy = f.head.shapes[0];
+  decoy.centre = glm::dvec3(1000.0, 0.0, 0.0);
+  decoy.penalty = 0.0;
+  f.head.shapes[0].fitted = true;
+  f.head.shapes.insert(f.head.shapes.begin(), decoy);
+  f.headIndex = 1;
+  ASSERT_EQ(headShape(f.head), &f.head.shapes[1]);
+  EXPECT_EQ(f.inside(with, false, 5), alone);
+}
+
+// HeadCentre auto is headShape's centre: the head turns about the fitted shape, which stays put.
+TEST(Simulate, TheHeadTurnsAboutTheHeadShape) {
+  Collision c;
+  c.shapes.resize(2);
+  c.shapes[0].kind = c.shapes[1].kind = ShapeKind::kEllipsoid;
+  c.shapes[0].centre = glm::dvec3(0.3, 0.0, 0.0);
+  c.shapes[1].centre = glm::dvec3(0.0, 0.07, 0.01);
+  c.shapes[1].fitted = true;
+  Dynamics d;
+  const glm::dvec3 centre = headCentre(d, c);
+  EXPECT_EQ(centre, c.shapes[1].centre);
+  HeadKey turn;
+  turn.frame = 10.0;
+  turn.rotation = glm::dvec3(20.0, 90.0, 0.0);
+  const Pose pose = HeadMotion({HeadKey{}, turn}, centre, 24.0).pose(10.0);
+  EXPECT_LT(glm::length(pose.apply(c.shapes[1].centre) - c.shapes[1].centre), 1e-12);
+  EXPECT_GT(glm::length(pose.apply(c.shapes[0].centre) - c.shapes[0].centre), 0.1);
 }
 
 // The step's own sin and cos (lane_trig.h): the library's to within a float's ulp over many turns, and

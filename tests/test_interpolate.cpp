@@ -268,5 +268,16 @@ TEST(Interpolate, GuidesThatDoNotFitTheWickAreAnInputError) {
   }
 }
 
+TEST(Interpolate, StrayHairsScaleAboutTheHeadShape) {
+  Collision c;
+  c.shapes.resize(3);
+  c.shapes[0].kind = ShapeKind::kSphere;
+  c.shapes[1].kind = c.shapes[2].kind = ShapeKind::kEllipsoid;
+  c.shapes[2].fitted = true;
+  for (size_t i = 0; i < 3; ++i) c.shapes[i].centre = glm::dvec3(double(i + 1), 0.0, 0.0);
+  EXPECT_EQ(strayCentre(c), headShape(c)->centre);
+  EXPECT_EQ(strayCentre(Collision{}), glm::dvec3(0.0));
+}
+
 }  // namespace
 }  // namespace hairgen

@@ -48,6 +48,14 @@ const char* name(ShapeKind kind) {
   return "Sphere";
 }
 
+const CollisionShape* headShape(const Collision& collision) {
+  for (const CollisionShape& s : collision.shapes)
+    if (s.fitted) return &s;
+  for (const CollisionShape& s : collision.shapes)
+    if (s.kind == ShapeKind::kEllipsoid) return &s;
+  return nullptr;
+}
+
 bool ForceField::contains(const glm::dvec3& p) const {
   switch (region) {
     case Region::kAll:

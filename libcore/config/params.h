@@ -118,6 +118,14 @@ struct Collision {
   std::vector<CollisionShape> shapes;
 };
 
+// Which collision shape is the head, the one answer for everything that asks: the cantilever's collision
+// avoidance, the centre stray hairs scale about, HeadCentre auto and Anjyo's pseudo-force. The first shape
+// fitted to the head (`Ellipsoid v k auto` or `Sphere v k auto`): it is the head by construction. Else the
+// first Ellipsoid: the thesis' cranium, as in every bundled config. Else none (null): a Sphere given by
+// hand is never the head, since in the thesis and the bundled configs a Sphere is a second body (the face
+// in front of the cranium), and a Cuboid is a prop.
+const CollisionShape* headShape(const Collision& collision);
+
 // Visuality Info: the hair's reflectance, for every shading model.
 struct Visuality {
   glm::dvec3 ambientColor{0.10, 0.10, 0.10};
@@ -196,7 +204,7 @@ struct Dynamics {
   double damping = 1.0;                // 1/s: the rate at which motion dies away (air, hair on hair)
   std::vector<WindKey> wind;
   std::vector<HeadKey> headKeys;
-  bool headCentreAuto = true;  // the first Ellipsoid's centre of Collision Info (else the origin)
+  bool headCentreAuto = true;  // the centre of headShape(Collision Info) (else the origin)
   glm::dvec3 headCentre{0.0};  // metres, when not auto
   // Anjyo et al. 1992 §3.2: the inertia of segment i of k is (k/i)^inertiaExponent times that of the
   // segment's mass at the hair's length, and rootInertia times that again for i <= rootSegments (the
@@ -204,7 +212,7 @@ struct Dynamics {
   double inertiaExponent = 1.0;
   double rootInertia = 1.0;
   int rootSegments = 0;
-  // §3.2.2, the pseudo-force field: near the head (within pseudoReach of the head ellipsoid) a force
+  // §3.2.2, the pseudo-force field: near the head (within pseudoReach of headShape) a force
   // pointing into it (D·F < α|D||F|) is scaled by ε.
   double pseudoAlpha = -0.75, pseudoEpsilon = 0.1, pseudoReach = 0.01;
   // §3.2.3: random turns of up to `fluctuation` radians, drawn once every fluctuationEvery frames.

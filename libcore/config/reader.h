@@ -48,6 +48,9 @@ struct KeySpec {
   bool repeatable = false;           // any number of lines, kept in file order
   bool required = false;
   bool inDigest = true;  // the value shapes the output (paths and flags of the job do not)
+  // The values of the section's Model that alone read the key (Dynamics Info: anjyo, springs); empty when
+  // every model does. Its help starts with them, and the section's check refuses it under another.
+  std::vector<std::string> models;
 
   // For messages: the value's shape, range and unit, then an example.
   std::string hint() const;

@@ -52,7 +52,7 @@ Section<S> makeSection(std::string name, std::string title, std::string file, st
   section.spec.name = std::move(name);
   section.spec.title = std::move(title);
   section.spec.file = std::move(file);
-  const S defaults{};
+  const S defaults = S();  // not `S defaults{}`: GCC 12 then sees a maybe-uninitialised string
   for (Key<S>& key : keys) {
     if (!key.spec.required) {
       std::string text;
@@ -206,6 +206,17 @@ Key<S> customKey(KeyText t, std::string value, std::string range,
                  std::function<void(SectionReader&, S&)> read,
                  std::function<std::vector<std::string>(const S&)> write) {
   return {detail::spec(t, std::move(value), std::move(range)), std::move(read), std::move(write)};
+}
+
+// Marks a key that only some values of the section's Model read (Dynamics Info's anjyo or springs): its
+// help is prefixed with them ("anjyo: ...") and the section's check refuses it under any other Model.
+template <class S>
+Key<S> onlyFor(std::vector<std::string> models, Key<S> key) {
+  std::string prefix;
+  for (const std::string& model : models) prefix += (prefix.empty() ? "" : ", ") + model;
+  key.spec.help = prefix + ": " + key.spec.help;
+  key.spec.models = std::move(models);
+  return key;
 }
 
 // Marks a key: required (no default), or repeatable (any number of lines, in file order).

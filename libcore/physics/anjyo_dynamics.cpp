@@ -74,8 +74,7 @@ AnjyoHair::AnjyoHair(const Strands& rest, const Hairstyle& style, const Dynamics
     origin_ = glm::floor(0.5 * (lo + hi) * 1024.0) / 1024.0;  // a round number: exact offsets
   }
   const std::vector<CollisionShape>& shapes = collision.shapes;
-  for (size_t c = 0; c < shapes.size() && head_ < 0; ++c)
-    if (shapes[c].kind == ShapeKind::kEllipsoid) head_ = int(c);
+  if (const CollisionShape* head = headShape(collision)) head_ = int(head - shapes.data());
   for (const CollisionShape& c : shapes) {
     LaneShape s;
     s.kind = c.kind;

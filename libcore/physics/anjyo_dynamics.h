@@ -25,8 +25,8 @@
 //   gravity), and an angular spring at RestFrequency pulls each segment toward its rest direction. Still
 //   hair (a still head, no wind) therefore stays exactly at rest, a wind or a turn of the head moves it,
 //   and a nod moves it as gravity turns in the head's frame.
-// - The pseudo-force field (§3.2.2) scales the departure force, not gravity: near the head ellipsoid, a
-//   departure pointing into it (D·F < α|D||F|, D the ellipsoid's gradient) is multiplied by ε.
+// - The pseudo-force field (§3.2.2) scales the departure force, not gravity: near the head (headShape), a
+//   departure pointing into it (D·F < α|D||F|, D the head's gradient) is multiplied by ε.
 // - Joint limits and collisions are measured against the rest shape: a node may turn as much as it did at
 //   rest, and sink as deep into a shape as it sat at rest, so the styled shape is always allowed.
 // - Precision: everything is floats, the precision the caches store, sixteen strands at a time
@@ -215,7 +215,7 @@ class AnjyoHair {
   std::vector<double> state_;           // kStateValues per segment (the restart layout): all 0 at rest
   std::vector<float, UninitialisedAllocator<float>> trig_;  // kTrigValues per segment: of state_'s angles
   glm::dvec3 origin_{0.0};                                  // the centre of the rest hair's bounds
-  int head_ = -1;  // the first ellipsoid (the pseudo-force head), an index into shapes
+  int head_ = -1;  // headShape (the pseudo-force head), an index into shapes; -1 for none
   glm::dvec3 restAcceleration_;
   double damping_ = 0.0;
   double pseudoAlpha_, pseudoEpsilon_;

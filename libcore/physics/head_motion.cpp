@@ -144,9 +144,8 @@ glm::dvec3 windAt(const std::vector<WindKey>& keys, double frame) {
 
 glm::dvec3 headCentre(const Dynamics& dynamics, const Collision& collision) {
   if (!dynamics.headCentreAuto) return dynamics.headCentre;
-  for (const CollisionShape& s : collision.shapes)
-    if (s.kind == ShapeKind::kEllipsoid) return s.centre;
-  return glm::dvec3(0.0);
+  const CollisionShape* head = headShape(collision);
+  return head ? head->centre : glm::dvec3(0.0);
 }
 
 }  // namespace hairgen

@@ -81,7 +81,7 @@ glm::dmat3 eulerRotation(const glm::dvec3& degrees);
 // The wind's acceleration at `frame` (m/s²): zero before the first key.
 glm::dvec3 windAt(const std::vector<WindKey>& keys, double frame);
 
-// The head's centre for dynamics: HeadCentre, or the first Ellipsoid's centre, or the origin.
+// The head's centre for dynamics: HeadCentre, or the centre of headShape(collision), or the origin.
 glm::dvec3 headCentre(const Dynamics& dynamics, const Collision& collision);
 
 }  // namespace hairgen
