@@ -139,12 +139,13 @@ void registerRun(CLI::App& app, int& exitCode) {
     bool noRender = false, motion = false;
   };
   auto options = std::make_shared<Options>();
-  CLI::App* cmd = app.add_subcommand("run",
-                                     "Run the stages in one process: grow and interpolate (or Load a saved "
-                                     "coupe), shade when the Setup asks, "
-                                     "then render; writes DIR/guides.hair, DIR/coupe.hair, DIR/shaded.hair, "
-                                     "DIR/beauty.exr and DIR/beauty.png, "
-                                     "each equal to what the stage run alone writes");
+  CLI::App* cmd = app.add_subcommand(
+      "run",
+      "Run the stages in one process: grow and interpolate (or Load a saved coupe), shade when the Setup "
+      "asks, then render. A still writes DIR/guides.hair, DIR/coupe.hair, DIR/shaded.hair (only when the "
+      "Setup shades), DIR/beauty.exr and DIR/beauty.png; a shot (the Setup names a Dynamics Info) also "
+      "simulates the guides into DIR/sim/guides.####.hair and renders DIR/beauty.####.exr and .png and the "
+      "movie DIR/beauty.mp4 and .gif. Each file equals what the stage run alone writes");
   cmd->add_option("SETUP", options->setup, "The Setup file (default: the bundled configs/default/setup.txt)");
   cmd->add_option("-o,--output", options->outDir,
                   "Output folder (default: out/NAME, NAME the Setup's folder)")
@@ -154,7 +155,6 @@ void registerRun(CLI::App& app, int& exitCode) {
                 "On a shot, motion vectors in every frame's EXR (the layer motion.u, motion.v, pixels "
                 "moved since the frame before)");
   addCommonFlags(*cmd, options->common, true);
-  cmd->footer(exitCodeHelp());
   cmd->callback([options, &exitCode] {
     exitCode = runCommand("run", options->common, [&] {
       Stats stats("run");

@@ -10,14 +10,47 @@ help)
   for cmd in grow info convert check assets; do
     grep -q "^  $cmd" "$tmp/out" || fail "--help does not list $cmd"
   done
+  for word in simulate farm; do grep -q "$word" "$tmp/out" || fail "--help's description omits $word"; done
   for cmd in grow info convert check assets; do
     expect_rc 0 "$hairgen" "$cmd" --help
     for flag in --threads --quiet --stats; do grep -q -- "$flag" "$tmp/out" || fail "$cmd --help lacks $flag"; done
-    grep -q "Exit codes" "$tmp/out" || fail "$cmd --help lists no exit codes"
   done
   for flag in --set --seed; do
     "$hairgen" check --help | grep -q -- "$flag" || fail "check --help lacks $flag"
   done
+  # Every command and subcommand: human labels (N, FILE, A-B), not CLI11's types and validators; the
+  # exit-code table once, in hairgen --help, and a pointer to it in each command's.
+  commands=$("$hairgen" --help | sed -n '/^Subcommands:/,/^$/s/^  \([a-z]*\) .*/\1/p')
+  [ "$(echo "$commands" | wc -w)" -ge 14 ] || fail "the command list was not read: $commands"
+  for cmd in $commands "farm plan" "farm submit"; do
+    # shellcheck disable=SC2086 # "farm plan" is two words
+    expect_rc 0 "$hairgen" $cmd --help
+    grep -E "^ +-.* (TEXT|INT|UINT|FLOAT)\b|^ +[A-Z]+ (TEXT|INT|FLOAT)|[A-Z]:[A-Z(]|AND \(|in \[" "$tmp/out" &&
+      fail "$cmd --help shows a parser's type label"
+    grep -q "^Exit codes: see hairgen --help" "$tmp/out" || fail "$cmd --help does not point at the exit codes"
+    [ "$(grep -c '^  [0-9]  ' "$tmp/out")" -eq 0 ] || fail "$cmd --help repeats the exit-code table"
+  done
+  # Required positionals show as required; the descriptions say what the commands do.
+  expect_rc 0 "$hairgen" render --help
+  grep -q "Usage: hairgen render \[OPTIONS\] SETUP$" "$tmp/out" && grep -q "^  SETUP  *REQUIRED" "$tmp/out" ||
+    fail "render --help does not show SETUP as required"
+  for model in kajiya-kay thesis anjyo volumetric; do
+    grep -q "$model" "$tmp/out" || fail "render --help does not name the shading model $model"
+  done
+  for flag in --frames --guides; do grep -q -- "$flag" "$tmp/out" || fail "render --help omits $flag"; done
+  for cmd in check "farm plan" grow simulate; do
+    # shellcheck disable=SC2086
+    "$hairgen" $cmd --help | grep -q "^  SETUP  *REQUIRED" || fail "$cmd --help does not show SETUP as required"
+  done
+  expect_rc 0 "$hairgen" run --help
+  grep -q "shaded.hair (only when the Setup shades)" "$tmp/out" || fail "run --help says shaded.hair is always written"
+  grep -q "sim/guides.####.hair" "$tmp/out" && grep -q "beauty.mp4" "$tmp/out" ||
+    fail "run --help does not say what a shot writes"
+  # The flags that need no SETUP still work without one.
+  expect_rc 0 "$hairgen" check --keys
+  grep -q '^| `HairDensity` |' "$tmp/out" || fail "check --keys printed no keys"
+  expect_rc 2 "$hairgen" check
+  grep -q "SETUP is required" "$tmp/err" || fail "check without SETUP: $(cat "$tmp/err")"
   ;;
 usage)
   expect_rc 2 "$hairgen"
