@@ -619,6 +619,37 @@ shot_run_equals_stages)
   ffprobe -v error -count_frames -select_streams v:0 -show_entries stream=nb_read_frames -of csv=p=0 \
     "$tmp/run/beauty.mp4" | grep -qx 4 || fail "the movie does not hold the shot's 4 frames"
   ;;
+run_frames)
+  # run --frames A-B on a shot writes exactly those frames, each equal byte for byte to the same frame
+  # of the whole shot (simulated from its first frame; motion vectors from the frame before A).
+  setup="$src/configs/anjyo/gust/setup.txt"
+  small=(--quiet --set Hairstyle.HairDensity=5 --set "Dynamics.Frames=1 5" --set "Render.Resolution=40 40")
+  expect_rc 0 "$hairgen" run "$setup" -o "$tmp/all" "${small[@]}"
+  expect_rc 0 "$hairgen" run "$setup" -o "$tmp/part" --frames 1-3 "${small[@]}"
+  [ "$(cd "$tmp/part" && echo sim/guides.*.hair beauty.*.exr)" = \
+    "sim/guides.0001.hair sim/guides.0002.hair sim/guides.0003.hair beauty.0001.exr beauty.0002.exr beauty.0003.exr" ] ||
+    fail "run --frames 1-3 wrote other frames: $(ls "$tmp/part" "$tmp/part/sim")"
+  for f in 0001 0002 0003; do
+    cmp "$tmp/all/sim/guides.$f.hair" "$tmp/part/sim/guides.$f.hair" || fail "run --frames: simulated frame $f differs"
+    cmp "$tmp/all/beauty.$f.exr" "$tmp/part/beauty.$f.exr" || fail "run --frames: frame $f differs"
+  done
+  ffprobe -v error -count_frames -select_streams v:0 -show_entries stream=nb_read_frames -of csv=p=0 \
+    "$tmp/part/beauty.mp4" | grep -qx 3 || fail "the movie of run --frames 1-3 does not hold 3 frames"
+  # A range after the shot's first frame, with motion vectors.
+  expect_rc 0 "$hairgen" run "$setup" -o "$tmp/allm" --motion "${small[@]}"
+  expect_rc 0 "$hairgen" run "$setup" -o "$tmp/partm" --motion --frames 3-4 "${small[@]}"
+  [ ! -e "$tmp/partm/beauty.0002.exr" ] && [ ! -e "$tmp/partm/sim/guides.0002.hair" ] &&
+    [ ! -e "$tmp/partm/beauty.0005.exr" ] || fail "run --frames 3-4 wrote frames outside 3-4"
+  for f in 0003 0004; do
+    cmp "$tmp/allm/sim/guides.$f.hair" "$tmp/partm/sim/guides.$f.hair" || fail "run --frames 3-4: simulated frame $f differs"
+    cmp "$tmp/allm/beauty.$f.exr" "$tmp/partm/beauty.$f.exr" || fail "run --frames 3-4 --motion: frame $f differs"
+  done
+  expect_rc 2 "$hairgen" run "$src/configs/default/setup.txt" -o "$tmp/still" --frames 1-3 --quiet
+  expect_err "names no Dynamics Info; a still has no frames"
+  [ ! -e "$tmp/still" ] || fail "run --frames on a still made its output folder"
+  expect_rc 2 "$hairgen" run "$setup" -o "$tmp/out6" --frames 4-9 "${small[@]}"
+  expect_err "the shot's frames are 1-5"
+  ;;
 shot_headturn)
   # The bundled head turn, small: the shot runs end to end, the head has turned by its last frame (the
   # pictures differ) and the hair settles once the head stops.
