@@ -59,15 +59,22 @@ void registerCheck(CLI::App& app, int& exitCode) {
         note(options->common, "warning: " + why);
       }
       if (scene.wick && !config.setup.load) {
-        nlohmann::ordered_json work = nlohmann::ordered_json::array();
-        for (const WorkEstimate& e :
-             estimateRun(config, *scene.wick, wantsShade(config.visuality, config.render), true,
-                         size_t(tbb::this_task_arena::max_concurrency()))) {
+        // What run would refuse, refused here; the time of every stage of run, a shot's frames included.
+        const bool shade = wantsShade(config.visuality, config.render);
+        const size_t threads = size_t(tbb::this_task_arena::max_concurrency());
+        for (const WorkEstimate& e : estimateRun(config, *scene.wick, shade, true, threads))
           requireFits(e, options->common.force);
+        nlohmann::ordered_json work = nlohmann::ordered_json::array();
+        double seconds = 0.0;
+        for (const WorkEstimate& e : estimateShot(config, *scene.wick, shade, true, threads)) {
           work.push_back(
               {{"stage", e.stage}, {"bytes", e.bytes}, {"seconds", e.seconds}, {"detail", e.detail}});
+          if (e.frames > 0) work.back()["frames"] = e.frames;
+          seconds += e.seconds;
         }
         report["work"] = work;
+        report["workSeconds"] = seconds;
+        report["workThreads"] = threads;
       }
       stats.json()["report"] = report;
       if (options->canonical) {
