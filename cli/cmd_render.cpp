@@ -228,20 +228,9 @@ void registerRender(CLI::App& app, int& exitCode) {
       const UnitConversion conversion = unitConversion(options->units);
       renderOptions.zUp = conversion.upAxis == UpAxis::kZ;
       renderOptions.scale = conversion.metresPerUnit.value_or(options->scale);
-      // The head of a foreign hair file is usually in the file's units and axis too: it moves with the
-      // hair unless the Setup says how to read it (MeshUnits, MeshUpAxis).
-      const Setup& s = config.setup;
-      if (head && !s.meshConversion.metresPerUnit && !s.meshConversion.upAxis &&
-          (renderOptions.zUp || renderOptions.scale != 1.0)) {
-        UnitConversion headConversion;
-        if (renderOptions.scale != 1.0) headConversion.metresPerUnit = renderOptions.scale;
-        if (renderOptions.zUp) headConversion.upAxis = UpAxis::kZ;
-        for (glm::vec3& p : head->positions) p = headConversion.position(p);
-        for (glm::vec3& n : head->normals) n = headConversion.direction(n);
-        note(options->common, "render: the head " + s.headModel.path.filename().string() +
-                                  " is read in the hair's units and axis too; to read it as it is, set "
-                                  "Setup.MeshUnits (and MeshUpAxis) for it");
-      }
+      // --units, --up-axis and --scale describe the hair file alone: the head is read as the Setup says
+      // (MeshUnits, MeshUpAxis), so foreign hair sits on the bundled head; a head in the hair's units
+      // is asked for with --set Setup.MeshUnits=U (docs/real-heads.md).
       renderOptions.keepDom = !options->dom.empty();
       // One context for every frame, opened once the first frame's hair has been read: bad input is
       // exit 2 on a machine without a device too, not 3.
