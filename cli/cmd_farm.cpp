@@ -620,8 +620,7 @@ void registerFarm(CLI::App& app, int& exitCode) {
         o.common.sets.push_back("Dynamics.Frames=" + std::to_string(f.first) + " " + std::to_string(f.last));
       }
       Config config = loadStageConfig(o.setup, o.common, SetupUse::kRun, stats);
-      if (!o.frames.empty() && !config.dynamics.given)
-        throw InputError("--frames: " + o.setup + " names no Dynamics Info; a still has no frames");
+      if (!o.frames.empty()) requireShotForFrames(config, o.setup);
       Mesh wick = readWick(config);  // as the stages read it: MeshUnits, MeshUpAxis, WickGroup, roots alone
       FarmPlanOptions options;
       options.hairgen = executablePath();

@@ -143,6 +143,18 @@ void runShot(const CommonOptions& common, const Config& config, const Mesh& wick
   stats.add("movie", clock.lap());
 }
 
+// run --frames A-B (none: Dynamics Frames, on a still too), within the shot's frames.
+FrameRange shotFrames(const Config& config, const std::string& text, const std::string& setup) {
+  const Dynamics& d = config.dynamics;
+  if (text.empty()) return {d.firstFrame, d.lastFrame};
+  requireShotForFrames(config, setup);
+  const FrameRange frames = parseFrameRange(text, "--frames");
+  if (frames.first < d.firstFrame || frames.last > d.lastFrame)
+    throw InputError("--frames " + text + ": the shot's frames are " + std::to_string(d.firstFrame) + "-" +
+                     std::to_string(d.lastFrame) + " (Dynamics Frames)");
+  return frames;
+}
+
 }  // namespace
 
 void registerRun(CLI::App& app, int& exitCode) {
@@ -181,15 +193,7 @@ void registerRun(CLI::App& app, int& exitCode) {
       Stopwatch clock;
       Config config = loadStageConfig(setup, options->common, SetupUse::kRun, stats);
       stats.time("read", clock.lap());
-      const Dynamics& d = config.dynamics;
-      const FrameRange frames = options->frames.empty() ? FrameRange{d.firstFrame, d.lastFrame}
-                                                        : parseFrameRange(options->frames, "--frames");
-      if (!options->frames.empty() && !d.given)
-        throw InputError("--frames: " + setup.string() + " names no Dynamics Info; a still has no frames");
-      if (frames.first < d.firstFrame || frames.last > d.lastFrame)
-        throw InputError("--frames " + options->frames + ": the shot's frames are " +
-                         std::to_string(d.firstFrame) + "-" + std::to_string(d.lastFrame) +
-                         " (Dynamics Frames)");
+      const FrameRange frames = shotFrames(config, options->frames, setup.string());
       if (options->motion && (!config.dynamics.given || options->noRender))
         throw InputError(setup.string() + ": --motion renders motion vectors of a shot, and " +
                          (options->noRender ? "--no-render renders nothing"

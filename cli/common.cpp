@@ -270,6 +270,11 @@ void addStandaloneFlag(CLI::App& command, const std::string& name, const std::st
       name, [action = std::move(action)] { throw CLI::RuntimeError(action()); }, help);
 }
 
+void requireShotForFrames(const Config& config, const std::string& setup) {
+  if (!config.dynamics.given)
+    throw InputError("--frames: " + setup + " names no Dynamics Info; a still has no frames");
+}
+
 std::optional<ShardSpec> shardOption(const std::string& shard, const std::string& output, HairFormat format) {
   if (shard.empty()) return std::nullopt;
   const ShardSpec spec = parseShardSpec(shard, "--shard");

@@ -130,6 +130,9 @@ void pointAtExitCodes(CLI::App& app);
 void addStandaloneFlag(CLI::App& command, const std::string& name, const std::string& help,
                        std::function<int()> action);
 
+// --frames A-B of run and farm plan on a still: an InputError, as a still has no frames.
+void requireShotForFrames(const Config& config, const std::string& setup);
+
 // --shard K/N of grow and interpolate: none when not given; a shard is written as .hair (its provenance
 // carries the range), so another output format is an InputError.
 std::optional<ShardSpec> shardOption(const std::string& shard, const std::string& output, HairFormat format);
