@@ -15,9 +15,10 @@ void registerAssets(CLI::App& app, int& exitCode) {
       "assets",
       "Generate the bundled head.obj and wick.obj (fitted to the thesis' head ellipsoid) and assets.txt, "
       "the generator's parameters");
-  cmd->add_option("-o,--output", options->outputDir, "Directory to write into")->capture_default_str();
+  cmd->add_option("-o,--output", options->outputDir, "Directory to write into")
+      ->type_name("DIR")
+      ->capture_default_str();
   addCommonFlags(*cmd, options->common, false);
-  cmd->footer(exitCodeHelp());
   cmd->callback([options, &exitCode] {
     exitCode = runCommand("assets", options->common, [&] {
       Stats stats("assets");

@@ -20,27 +20,23 @@ void registerCheck(CLI::App& app, int& exitCode) {
     std::string setup;
     bool json = false;
     bool canonical = false;
-    bool keys = false;
   };
   auto options = std::make_shared<Options>();
   CLI::App* cmd = app.add_subcommand(
       "check",
       "Validate a Setup and every file it names (configs, meshes); print the effective values and digest");
-  cmd->add_option("SETUP", options->setup, "The Setup file");
-  cmd->add_flag("--keys", options->keys,
-                "Print the reference of every config key (Markdown, as docs/config-keys.md) and exit");
+  cmd->add_option("SETUP", options->setup, "The Setup file")->required();
   cmd->add_flag("--json", options->json, "Print the report as JSON");
   cmd->add_flag("--canonical", options->canonical,
                 "Print every effective value, one `Section.Key value` a line");
   addCommonFlags(*cmd, options->common, true);
-  cmd->footer(exitCodeHelp());
+  addStandaloneFlag(
+      *cmd, "--keys",
+      "Print the reference of every config key (Markdown, as docs/config-keys.md) and exit (no "
+      "SETUP needed)",
+      [options] { return runCommand("check", options->common, [] { std::cout << keyReference(); }); });
   cmd->callback([options, &exitCode] {
     exitCode = runCommand("check", options->common, [&] {
-      if (options->keys) {
-        std::cout << keyReference();
-        return;
-      }
-      if (options->setup.empty()) throw InputError("check needs a SETUP (or --keys)");
       Stats stats("check");
       // As every stage's --stats: the overrides, the config's digest and its seed at the top.
       Config config = loadStageConfig(options->setup, options->common, SetupUse::kCheck, stats);
@@ -63,15 +59,22 @@ void registerCheck(CLI::App& app, int& exitCode) {
         note(options->common, "warning: " + why);
       }
       if (scene.wick && !config.setup.load) {
-        nlohmann::ordered_json work = nlohmann::ordered_json::array();
-        for (const WorkEstimate& e :
-             estimateRun(config, *scene.wick, wantsShade(config.visuality, config.render), true,
-                         size_t(tbb::this_task_arena::max_concurrency()))) {
+        // What run would refuse, refused here; the time of every stage of run, a shot's frames included.
+        const bool shade = wantsShade(config.visuality, config.render);
+        const size_t threads = size_t(tbb::this_task_arena::max_concurrency());
+        for (const WorkEstimate& e : estimateRun(config, *scene.wick, shade, true, threads))
           requireFits(e, options->common.force);
+        nlohmann::ordered_json work = nlohmann::ordered_json::array();
+        double seconds = 0.0;
+        for (const WorkEstimate& e : estimateShot(config, *scene.wick, shade, true, threads)) {
           work.push_back(
               {{"stage", e.stage}, {"bytes", e.bytes}, {"seconds", e.seconds}, {"detail", e.detail}});
+          if (e.frames > 0) work.back()["frames"] = e.frames;
+          seconds += e.seconds;
         }
         report["work"] = work;
+        report["workSeconds"] = seconds;
+        report["workThreads"] = threads;
       }
       stats.json()["report"] = report;
       if (options->canonical) {

@@ -25,7 +25,6 @@ void registerConvert(CLI::App& app, int& exitCode) {
   addUnitFlags(*cmd, options->units, "IN");
   cmd->add_flag("--ascii", options->ascii, "Write a .ply as ASCII text instead of binary little-endian");
   addCommonFlags(*cmd, options->common, false);
-  cmd->footer(exitCodeHelp());
   cmd->callback([options, &exitCode] {
     exitCode = runCommand("convert", options->common, [&] {
       Stats stats("convert");

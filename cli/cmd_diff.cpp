@@ -46,25 +46,28 @@ void registerDiff(CLI::App& app, int& exitCode) {
   cmd->add_option("A", options->a, "The reference image (any format OpenImageIO reads)")->required();
   cmd->add_option("B", options->b, "The image to check")->required();
   cmd->add_option("--fail", options->thresholds.fail,
-                  "A pixel fails when a channel differs by more than this")
+                  "A pixel fails when a channel differs by more than this (>= 0)")
+      ->type_name("X")
       ->capture_default_str()
       ->check(kFiniteNonNegative);
   cmd->add_option("--failpercent", options->thresholds.failPercent,
-                  "The images fail when more than this percent of pixels fail")
+                  "The images fail when more than this percent of pixels fail (0 to 100)")
+      ->type_name("PERCENT")
       ->capture_default_str()
       ->check(kFiniteNonNegative & CLI::Range(0.0, 100.0));
   cmd->add_option("--hardfail", options->thresholds.hardFail,
-                  "The images fail when any channel anywhere differs by more than this")
+                  "The images fail when any channel anywhere differs by more than this (>= 0)")
+      ->type_name("X")
       ->capture_default_str()
       ->check(kFiniteNonNegative);
   cmd->add_option("--channels", options->channels, "Compare only these channels (default: all of A's)")
+      ->type_name("NAME")
       ->delimiter(',');
   cmd->add_option("--out", options->out, "Write |A - B| per channel")->type_name("DIFF.exr");
   cmd->add_option("--sheet", options->sheet,
                   "Write A, B and 10 x |A - B| side by side as one sRGB picture, to look at")
       ->type_name("FILE.png");
   addCommonFlags(*cmd, options->common, false);
-  cmd->footer(exitCodeHelp());
   cmd->callback([options, &exitCode] {
     ExitCode verdict = ExitCode::kSuccess;
     exitCode = runCommand("diff", options->common, [&] {

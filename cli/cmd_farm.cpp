@@ -577,7 +577,6 @@ void registerFarm(CLI::App& app, int& exitCode) {
       "The work of `hairgen run` as tasks for a render farm: `farm plan` writes them, `farm submit` "
       "hands them to a scheduler (Slurm)");
   farm->require_subcommand(1);
-  farm->footer(exitCodeHelp());
 
   struct PlanOptions {
     CommonOptions common;
@@ -598,16 +597,19 @@ void registerFarm(CLI::App& app, int& exitCode) {
       ->type_name("A-B");
   plan->add_option("--shards", planOptions->shards,
                    "Shards of grow and interpolate (1 to " + std::to_string(kFarmMaxGroupTasks) + ")")
+      ->type_name("N")
       ->capture_default_str();
   plan->add_option("--chunk", planOptions->chunk,
                    "Frames per render task (a shot has at most " + std::to_string(kFarmMaxGroupTasks) +
                        " chunks and " + std::to_string(kFarmMaxFrames) + " frames)")
+      ->type_name("FRAMES")
       ->capture_default_str();
-  plan->add_option("--cpus", planOptions->cpus, "The most CPUs one task asks for")
+  plan->add_option("--cpus", planOptions->cpus,
+                   "The most CPUs one task asks for (1 to " + std::to_string(kFarmMaxCpus) + ")")
+      ->type_name("N")
       ->capture_default_str()
       ->check(CLI::Range(1, kFarmMaxCpus));
   addCommonFlags(*plan, planOptions->common, true);
-  plan->footer(exitCodeHelp());
   plan->callback([planOptions, &exitCode] {
     PlanOptions& o = *planOptions;
     exitCode = runCommand("farm plan", o.common, [&] {
@@ -618,8 +620,7 @@ void registerFarm(CLI::App& app, int& exitCode) {
         o.common.sets.push_back("Dynamics.Frames=" + std::to_string(f.first) + " " + std::to_string(f.last));
       }
       Config config = loadStageConfig(o.setup, o.common, SetupUse::kRun, stats);
-      if (!o.frames.empty() && !config.dynamics.given)
-        throw InputError("--frames: " + o.setup + " names no Dynamics Info; a still has no frames");
+      if (!o.frames.empty()) requireShotForFrames(config, o.setup);
       Mesh wick = readWick(config);  // as the stages read it: MeshUnits, MeshUpAxis, WickGroup, roots alone
       FarmPlanOptions options;
       options.hairgen = executablePath();
@@ -658,6 +659,7 @@ void registerFarm(CLI::App& app, int& exitCode) {
       "requeueable");
   submitCmd->add_option("PLAN", submitOptions->plan, "DIR/plan.json from `hairgen farm plan`")->required();
   submitCmd->add_option("--scheduler", submitOptions->scheduler, "The scheduler")
+      ->type_name("NAME")
       ->required()
       ->check(CLI::IsMember({"slurm"}));
   submitCmd->add_flag(
@@ -667,7 +669,6 @@ void registerFarm(CLI::App& app, int& exitCode) {
                       "Print the sbatch lines as a shell script (each job id in a variable job_NAME); "
                       "submit nothing");
   addCommonFlags(*submitCmd, submitOptions->common, false);
-  submitCmd->footer(exitCodeHelp());
   submitCmd->callback([submitOptions, &exitCode] {
     SubmitOptions& o = *submitOptions;
     exitCode = runCommand("farm submit", o.common, [&] {

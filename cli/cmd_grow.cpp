@@ -76,6 +76,7 @@ void registerGrow(CLI::App& app, int& exitCode) {
   cmd->add_option("SETUP", options->setup, "The Setup file")->required();
   cmd->add_option("-o,--output", options->output,
                   "Guides to write: " + hairExtensionList() + " (written atomically)")
+      ->type_name("FILE")
       ->required();
   cmd->add_option("--diagnostics", options->diagnostics,
                   "Write per guide: follicle, generalised coordinates, energy terms at start and end, stages "
@@ -88,7 +89,6 @@ void registerGrow(CLI::App& app, int& exitCode) {
          "file a whole run writes")
       ->type_name("K/N");
   addCommonFlags(*cmd, options->common, true);
-  cmd->footer(exitCodeHelp());
   cmd->callback([options, &exitCode] {
     exitCode = runCommand("grow", options->common, [&] {
       Stats stats("grow");

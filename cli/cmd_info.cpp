@@ -21,7 +21,6 @@ void registerInfo(CLI::App& app, int& exitCode) {
   cmd->add_option("FILE", options->file, "The file to describe")->required();
   cmd->add_flag("--json", options->json, "Print the description as JSON");
   addCommonFlags(*cmd, options->common, false);
-  cmd->footer(exitCodeHelp());
   cmd->callback([options, &exitCode] {
     exitCode = runCommand("info", options->common, [&] {
       Stats stats("info");

@@ -29,12 +29,14 @@ void registerInterpolate(CLI::App& app, int& exitCode) {
          "--guides", options->guides,
          "Guides from `hairgen grow` on the same Setup (.hair, .gltf, .glb, .ply, .data); with --frames a "
          "pattern such as sim/guides.####.hair")
+      ->type_name("FILE")
       ->required();
   addUnitFlags(*cmd, options->units, "the guides");
   cmd->add_option(
          "-o,--output", options->output,
          "Coupe to write: .hair, .gltf, .glb, .ply, .data or .usda (written atomically); with --frames a "
          "pattern")
+      ->type_name("FILE")
       ->required();
   cmd->add_option("--frames", options->frames, "Interpolate these frames of a sequence")->type_name("A-B");
   cmd->add_option(
@@ -45,7 +47,6 @@ void registerInterpolate(CLI::App& app, int& exitCode) {
       ->type_name("K/N")
       ->excludes("--frames");
   addCommonFlags(*cmd, options->common, true);
-  cmd->footer(exitCodeHelp());
   cmd->callback([options, &exitCode] {
     exitCode = runCommand("interpolate", options->common, [&] {
       Stats stats("interpolate");

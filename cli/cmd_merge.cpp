@@ -21,9 +21,10 @@ void registerMerge(CLI::App& app, int& exitCode) {
       "byte for byte; refuses (exit 2, naming the part) a part from another config, stage or split, an "
       "overlapping part or a missing range");
   cmd->add_option("PARTS", options->parts, "The shards, in any order (.hair)")->required();
-  cmd->add_option("-o,--output", options->output, "The whole file to write (written atomically)")->required();
+  cmd->add_option("-o,--output", options->output, "The whole file to write (written atomically)")
+      ->type_name("FILE")
+      ->required();
   addCommonFlags(*cmd, options->common, false);
-  cmd->footer(exitCodeHelp());
   cmd->callback([options, &exitCode] {
     exitCode = runCommand("merge", options->common, [&] {
       Stats stats("merge");

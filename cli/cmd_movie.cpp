@@ -24,12 +24,14 @@ void registerMovie(CLI::App& app, int& exitCode) {
                   "The frames, #### standing for the frame number (beauty.####.png)")
       ->required();
   cmd->add_option("--frames", options->frames, "The frames to encode")->type_name("A-B")->required();
-  cmd->add_option("-o,--output", options->output, "The MP4 to write (written atomically)")->required();
+  cmd->add_option("-o,--output", options->output, "The MP4 to write (written atomically)")
+      ->type_name("FILE.mp4")
+      ->required();
   cmd->add_option("--gif", options->gif, "Also a GIF for a README or a review page")->type_name("FILE.gif");
-  cmd->add_option("--fps", options->fps, "Frames per second (the Dynamics FrameRate)")
+  cmd->add_option("--fps", options->fps, "Frames per second, 0.001 to 10000 (the Dynamics FrameRate)")
+      ->type_name("FPS")
       ->check(CLI::Range(0.001, 10000.0));
   addCommonFlags(*cmd, options->common, false);
-  cmd->footer(exitCodeHelp());
   cmd->callback([options, &exitCode] {
     exitCode = runCommand("movie", options->common, [&] {
       Stats stats("movie");

@@ -29,6 +29,18 @@ void requireExtension(const std::string& file, const char* extension, const char
     throw InputError(std::string(flag) + " " + file + ": expected a " + extension + " file");
 }
 
+// render --list-devices: what each EGL platform answered; a farm's health check reads the exit code,
+// 3 when nothing here can render.
+void listDevices() {
+  std::vector<GlDeviceInfo> devices = GlContext::probe();
+  for (const GlDeviceInfo& d : devices)
+    std::cout << d.platform << ": " << (d.opened ? "opens, " + d.name : "does not open: " + d.error)
+              << (d.platform == "device" ? "  [" + d.name + "]" : "") << "\n";
+  if (devices.empty()) std::cout << "no EGL platform found\n";
+  if (std::none_of(devices.begin(), devices.end(), [](const GlDeviceInfo& d) { return d.opened; }))
+    throw DeviceError("no EGL platform opens an OpenGL 4.5 core context (the list above)");
+}
+
 }  // namespace
 
 RenderOutput renderStage(const CommonOptions& common, const Config& config, GlContext& gl,
@@ -106,29 +118,41 @@ void registerRender(CLI::App& app, int& exitCode) {
     UnitOptions units;
     double scale = 1.0;
     std::vector<double> translate;
-    bool frame = false, listDevices = false, motion = false;
+    bool frame = false, motion = false;
   };
   auto options = std::make_shared<Options>();
+  std::string models;  // from the one list the config reader takes
+  for (ShadingModel model : kShadingModels) models += std::string(models.empty() ? "" : ", ") + name(model);
   CLI::App* cmd = app.add_subcommand(
       "render",
-      "Render a coupe headless (EGL): Kajiya-Kay hair, Lambert head, deep opacity map shadows, to EXR");
-  cmd->add_option("SETUP", options->setup, "The Setup file (Visuality and Render Info, the head)");
+      "Render a coupe headless (EGL) to EXR: the hair lit by Render Info's ShadingModel (" + models +
+          "), a Lambert head, deep opacity map shadows. With --frames, a sequence in one process: per-frame "
+          "coupes (--hair PATTERN) or a simulated shot's guides (--guides PATTERN)");
+  cmd->add_option("SETUP", options->setup, "The Setup file (Visuality and Render Info, the head)")
+      ->required();
   cmd->add_option("--hair", options->hair,
-                  "The coupe: .hair (also cyHair files made elsewhere), .gltf, .glb, .ply or .data");
+                  "The coupe: .hair (also cyHair files made elsewhere), .gltf, .glb, .ply or .data")
+      ->type_name("FILE");
   cmd->add_option("-o,--output", options->output,
-                  "Image to write: .exr with R G B A (half, premultiplied), Z, opacity.Y, shadow.Y");
+                  "Image to write: .exr with R G B A (half, premultiplied), Z, opacity.Y, shadow.Y")
+      ->type_name("FILE.exr")
+      ->required();
   cmd->add_option("--dom", options->dom,
                   "Also write the light's maps: Z where the hair begins and the 4 opacity layers")
       ->type_name("FILE.exr");
   cmd->add_option("--preview", options->preview, "Also write an sRGB preview, over Render Info's Background")
       ->type_name("FILE.png");
   addUnitFlags(*cmd, options->units, "the hair file");
-  CLI::Option* scale = cmd->add_option("--scale", options->scale,
-                                       "Multiply the hair's positions and widths: --units as a factor")
-                           ->check(kFiniteNonNegative & CLI::PositiveNumber);
+  CLI::Option* scale =
+      cmd->add_option("--scale", options->scale,
+                      "Multiply the hair's positions and widths by FACTOR > 0: --units as a factor")
+          ->type_name("FACTOR")
+          ->check(kFiniteNonNegative & CLI::PositiveNumber);
   scale->excludes(cmd->get_option("--units"));
   cmd->add_option("--translate", options->translate,
-                  "Move the hair by X Y Z metres after --units/--up-axis/--scale, to sit it on the head")
+                  "Move the hair by X Y Z metres (each within +-10 km) after --units/--up-axis/--scale, to "
+                  "sit it on the "
+                  "head")
       ->expected(3)
       ->type_name("X Y Z")
       ->check(CLI::Range(-1e4, 1e4));
@@ -146,31 +170,23 @@ void registerRender(CLI::App& app, int& exitCode) {
          "With --frames, instead of --hair: a simulated sequence's guides (sim/guides.####.hair), each "
          "frame interpolated and, when the Setup shades, re-posed from --rest in memory, as `run` "
          "does: a farm's frame chunk writes no per-frame coupes")
+      ->type_name("PATTERN")
       ->excludes("--hair")
       ->needs("--frames");
   cmd->add_option("--rest", options->rest,
                   "With --guides: the shaded rest coupe whose normals and colours each frame takes (`shade` "
                   "--rest); needed when the Setup shades")
+      ->type_name("FILE")
       ->needs("--guides");
-  cmd->add_flag("--list-devices", options->listDevices, "List the EGL devices and platforms found, and exit");
   addCommonFlags(*cmd, options->common, true);
-  cmd->footer(exitCodeHelp());
+  addStandaloneFlag(*cmd, "--list-devices",
+                    "List the EGL devices and platforms found, and exit (no SETUP needed)",
+                    [options] { return runCommand("render", options->common, listDevices); });
   cmd->callback([options, &exitCode] {
     exitCode = runCommand("render", options->common, [&] {
-      if (options->listDevices) {
-        std::vector<GlDeviceInfo> devices = GlContext::probe();
-        for (const GlDeviceInfo& d : devices)
-          std::cout << d.platform << ": " << (d.opened ? "opens, " + d.name : "does not open: " + d.error)
-                    << (d.platform == "device" ? "  [" + d.name + "]" : "") << "\n";
-        if (devices.empty()) std::cout << "no EGL platform found\n";
-        // A farm's health check reads the exit code: 3 when nothing here can render.
-        if (std::none_of(devices.begin(), devices.end(), [](const GlDeviceInfo& d) { return d.opened; }))
-          throw DeviceError("no EGL platform opens an OpenGL 4.5 core context (the list above)");
-        return;
-      }
       const bool fromGuides = !options->guides.empty();
-      if (options->setup.empty() || (options->hair.empty() && !fromGuides) || options->output.empty())
-        throw InputError("render needs SETUP, --hair FILE and -o IMAGE.exr (or --list-devices)");
+      if (options->hair.empty() && !fromGuides)
+        throw InputError("render needs --hair FILE (or --frames with --guides PATTERN): the coupe to render");
       requireExtension(options->output, ".exr", "-o");
       if (!options->dom.empty()) requireExtension(options->dom, ".exr", "--dom");
       if (!options->preview.empty()) requireExtension(options->preview, ".png", "--preview");
@@ -212,20 +228,9 @@ void registerRender(CLI::App& app, int& exitCode) {
       const UnitConversion conversion = unitConversion(options->units);
       renderOptions.zUp = conversion.upAxis == UpAxis::kZ;
       renderOptions.scale = conversion.metresPerUnit.value_or(options->scale);
-      // The head of a foreign hair file is usually in the file's units and axis too: it moves with the
-      // hair unless the Setup says how to read it (MeshUnits, MeshUpAxis).
-      const Setup& s = config.setup;
-      if (head && !s.meshConversion.metresPerUnit && !s.meshConversion.upAxis &&
-          (renderOptions.zUp || renderOptions.scale != 1.0)) {
-        UnitConversion headConversion;
-        if (renderOptions.scale != 1.0) headConversion.metresPerUnit = renderOptions.scale;
-        if (renderOptions.zUp) headConversion.upAxis = UpAxis::kZ;
-        for (glm::vec3& p : head->positions) p = headConversion.position(p);
-        for (glm::vec3& n : head->normals) n = headConversion.direction(n);
-        note(options->common, "render: the head " + s.headModel.path.filename().string() +
-                                  " is read in the hair's units and axis too; to read it as it is, set "
-                                  "Setup.MeshUnits (and MeshUpAxis) for it");
-      }
+      // --units, --up-axis and --scale describe the hair file alone: the head is read as the Setup says
+      // (MeshUnits, MeshUpAxis), so foreign hair sits on the bundled head; a head in the hair's units
+      // is asked for with --set Setup.MeshUnits=U (docs/real-heads.md).
       renderOptions.keepDom = !options->dom.empty();
       // One context for every frame, opened once the first frame's hair has been read: bad input is
       // exit 2 on a machine without a device too, not 3.

@@ -55,10 +55,15 @@ fs::path defaultSetup() {
 // to DIR/beauty.####.exr and .png, then the preview movies DIR/beauty.mp4 and DIR/beauty.gif. The
 // per-frame coupes stay in memory: a shot of a full coupe would write gigabytes of them. With
 // `motionVectors`, each frame's EXR has the motion layer (the first frame's is 0: nothing came before).
+// Only the frames of `wanted` are written and rendered (run --frames); the shot is still simulated from
+// its first frame, and the frames a written one depends on (the first, at which an auto camera aims,
+// and with motion vectors the one before) are interpolated in memory, so every file equals the whole
+// run's byte for byte.
 void runShot(const CommonOptions& common, const Config& config, const Mesh& wick, const Strands& guides,
-             const Strands& restCoupe, const fs::path& out, bool render, bool motionVectors, Stats& stats) {
+             const Strands& restCoupe, const fs::path& out, FrameRange wanted, bool render,
+             bool motionVectors, Stats& stats) {
   const Dynamics& d = config.dynamics;
-  const FrameRange frames{d.firstFrame, d.lastFrame};
+  const FrameRange frames{d.firstFrame, wanted.last};  // simulated
   const HeadMotion motion = headMotionOf(config);
   const bool shaded = wantsShade(config.visuality, config.render);
   std::optional<Mesh> head;
@@ -67,7 +72,7 @@ void runShot(const CommonOptions& common, const Config& config, const Mesh& wick
   if (render) gl = openDevice(common, config, stats);
   const fs::path simPattern = out / "sim" / "guides.####.hair", exrPattern = out / "beauty.####.exr",
                  pngPattern = out / "beauty.####.png";
-  note(common, "run: a shot of frames " + std::to_string(frames.first) + "-" + std::to_string(frames.last) +
+  note(common, "run: a shot of frames " + std::to_string(wanted.first) + "-" + std::to_string(wanted.last) +
                    " at " + formatReal(d.frameRate) + " fps");
   Progress progress("run", "frames", size_t(frames.count()), !common.quiet);
   Stopwatch clock;
@@ -84,10 +89,14 @@ void runShot(const CommonOptions& common, const Config& config, const Mesh& wick
   simOptions.densityTarget = target ? &*target : nullptr;
   simulate(guides, config, simOptions, [&](int f, const Strands& frameGuides) {
     stats.add("simulate", clock.lap());
-    writeStrands(framePath(simPattern, f), frameGuides);
-    keepCommittedOutputs();  // a finished frame stays, whatever a later one does
-    stats.add("write", clock.lap());
-    if (!render) return progress.advance();
+    const bool written = f >= wanted.first;
+    if (written) {
+      writeStrands(framePath(simPattern, f), frameGuides);
+      keepCommittedOutputs();  // a finished frame stays, whatever a later one does
+      stats.add("write", clock.lap());
+    }
+    const bool needed = written || f == frames.first || (motionVectors && f == wanted.first - 1);
+    if (!render || !needed) return progress.advance();
     InterpolateOptions interpolation{config.digest(), framePath(simPattern, f).string(), nullptr,
                                      common.force, motion.pose(f).matrix()};
     Strands coupe = interpolate(wick, frameGuides, config.hairstyle, config.collision, interpolation);
@@ -97,6 +106,10 @@ void runShot(const CommonOptions& common, const Config& config, const Mesh& wick
     if (head) posedHead = motion.still() ? *head : posedMesh(*head, motion.pose(f));
     if (motionVectors && !coupeBefore) coupeBefore = coupe, headBefore = posedHead;
     if (!firstCoupe) renderOptions.framing = &firstCoupe.emplace(coupe);
+    if (!written) {  // only what a written frame needs
+      if (motionVectors) coupeBefore = std::move(coupe), headBefore = std::move(posedHead);
+      return progress.advance();
+    }
     const FrameBefore before{coupeBefore ? &*coupeBefore : nullptr, headBefore ? &*headBefore : nullptr};
     RenderOutput image = renderStage(common, config, *gl, coupe, posedHead ? &*posedHead : nullptr,
                                      renderOptions, stats, motionVectors ? &before : nullptr);
@@ -109,7 +122,7 @@ void runShot(const CommonOptions& common, const Config& config, const Mesh& wick
     progress.advance();
   });
   progress.finish();
-  stats.counts()["frames"] = frames.count();
+  stats.counts()["frames"] = wanted.count();
   if (!render) return;
   clock.lap();
   MovieOptions movie;
@@ -117,9 +130,9 @@ void runShot(const CommonOptions& common, const Config& config, const Mesh& wick
   // The frames are the shot; the movie only previews them. One that cannot be made is a warning (even
   // with --quiet) and run still succeeds, so a farm script does not render the shot again for it.
   try {
-    if (writeMovie(pngPattern, frames, out / "beauty.mp4", out / "beauty.gif", movie))
-      note(common, "run: wrote " + framePath(exrPattern, frames.first).string() + " to " +
-                       framePath(exrPattern, frames.last).filename().string() +
+    if (writeMovie(pngPattern, wanted, out / "beauty.mp4", out / "beauty.gif", movie))
+      note(common, "run: wrote " + framePath(exrPattern, wanted.first).string() + " to " +
+                       framePath(exrPattern, wanted.last).filename().string() +
                        ", beauty.mp4 and beauty.gif");
     else
       note(common,
@@ -130,31 +143,47 @@ void runShot(const CommonOptions& common, const Config& config, const Mesh& wick
   stats.add("movie", clock.lap());
 }
 
+// run --frames A-B (none: Dynamics Frames, on a still too), within the shot's frames.
+FrameRange shotFrames(const Config& config, const std::string& text, const std::string& setup) {
+  const Dynamics& d = config.dynamics;
+  if (text.empty()) return {d.firstFrame, d.lastFrame};
+  requireShotForFrames(config, setup);
+  const FrameRange frames = parseFrameRange(text, "--frames");
+  if (frames.first < d.firstFrame || frames.last > d.lastFrame)
+    throw InputError("--frames " + text + ": the shot's frames are " + std::to_string(d.firstFrame) + "-" +
+                     std::to_string(d.lastFrame) + " (Dynamics Frames)");
+  return frames;
+}
+
 }  // namespace
 
 void registerRun(CLI::App& app, int& exitCode) {
   struct Options {
     CommonOptions common;
-    std::string setup, outDir;
+    std::string setup, outDir, frames;
     bool noRender = false, motion = false;
   };
   auto options = std::make_shared<Options>();
-  CLI::App* cmd = app.add_subcommand("run",
-                                     "Run the stages in one process: grow and interpolate (or Load a saved "
-                                     "coupe), shade when the Setup asks, "
-                                     "then render; writes DIR/guides.hair, DIR/coupe.hair, DIR/shaded.hair, "
-                                     "DIR/beauty.exr and DIR/beauty.png, "
-                                     "each equal to what the stage run alone writes");
+  CLI::App* cmd = app.add_subcommand(
+      "run",
+      "Run the stages in one process: grow and interpolate (or Load a saved coupe), shade when the Setup "
+      "asks, then render. A still writes DIR/guides.hair, DIR/coupe.hair, DIR/shaded.hair (only when the "
+      "Setup shades), DIR/beauty.exr and DIR/beauty.png; a shot (the Setup names a Dynamics Info) also "
+      "simulates the guides into DIR/sim/guides.####.hair and renders DIR/beauty.####.exr and .png and the "
+      "movie DIR/beauty.mp4 and .gif. Each file equals what the stage run alone writes");
   cmd->add_option("SETUP", options->setup, "The Setup file (default: the bundled configs/default/setup.txt)");
   cmd->add_option("-o,--output", options->outDir,
                   "Output folder (default: out/NAME, NAME the Setup's folder)")
       ->type_name("DIR");
+  cmd->add_option("--frames", options->frames,
+                  "On a shot, only these frames (within Dynamics Frames), equal to the same frames of the "
+                  "whole shot: it is simulated from its first frame, and only A to B are written")
+      ->type_name("A-B");
   cmd->add_flag("--no-render", options->noRender, "Stop after the coupe (no EXR, no preview)");
   cmd->add_flag("--motion", options->motion,
                 "On a shot, motion vectors in every frame's EXR (the layer motion.u, motion.v, pixels "
                 "moved since the frame before)");
   addCommonFlags(*cmd, options->common, true);
-  cmd->footer(exitCodeHelp());
   cmd->callback([options, &exitCode] {
     exitCode = runCommand("run", options->common, [&] {
       Stats stats("run");
@@ -164,6 +193,7 @@ void registerRun(CLI::App& app, int& exitCode) {
       Stopwatch clock;
       Config config = loadStageConfig(setup, options->common, SetupUse::kRun, stats);
       stats.time("read", clock.lap());
+      const FrameRange frames = shotFrames(config, options->frames, setup.string());
       if (options->motion && (!config.dynamics.given || options->noRender))
         throw InputError(setup.string() + ": --motion renders motion vectors of a shot, and " +
                          (options->noRender ? "--no-render renders nothing"
@@ -224,8 +254,8 @@ void registerRun(CLI::App& app, int& exitCode) {
         note(options->common, "run: saved the coupe to " + config.setup.saveFile.path.string());
       }
       if (config.dynamics.given) {
-        runShot(options->common, config, wick, grown.guides, coupe, out, !options->noRender, options->motion,
-                stats);
+        runShot(options->common, config, wick, grown.guides, coupe, out, frames, !options->noRender,
+                options->motion, stats);
       } else if (!options->noRender) {
         std::optional<Mesh> head;
         if (config.setup.headModel.given()) head = readHead(config);

@@ -62,13 +62,14 @@ void registerShade(CLI::App& app, int& exitCode) {
          "SETUP", options->first,
          "The Setup file (Render Info, Visuality Info, Hairstyle's Seed); with --rest, the deformed coupe")
       ->type_name("SETUP|COUPE");
-  cmd->add_option("--hair", options->hair, "The coupe (.hair, .gltf, .glb, .ply, .data)");
+  cmd->add_option("--hair", options->hair, "The coupe (.hair, .gltf, .glb, .ply, .data)")->type_name("FILE");
   addUnitFlags(*cmd, options->units, "the coupe");
   cmd->add_option("--rest", options->rest,
                   "A coupe shaded at rest; its normals are carried onto the coupe by "
                   "parallel-transport frames, with no volume built")
       ->type_name("REST");
   cmd->add_option("-o,--output", options->output, "Shaded coupe to write (.hair, .gltf, .glb, .ply, .usda)")
+      ->type_name("FILE")
       ->required();
   cmd->add_option("--vdb", options->vdb,
                   "Also write the density and signed-distance grids as OpenVDB float grids "
@@ -78,7 +79,6 @@ void registerShade(CLI::App& app, int& exitCode) {
                   "With --rest: re-pose every frame of a sequence, the coupe and -o being patterns with ####")
       ->type_name("A-B");
   addCommonFlags(*cmd, options->common, true);
-  cmd->footer(exitCodeHelp());
   cmd->callback([options, &exitCode] {
     exitCode = runCommand("shade", options->common, [&] {
       Stats stats("shade");

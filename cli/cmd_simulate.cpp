@@ -25,16 +25,17 @@ void registerSimulate(CLI::App& app, int& exitCode) {
   cmd->add_option("SETUP", options->setup, "The Setup file; it names the Dynamics Info")->required();
   cmd->add_option("--guides", options->guides,
                   "The rest guides (`hairgen grow` on the same Setup, any format)")
+      ->type_name("FILE")
       ->required();
   cmd->add_option(
          "-o,--output", options->output,
          "Per-frame guides, #### (or %04d) standing for the frame number, e.g. sim/guides.####.hair; "
          ".hair keeps the state a restart needs")
+      ->type_name("PATTERN")
       ->required();
   cmd->add_option("--frames", options->frames, "The frames to simulate (default: Dynamics Frames)")
       ->type_name("A-B");
   addCommonFlags(*cmd, options->common, true);
-  cmd->footer(exitCodeHelp());
   cmd->callback([options, &exitCode] {
     exitCode = runCommand("simulate", options->common, [&] {
       Stats stats("simulate");

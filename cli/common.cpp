@@ -35,7 +35,8 @@ const CLI::Validator kFiniteNonNegative(
 void addCommonFlags(CLI::App& command, CommonOptions& options, bool configFlags) {
   command
       .add_option("--threads", options.threads,
-                  "Worker threads; 0 uses every core (output is identical for any value)")
+                  "Worker threads, 0 to 4096; 0 uses every core (output is identical for any value)")
+      ->type_name("N")
       ->capture_default_str()
       ->check(CLI::Range(0, 4096));
   command.add_flag("--quiet,-q", options.quiet, "Print nothing but errors");
@@ -197,6 +198,7 @@ void addUnitFlags(CLI::App& command, UnitOptions& options, const std::string& fi
           "UNIT"));
   command
       .add_option("--up-axis", options.upAxis, "The up axis of " + file + ": z turns z-up to hairgen's +y up")
+      ->type_name("y|z")
       ->check(CLI::IsMember({"y", "z"}));
 }
 
@@ -226,6 +228,51 @@ std::string exitCodeHelp() {
   for (const ExitCodeInfo& e : kExitCodes)
     text += "  " + std::to_string(int(e.code)) + "  " + e.meaning + "\n";
   return text;
+}
+
+std::string HelpFormatter::make_option_opts(const CLI::Option* option) const {
+  if (!option->get_option_text().empty()) return " " + option->get_option_text();
+  std::string text;
+  if (option->get_type_size() != 0) {
+    // A positional's name is its label (SETUP, FILE); an option's is its type name, without the
+    // validators' descriptions CLI11 appends after a ':'.
+    const std::string type = option->get_type_name();
+    const std::string label = option->get_positional() ? "" : type.substr(0, type.find(':'));
+    if (!label.empty()) text += " " + label;
+    if (!option->get_default_str().empty()) text += "=" + option->get_default_str();
+    if (option->get_expected_max() == CLI::detail::expected_max_vector_size)
+      text += " ...";
+    else if (option->get_expected_min() > 1 && label.find(' ') == std::string::npos)  // not "X Y Z"
+      text += " x " + std::to_string(option->get_expected());
+    if (option->get_required()) text += " REQUIRED";
+  }
+  if (!option->get_needs().empty()) {
+    text += " Needs:";
+    for (const CLI::Option* other : option->get_needs()) text += " " + other->get_name();
+  }
+  if (!option->get_excludes().empty()) {
+    text += " Excludes:";
+    for (const CLI::Option* other : option->get_excludes()) text += " " + other->get_name();
+  }
+  return text;
+}
+
+void pointAtExitCodes(CLI::App& app) {
+  for (CLI::App* command : app.get_subcommands([](const CLI::App*) { return true; })) {
+    command->footer("Exit codes: see hairgen --help");
+    pointAtExitCodes(*command);
+  }
+}
+
+void addStandaloneFlag(CLI::App& command, const std::string& name, const std::string& help,
+                       std::function<int()> action) {
+  command.add_flag_callback(
+      name, [action = std::move(action)] { throw CLI::RuntimeError(action()); }, help);
+}
+
+void requireShotForFrames(const Config& config, const std::string& setup) {
+  if (!config.dynamics.given)
+    throw InputError("--frames: " + setup + " names no Dynamics Info; a still has no frames");
 }
 
 std::optional<ShardSpec> shardOption(const std::string& shard, const std::string& output, HairFormat format) {

@@ -109,8 +109,29 @@ int runCommand(const std::string& command, const CommonOptions& options, const s
 // Progress and notes on stderr unless --quiet.
 void note(const CommonOptions& options, const std::string& line);
 
-// The exit-code table shown in --help.
+// The exit-code table shown in `hairgen --help`; every command's help points there in one line.
 std::string exitCodeHelp();
+
+// Help as a user reads it: an option's label is its type name alone (N, SECONDS, FILE), never CLI11's
+// validators' descriptions (`INT:INT in [0 - 4096]`); an option's range is said in its text. Set on
+// the top-level app before the commands are registered, which take it.
+class HelpFormatter : public CLI::Formatter {
+ public:
+  std::string make_option_opts(const CLI::Option* option) const override;
+};
+
+// Gives every command and subcommand of `app` the one-line footer that points at the exit codes.
+void pointAtExitCodes(CLI::App& app);
+
+// A flag that does a whole job by itself and needs none of the command's required arguments (render
+// --list-devices, check --keys): `action` runs when the command line has been read, before the
+// requirements are checked, and the program ends with the exit code it returns (main catches the
+// CLI::RuntimeError that carries it). Register it after the common flags, so that they are read first.
+void addStandaloneFlag(CLI::App& command, const std::string& name, const std::string& help,
+                       std::function<int()> action);
+
+// --frames A-B of run and farm plan on a still: an InputError, as a still has no frames.
+void requireShotForFrames(const Config& config, const std::string& setup);
 
 // --shard K/N of grow and interpolate: none when not given; a shard is written as .hair (its provenance
 // carries the range), so another output format is an InputError.

@@ -2,6 +2,7 @@
 // over to one command; everything else lives in libcore/ and stages/.
 #include <algorithm>
 #include <iostream>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -15,11 +16,14 @@ int main(int argc, char** argv) {
   using namespace hairgen::cli;
   CLI::App app{
       "hairgen " HAIRGEN_VERSION
-      ": grows, styles, caches and renders hair for CG characters (Super-Helix guides, "
-      "interpolation, Anjyo's cantilever styling, hair shading (Kajiya-Kay, Anjyo, volumetric) with deep "
-      "opacity maps).",
+      ": grows, styles, simulates, caches and renders hair for CG characters: Super-Helix guides, "
+      "interpolation, Anjyo's cantilever styling, dynamics (a shot's guides simulated frame by frame with "
+      "Anjyo's model or mass springs, under a moving head), hair shading (Kajiya-Kay, the thesis's, "
+      "Anjyo's, volumetric) with deep opacity maps, and a shot's work split into tasks for a render farm "
+      "(farm plan, farm submit to Slurm).",
       "hairgen"};
   app.footer(exitCodeHelp());
+  app.formatter(std::make_shared<HelpFormatter>());
   app.require_subcommand(1);
   app.set_version_flag("--version", "hairgen " HAIRGEN_VERSION);
 
@@ -38,6 +42,7 @@ int main(int argc, char** argv) {
   registerConvert(app, exitCode);
   registerCheck(app, exitCode);
   registerAssets(app, exitCode);
+  pointAtExitCodes(app);
 
   // A first word that is no command (a typo): named, with the nearest command, rather than CLI11's
   // "A subcommand is required".
@@ -63,6 +68,8 @@ int main(int argc, char** argv) {
     return app.exit(e);
   } catch (const CLI::CallForVersion& e) {
     return app.exit(e);
+  } catch (const CLI::RuntimeError& e) {  // a standalone flag's job ended (addStandaloneFlag)
+    return e.get_exit_code();
   } catch (const CLI::ParseError& e) {
     std::string where = "hairgen";
     for (const CLI::App* sub : app.get_subcommands()) where += " " + sub->get_name();

@@ -385,4 +385,26 @@ std::vector<WorkEstimate> estimateRun(const Config& config, const Mesh& wick, bo
   return out;
 }
 
+std::vector<WorkEstimate> estimateShot(const Config& config, const Mesh& wick, bool shade, bool render,
+                                       size_t threads) {
+  if (!config.dynamics.given) return estimateRun(config, wick, shade, render, threads);
+  const Dynamics& d = config.dynamics;
+  const FrameRange frames{d.firstFrame, d.lastFrame};
+  std::vector<WorkEstimate> out = estimateRun(config, wick, shade, false, threads);
+  // The guides: one a wick vertex; their box reaches at most the hair's length beyond the wick.
+  const size_t segments = wick.vertexCount() * (pointsPerGuide(config.hairstyle) - 1);
+  const Bounds box = bounds(wick.positions);
+  const glm::dvec3 span = glm::dvec3(box.max) - glm::dvec3(box.min) + 2.0 * config.hairstyle.totalLength();
+  out.push_back(estimateSimulate(d, segments, frames, threads, span));
+  out.back().frames = frames.count();
+  // Each frame is interpolated and rendered as the rest coupe would be.
+  for (WorkEstimate e : estimateRun(config, wick, false, render, threads)) {
+    if (e.stage == "grow") continue;
+    e.seconds *= double(frames.count());
+    e.frames = frames.count();
+    out.push_back(std::move(e));
+  }
+  return out;
+}
+
 }  // namespace hairgen

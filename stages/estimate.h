@@ -26,6 +26,7 @@ struct WorkEstimate {
   std::string timeKey;    // the key that drives the time
   std::string detail;     // what the figures come from: "759 guides x 65 points"
   std::string refusal;    // work that is wrong whatever it costs, naming the key; --force overrides it
+  int frames = 0;         // a shot's work: the frames it covers (`seconds` is all of them, `bytes` one's)
 };
 
 // Beyond this a stage is stopped before it starts unless --force: an hour is far past any coupe or
@@ -73,5 +74,12 @@ size_t pointsPerGuide(const Hairstyle& style);
 // size and extent are predicted from the wick, the density and the hair's length.
 std::vector<WorkEstimate> estimateRun(const Config& config, const Mesh& wick, bool shade, bool render,
                                       size_t threads);
+
+// Every stage of `hairgen run` on a shot (the Setup names a Dynamics Info): the rest coupe as
+// estimateRun's (grown, interpolated, shaded), then the guides simulated over Dynamics Frames and each
+// frame interpolated and, with `render`, rendered, those three with `frames` set. A still's is
+// estimateRun's.
+std::vector<WorkEstimate> estimateShot(const Config& config, const Mesh& wick, bool shade, bool render,
+                                       size_t threads);
 
 }  // namespace hairgen

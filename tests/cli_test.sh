@@ -10,14 +10,47 @@ help)
   for cmd in grow info convert check assets; do
     grep -q "^  $cmd" "$tmp/out" || fail "--help does not list $cmd"
   done
+  for word in simulate farm; do grep -q "$word" "$tmp/out" || fail "--help's description omits $word"; done
   for cmd in grow info convert check assets; do
     expect_rc 0 "$hairgen" "$cmd" --help
     for flag in --threads --quiet --stats; do grep -q -- "$flag" "$tmp/out" || fail "$cmd --help lacks $flag"; done
-    grep -q "Exit codes" "$tmp/out" || fail "$cmd --help lists no exit codes"
   done
   for flag in --set --seed; do
     "$hairgen" check --help | grep -q -- "$flag" || fail "check --help lacks $flag"
   done
+  # Every command and subcommand: human labels (N, FILE, A-B), not CLI11's types and validators; the
+  # exit-code table once, in hairgen --help, and a pointer to it in each command's.
+  commands=$("$hairgen" --help | sed -n '/^Subcommands:/,/^$/s/^  \([a-z]*\) .*/\1/p')
+  [ "$(echo "$commands" | wc -w)" -ge 14 ] || fail "the command list was not read: $commands"
+  for cmd in $commands "farm plan" "farm submit"; do
+    # shellcheck disable=SC2086 # "farm plan" is two words
+    expect_rc 0 "$hairgen" $cmd --help
+    grep -E "^ +-.* (TEXT|INT|UINT|FLOAT)\b|^ +[A-Z]+ (TEXT|INT|FLOAT)|[A-Z]:[A-Z(]|AND \(|in \[" "$tmp/out" &&
+      fail "$cmd --help shows a parser's type label"
+    grep -q "^Exit codes: see hairgen --help" "$tmp/out" || fail "$cmd --help does not point at the exit codes"
+    [ "$(grep -c '^  [0-9]  ' "$tmp/out")" -eq 0 ] || fail "$cmd --help repeats the exit-code table"
+  done
+  # Required positionals show as required; the descriptions say what the commands do.
+  expect_rc 0 "$hairgen" render --help
+  grep -q "Usage: hairgen render \[OPTIONS\] SETUP$" "$tmp/out" && grep -q "^  SETUP  *REQUIRED" "$tmp/out" ||
+    fail "render --help does not show SETUP as required"
+  for model in kajiya-kay thesis anjyo volumetric; do
+    grep -q "$model" "$tmp/out" || fail "render --help does not name the shading model $model"
+  done
+  for flag in --frames --guides; do grep -q -- "$flag" "$tmp/out" || fail "render --help omits $flag"; done
+  for cmd in check "farm plan" grow simulate; do
+    # shellcheck disable=SC2086
+    "$hairgen" $cmd --help | grep -q "^  SETUP  *REQUIRED" || fail "$cmd --help does not show SETUP as required"
+  done
+  expect_rc 0 "$hairgen" run --help
+  grep -q "shaded.hair (only when the Setup shades)" "$tmp/out" || fail "run --help says shaded.hair is always written"
+  grep -q "sim/guides.####.hair" "$tmp/out" && grep -q "beauty.mp4" "$tmp/out" ||
+    fail "run --help does not say what a shot writes"
+  # The flags that need no SETUP still work without one.
+  expect_rc 0 "$hairgen" check --keys
+  grep -q '^| `HairDensity` |' "$tmp/out" || fail "check --keys printed no keys"
+  expect_rc 2 "$hairgen" check
+  grep -q "SETUP is required" "$tmp/err" || fail "check without SETUP: $(cat "$tmp/err")"
   ;;
 usage)
   expect_rc 2 "$hairgen"
@@ -53,6 +86,23 @@ no_partial_output)
   [ ! -e "$tmp/out.glb" ] || fail "a failed convert left output behind"
   [ -z "$(ls "$tmp" | grep tmp-)" ] || fail "a temporary file was left behind"
   expect_rc 2 "$hairgen" convert "$tmp/broken.hair" "$tmp/out.xyz"
+  ;;
+render_units_head)
+  # render --units/--up-axis convert the hair file alone: a data set's hair (cyHair, cm, z up) sits on
+  # the bundled head, the image the same as of the hair converted to metres first (docs/real-heads.md).
+  [ -f "$real/luxcore/straight.hair" ] || skip "shared/testdata/real is absent"
+  small=(--quiet --set "Render.Resolution=48 48")
+  on_head=(--translate 0 -0.49 -0.02)
+  expect_rc 0 "$hairgen" render "$src/configs/default/setup.txt" --hair "$real/luxcore/straight.hair" --units cm \
+    --up-axis z "${on_head[@]}" -o "$tmp/units.exr" "${small[@]}"
+  expect_rc 0 "$hairgen" convert "$real/luxcore/straight.hair" "$tmp/metres.hair" --units cm --up-axis z -q
+  expect_rc 0 "$hairgen" render "$src/configs/default/setup.txt" --hair "$tmp/metres.hair" "${on_head[@]}" \
+    -o "$tmp/metres.exr" "${small[@]}"
+  cmp "$tmp/units.exr" "$tmp/metres.exr" || fail "render --units converted the head too"
+  # A head in the hair's units is asked for in the Setup: then the images differ.
+  expect_rc 0 "$hairgen" render "$src/configs/default/setup.txt" --hair "$real/luxcore/straight.hair" --units cm \
+    --up-axis z "${on_head[@]}" -o "$tmp/both.exr" "${small[@]}" --set Setup.MeshUnits=cm --set Setup.MeshUpAxis=z
+  expect_rc 4 "$hairgen" diff "$tmp/metres.exr" "$tmp/both.exr"
   ;;
 real_cyhair)
   [ -f "$real/luxcore/straight.hair" ] || skip "shared/testdata/real is absent"
@@ -597,6 +647,57 @@ shot_run_equals_stages)
   [ -s "$tmp/run/beauty.mp4" ] && [ -s "$tmp/run/beauty.gif" ] || fail "no preview movie"
   ffprobe -v error -count_frames -select_streams v:0 -show_entries stream=nb_read_frames -of csv=p=0 \
     "$tmp/run/beauty.mp4" | grep -qx 4 || fail "the movie does not hold the shot's 4 frames"
+  ;;
+run_frames)
+  # run --frames A-B on a shot writes exactly those frames, each equal byte for byte to the same frame
+  # of the whole shot (simulated from its first frame; motion vectors from the frame before A).
+  setup="$src/configs/anjyo/gust/setup.txt"
+  small=(--quiet --set Hairstyle.HairDensity=5 --set "Dynamics.Frames=1 5" --set "Render.Resolution=40 40")
+  expect_rc 0 "$hairgen" run "$setup" -o "$tmp/all" "${small[@]}"
+  expect_rc 0 "$hairgen" run "$setup" -o "$tmp/part" --frames 1-3 "${small[@]}"
+  [ "$(cd "$tmp/part" && echo sim/guides.*.hair beauty.*.exr)" = \
+    "sim/guides.0001.hair sim/guides.0002.hair sim/guides.0003.hair beauty.0001.exr beauty.0002.exr beauty.0003.exr" ] ||
+    fail "run --frames 1-3 wrote other frames: $(ls "$tmp/part" "$tmp/part/sim")"
+  for f in 0001 0002 0003; do
+    cmp "$tmp/all/sim/guides.$f.hair" "$tmp/part/sim/guides.$f.hair" || fail "run --frames: simulated frame $f differs"
+    cmp "$tmp/all/beauty.$f.exr" "$tmp/part/beauty.$f.exr" || fail "run --frames: frame $f differs"
+  done
+  ffprobe -v error -count_frames -select_streams v:0 -show_entries stream=nb_read_frames -of csv=p=0 \
+    "$tmp/part/beauty.mp4" | grep -qx 3 || fail "the movie of run --frames 1-3 does not hold 3 frames"
+  # A range after the shot's first frame, with motion vectors.
+  expect_rc 0 "$hairgen" run "$setup" -o "$tmp/allm" --motion "${small[@]}"
+  expect_rc 0 "$hairgen" run "$setup" -o "$tmp/partm" --motion --frames 3-4 "${small[@]}"
+  [ ! -e "$tmp/partm/beauty.0002.exr" ] && [ ! -e "$tmp/partm/sim/guides.0002.hair" ] &&
+    [ ! -e "$tmp/partm/beauty.0005.exr" ] || fail "run --frames 3-4 wrote frames outside 3-4"
+  for f in 0003 0004; do
+    cmp "$tmp/allm/sim/guides.$f.hair" "$tmp/partm/sim/guides.$f.hair" || fail "run --frames 3-4: simulated frame $f differs"
+    cmp "$tmp/allm/beauty.$f.exr" "$tmp/partm/beauty.$f.exr" || fail "run --frames 3-4 --motion: frame $f differs"
+  done
+  expect_rc 2 "$hairgen" run "$src/configs/default/setup.txt" -o "$tmp/still" --frames 1-3 --quiet
+  expect_err "names no Dynamics Info; a still has no frames"
+  [ ! -e "$tmp/still" ] || fail "run --frames on a still made its output folder"
+  expect_rc 2 "$hairgen" run "$setup" -o "$tmp/out6" --frames 4-9 "${small[@]}"
+  expect_err "the shot's frames are 1-5"
+  ;;
+check_shot_time)
+  # check on a shot estimates its time as well as its memory: each stage's, the frames' render (the
+  # most of it), and the total.
+  expect_rc 0 "$hairgen" check "$src/configs/shots/headturn/setup.txt"
+  grep -Eq "^  render, 72 frames: about [0-9]+ MB, [0-9]+ (s|min [0-9]+ s|h [0-9]+ min) \([0-9]+ s a frame\)" "$tmp/out" ||
+    fail "check names no time for the render of the shot's frames: $(cat "$tmp/out")"
+  grep -Eq "^  simulate, 72 frames: " "$tmp/out" || fail "check names no simulation: $(cat "$tmp/out")"
+  grep -Eq "^  in all about [0-9]+ (s|min|h)" "$tmp/out" || fail "check names no total time: $(cat "$tmp/out")"
+  expect_rc 0 "$hairgen" check "$src/configs/shots/headturn/setup.txt" --json
+  python3 - "$tmp/out" <<'PY' || fail "check --json's times do not add up"
+import json, sys
+r = json.load(open(sys.argv[1]))
+render = [w for w in r["work"] if w["stage"] == "render"]
+assert len(render) == 1 and render[0]["frames"] == 72 and render[0]["seconds"] > 0, render
+assert abs(sum(w["seconds"] for w in r["work"]) - r["workSeconds"]) < 1e-6 * r["workSeconds"]
+PY
+  # A still: one render, no frames.
+  expect_rc 0 "$hairgen" check "$src/configs/default/setup.txt"
+  grep -Eq "^  render: about [0-9]+ MB, ([0-9]+ s|under a second)" "$tmp/out" || fail "check names no render time: $(cat "$tmp/out")"
   ;;
 shot_headturn)
   # The bundled head turn, small: the shot runs end to end, the head has turned by its last frame (the

@@ -1,5 +1,6 @@
 #include "libcore/io/info.h"
 
+#include <algorithm>
 #include <cmath>
 #include <span>
 #include <sstream>
@@ -13,6 +14,7 @@
 #include "libcore/io/usd_io.h"
 #include "libcore/util/error.h"
 #include "libcore/util/json.h"
+#include "libcore/util/progress.h"
 #include "libcore/util/resources.h"
 #include "libcore/util/text.h"
 
@@ -323,10 +325,25 @@ std::string formatSetupReport(const nlohmann::ordered_json& report) {
     out << "  the head's whorl, where the follicles lean away from (to freeze it, in the Hairstyle Info):\n  "
            "  "
         << report["fittedRootFlow"].get<std::string>() << "\n";
-  if (report.contains("work"))
-    for (const auto& w : report["work"])
-      out << "  " << w["stage"].get<std::string>() << ": about " << formatBytes(w["bytes"].get<uint64_t>())
-          << ", " << w["detail"].get<std::string>() << "\n";
+  auto time = [](double seconds) {
+    return seconds < 0.5 ? std::string("under a second") : formatDuration(seconds);
+  };
+  if (report.contains("work")) {
+    for (const auto& w : report["work"]) {
+      const double seconds = w["seconds"].get<double>();
+      out << "  " << w["stage"].get<std::string>();
+      if (w.contains("frames")) {
+        const int frames = w["frames"].get<int>();
+        out << ", " << frames << " frames: about " << formatBytes(w["bytes"].get<uint64_t>()) << ", "
+            << time(seconds) << " (" << time(seconds / std::max(frames, 1)) << " a frame)";
+      } else {
+        out << ": about " << formatBytes(w["bytes"].get<uint64_t>()) << ", " << time(seconds);
+      }
+      out << ", " << w["detail"].get<std::string>() << "\n";
+    }
+    out << "  in all about " << time(report["workSeconds"].get<double>()) << " on "
+        << report["workThreads"].get<size_t>() << " threads (a rough estimate; --stats measures a run)\n";
+  }
   return out.str();
 }
 

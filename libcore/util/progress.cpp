@@ -2,6 +2,8 @@
 
 #include <unistd.h>
 
+#include <algorithm>
+#include <cmath>
 #include <cstdio>
 
 namespace hairgen {
@@ -12,6 +14,25 @@ constexpr double kBarEvery = 0.1;   // live bar refresh
 constexpr double kLineEvery = 5.0;  // log line interval
 
 }  // namespace
+
+std::optional<double> estimatedSecondsLeft(size_t done, size_t total, double elapsed) {
+  if (done == 0 || done >= total || !(elapsed >= 0.0)) return std::nullopt;
+  const double fraction = double(done) / double(total);
+  if (fraction < kEtaAfterFraction && elapsed < kEtaAfterSeconds) return std::nullopt;
+  return elapsed * double(total - done) / double(done);
+}
+
+std::string formatDuration(double seconds) {
+  const long long s = std::llround(std::max(seconds, 0.0));
+  char text[48];
+  if (s < 60)
+    std::snprintf(text, sizeof text, "%lld s", s);
+  else if (s < 3600)
+    std::snprintf(text, sizeof text, "%lld min %02lld s", s / 60, s % 60);
+  else
+    std::snprintf(text, sizeof text, "%lld h %02lld min", s / 3600, s / 60 % 60);
+  return text;
+}
 
 Progress::Progress(std::string stage, std::string unit, size_t total, bool enabled)
     : stage_(std::move(stage)),
@@ -43,15 +64,19 @@ void Progress::advance(size_t done) {
 
 void Progress::print(size_t done, double seconds) {
   int percent = static_cast<int>(100 * std::min(done, total_) / total_);
+  const std::optional<double> left = estimatedSecondsLeft(done, total_, seconds);
   if (terminal_) {
     constexpr int kWidth = 30;
     std::string bar(kWidth * percent / 100, '#');
     bar.resize(kWidth, ' ');
-    std::fprintf(stderr, "\r%s [%s] %3d%% %zu/%zu %s %.1f s", stage_.c_str(), bar.c_str(), percent, done,
-                 total_, unit_.c_str(), seconds);
+    // Padded, so a shorter estimate overwrites the end of a longer one.
+    const std::string eta = left ? ", about " + formatDuration(*left) + " left" : "";
+    std::fprintf(stderr, "\r%s [%s] %3d%% %zu/%zu %s %.1f s%-26s", stage_.c_str(), bar.c_str(), percent, done,
+                 total_, unit_.c_str(), seconds, eta.c_str());
   } else {
-    std::fprintf(stderr, "%s: %3d%% (%zu of %zu %s, %.1f s)\n", stage_.c_str(), percent, done, total_,
-                 unit_.c_str(), seconds);
+    const std::string eta = left ? ", about " + formatDuration(*left) + " left" : "";
+    std::fprintf(stderr, "%s: %3d%% (%zu of %zu %s, %.1f s%s)\n", stage_.c_str(), percent, done, total_,
+                 unit_.c_str(), seconds, eta.c_str());
   }
   std::fflush(stderr);
   printed_ = true;
