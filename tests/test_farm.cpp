@@ -8,6 +8,8 @@
 #include <functional>
 #include <set>
 
+#include "farm/done.h"
+#include "farm/scheduler.h"
 #include "libcore/io/hair_io.h"
 #include "libcore/model/shards.h"
 #include "libcore/util/error.h"
@@ -303,6 +305,47 @@ TEST(FarmPlan, ArrayIndexIsTheIdsNumber) {
     const size_t dot = t.id.find('.');
     EXPECT_EQ(farmArrayIndex(t), dot == std::string::npos ? 0 : std::stoi(t.id.substr(dot + 1))) << t.id;
   }
+}
+
+// A back end that records what it was asked to submit: the done set is the farm's, not the scheduler's.
+class RecordingScheduler : public farm::Scheduler {
+ public:
+  std::vector<std::string> asked;
+  size_t submit(const FarmPlan& plan, const std::vector<bool>& done) override {
+    for (size_t i = 0; i < plan.tasks.size(); ++i)
+      if (!done[i]) asked.push_back(plan.tasks[i].id);
+    return asked.size();
+  }
+  void wait(const FarmPlan&) override {}
+};
+
+TEST(FarmPlan, ABackEndIsAskedOnlyForTasksWhoseOutputsLackThePlansDigest) {
+  test::TempDir dir("farm-done");
+  const Coupe c;
+  FarmPlan plan;
+  plan.directory = dir.path().string();
+  plan.configDigest = c.job.config.digest();
+  Strands stale = c.guides;
+  stale.provenance.configDigest = "ffffffffffffffff";
+  writeHair(dir.path() / "fresh.hair", c.guides);
+  writeHair(dir.path() / "stale.hair", stale);
+  std::ofstream(dir.path() / "present.txt") << "x";
+  std::ofstream(dir.path() / "garbage.exr") << "not an image";
+  auto task = [&](const std::string& id, std::vector<std::string> outputs) {
+    FarmTask t;
+    t.id = t.group = id;
+    for (const std::string& o : outputs) t.outputs.push_back((dir.path() / o).string());
+    plan.tasks.push_back(t);
+  };
+  task("done", {"fresh.hair", "present.txt"});
+  task("stale", {"stale.hair"});
+  task("missing", {"missing.hair"});
+  task("partly", {"fresh.hair", "missing.txt"});
+  task("unreadable", {"garbage.exr"});
+  task("nothing", {});
+  RecordingScheduler scheduler;
+  EXPECT_EQ(scheduler.submit(plan, farm::doneTasks(plan)), 4u);
+  EXPECT_EQ(scheduler.asked, (std::vector<std::string>{"stale", "missing", "partly", "unreadable"}));
 }
 
 }  // namespace
