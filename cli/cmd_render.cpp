@@ -17,6 +17,7 @@
 #include "stages/interpolate.h"
 #include "stages/render.h"
 #include "stages/shade.h"
+#include "stages/shot.h"
 #include "stages/simulate.h"
 
 namespace hairgen::cli {
@@ -222,6 +223,13 @@ void registerRender(CLI::App& app, int& exitCode) {
         throw InputError("--rest: this Setup does not shade; each frame is rendered as interpolated");
       Strands rest;
       if (!options->rest.empty()) rest = readStrands(options->rest);
+      // A frame of a shot from its guides, as `run` makes it (stages/shot.h).
+      const ShotInputs shot{&config,
+                            scene.wick ? &*scene.wick : nullptr,
+                            shaded ? &rest : nullptr,
+                            head ? &*head : nullptr,
+                            motion,
+                            options->common.force};
       stats.time("read", clock.lap());
       RenderOptions renderOptions;
       renderOptions.frame = options->frame;
@@ -239,13 +247,8 @@ void registerRender(CLI::App& app, int& exitCode) {
       // (Dynamics Info's Frames; without one, the frames rendered), so a range split across jobs gives
       // the same vectors as one job; the shot's first frame has nothing before it and moves by 0.
       const int shotStart = config.dynamics.given ? config.dynamics.firstFrame : frames.first;
-      std::optional<Strands> hairBefore;
-      std::optional<Mesh> headBefore;
+      ShotMotion before;  // with --motion, the frame before
       std::string hairFileBefore;
-      auto poseHead = [&](int f) -> std::optional<Mesh> {
-        if (head && sequence && !motion.still()) return posedMesh(*head, motion.pose(f));
-        return std::nullopt;
-      };
       if (options->motion && !config.dynamics.given)
         note(options->common,
              "hairgen render: no Dynamics Info names the shot's first frame, so frame " +
@@ -264,18 +267,14 @@ void registerRender(CLI::App& app, int& exitCode) {
         }
         return h;
       };
-      // A frame's hair: its coupe file, or with --guides its guides interpolated (and re-posed from the
-      // shaded rest) as `run` does it, so the image is run's.
+      // A frame's hair: its coupe file, or with --guides the shot's frame from its guides, the stage
+      // `run` calls, so the image is run's. In a sequence the head moves with its keys (Dynamics Info),
+      // as the hair's roots did; a single image has the head at rest.
       const std::string& pattern = fromGuides ? options->guides : options->hair;
       auto loadFrame = [&](int f, std::string& file) {
         file = frameFile(pattern, f);
-        if (!fromGuides) return readHair(file);
-        const InterpolateOptions interpolation{config.digest(), file, nullptr, options->common.force,
-                                               motion.pose(f).matrix()};
-        Strands coupe =
-            interpolate(*scene.wick, readStrands(file), config.hairstyle, config.collision, interpolation);
-        if (shaded) coupe = repose(rest, coupe);
-        return coupe;
+        if (fromGuides) return shotFrame(shot, f, readStrands(file), file);
+        return ShotFrame{readHair(file), sequence ? shotHead(shot, f) : std::nullopt};
       };
       // A sequence aims an auto camera (or --frame) at its shot's first frame, so the camera holds still
       // and a range split into jobs sees through the same camera; when that frame's file is gone, at the
@@ -284,13 +283,12 @@ void registerRender(CLI::App& app, int& exitCode) {
       if (sequence && (options->frame || config.render.cameraAuto)) {
         std::string file;
         framing =
-            loadFrame(fs::is_regular_file(frameFile(pattern, shotStart)) ? shotStart : frames.first, file);
+            loadFrame(fs::is_regular_file(frameFile(pattern, shotStart)) ? shotStart : frames.first, file)
+                .coupe;
         frameOptions.framing = &*framing;
       }
-      if (options->motion && frames.first - 1 >= shotStart) {
-        hairBefore = loadFrame(frames.first - 1, hairFileBefore);
-        headBefore = poseHead(frames.first - 1);
-      }
+      if (options->motion && frames.first - 1 >= shotStart)
+        before.keep(loadFrame(frames.first - 1, hairFileBefore));
       Progress progress("render", "frames", size_t(frames.count()), sequence && !options->common.quiet);
       // One image: its passes are the progress (a 1080p coupe spends seconds in each on llvmpipe).
       Progress passes("render", "passes", renderPassCount(options->motion),
@@ -298,13 +296,11 @@ void registerRender(CLI::App& app, int& exitCode) {
       if (!sequence) frameOptions.progress = &passes;
       for (int f = frames.first; f <= frames.last; ++f) {
         std::string hairFile;
-        Strands hair = loadFrame(f, hairFile);
-        if (options->motion && !hairBefore) {
-          hairBefore = hair;  // nothing before the shot: no motion
-          hairFileBefore = hairFile;
-          headBefore = poseHead(f);
-        }
-        if (hairBefore && !sameStrands(hair, *hairBefore))
+        ShotFrame frame = loadFrame(f, hairFile);
+        Strands& hair = frame.coupe;
+        if (options->motion && !before.started()) hairFileBefore = hairFile;  // no motion at the shot's start
+        const FrameBefore frameBefore = options->motion ? before.before(frame) : FrameBefore{};
+        if (frameBefore.hair && !sameStrands(hair, *frameBefore.hair))
           throw InputError({hairFile, 0}, "has other strands than " + hairFileBefore +
                                               " (frames of a sequence have the same strands and points), so "
                                               "no motion vectors can be drawn between them");
@@ -314,23 +310,18 @@ void registerRender(CLI::App& app, int& exitCode) {
                            "ShadingModel volumetric needs the coupe's volume normals, and this one "
                            "has none; run `hairgen shade SETUP --hair " +
                                hairFile + " -o shaded.hair` and render that");
-        // In a sequence the head moves with its keys (Dynamics Info), as the hair's roots did.
-        std::optional<Mesh> posedHead = poseHead(f);
         stats.add("read", clock.lap());
         // Without motion vectors the frame's hair has no use once the render reads it no more: freed
         // then (after the upload where the device copies it, so the passes run without a second copy
         // of a 150,000-strand coupe's 230 MB).
         frameOptions.uploaded = nullptr;
         if (!options->motion) frameOptions.uploaded = [&hair] { hair = Strands{}; };
-        FrameBefore before{hairBefore ? &*hairBefore : nullptr, headBefore ? &*headBefore
-                                                                : head     ? &*head
-                                                                           : nullptr};
         if (!gl) gl = openDevice(options->common, config, stats);
         RenderOutput out = renderStage(options->common, config, *gl, hair,
-                                       posedHead ? &*posedHead
-                                       : head    ? &*head
-                                                 : nullptr,
-                                       frameOptions, stats, options->motion ? &before : nullptr);
+                                       frame.head ? &*frame.head
+                                       : head     ? &*head
+                                                  : nullptr,
+                                       frameOptions, stats, options->motion ? &frameBefore : nullptr);
         clock.lap();
         // The image's config digest is the Setup's, as `run` and a farm plan write and expect it (an auto
         // camera is part of the Setup: the same inputs aim it the same way). --frame, which is not,
@@ -342,9 +333,8 @@ void registerRender(CLI::App& app, int& exitCode) {
         if (sequence) keepCommittedOutputs();  // a finished frame stays, whatever a later one does
         stats.add("write", clock.lap());
         if (options->motion) {
-          hairBefore = std::move(hair);
           hairFileBefore = hairFile;
-          headBefore = std::move(posedHead);
+          before.keep(std::move(frame));
         }
         progress.advance();
       }

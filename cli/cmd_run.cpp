@@ -22,6 +22,7 @@
 #include "stages/estimate.h"
 #include "stages/interpolate.h"
 #include "stages/shade.h"
+#include "stages/shot.h"
 #include "stages/simulate.h"
 
 namespace hairgen::cli {
@@ -64,10 +65,12 @@ void runShot(const CommonOptions& common, const Config& config, const Mesh& wick
              bool motionVectors, Stats& stats) {
   const Dynamics& d = config.dynamics;
   const FrameRange frames{d.firstFrame, wanted.last};  // simulated
-  const HeadMotion motion = headMotionOf(config);
-  const bool shaded = wantsShade(config.visuality, config.render);
   std::optional<Mesh> head;
   if (render && config.setup.headModel.given()) head = readHead(config);
+  const bool shaded = wantsShade(config.visuality, config.render);
+  const ShotInputs inputs{
+      &config,     &wick, shaded ? &restCoupe : nullptr, head ? &*head : nullptr, headMotionOf(config),
+      common.force};
   std::unique_ptr<GlContext> gl;
   if (render) gl = openDevice(common, config, stats);
   const fs::path simPattern = out / "sim" / "guides.####.hair", exrPattern = out / "beauty.####.exr",
@@ -76,8 +79,8 @@ void runShot(const CommonOptions& common, const Config& config, const Mesh& wick
                    " at " + formatReal(d.frameRate) + " fps");
   Progress progress("run", "frames", size_t(frames.count()), !common.quiet);
   Stopwatch clock;
-  std::optional<Strands> coupeBefore, firstCoupe;
-  std::optional<Mesh> headBefore;
+  std::optional<Strands> firstCoupe;
+  ShotMotion before;            // with motion vectors, the frame before
   RenderOptions renderOptions;  // an auto camera aims at the shot's first frame and holds still
   SimulateOptions simOptions;
   simOptions.configDigest = config.digest();
@@ -97,23 +100,17 @@ void runShot(const CommonOptions& common, const Config& config, const Mesh& wick
     }
     const bool needed = written || f == frames.first || (motionVectors && f == wanted.first - 1);
     if (!render || !needed) return progress.advance();
-    InterpolateOptions interpolation{config.digest(), framePath(simPattern, f).string(), nullptr,
-                                     common.force, motion.pose(f).matrix()};
-    Strands coupe = interpolate(wick, frameGuides, config.hairstyle, config.collision, interpolation);
-    if (shaded) coupe = repose(restCoupe, coupe);
+    ShotFrame frame = shotFrame(inputs, f, frameGuides, framePath(simPattern, f).string());
     stats.add("interpolate", clock.lap());
-    std::optional<Mesh> posedHead;
-    if (head) posedHead = motion.still() ? *head : posedMesh(*head, motion.pose(f));
-    if (motionVectors && !coupeBefore) coupeBefore = coupe, headBefore = posedHead;
-    if (!firstCoupe) renderOptions.framing = &firstCoupe.emplace(coupe);
+    if (!firstCoupe) renderOptions.framing = &firstCoupe.emplace(frame.coupe);
     if (!written) {  // only what a written frame needs
-      if (motionVectors) coupeBefore = std::move(coupe), headBefore = std::move(posedHead);
+      if (motionVectors) before.keep(std::move(frame));
       return progress.advance();
     }
-    const FrameBefore before{coupeBefore ? &*coupeBefore : nullptr, headBefore ? &*headBefore : nullptr};
-    RenderOutput image = renderStage(common, config, *gl, coupe, posedHead ? &*posedHead : nullptr,
-                                     renderOptions, stats, motionVectors ? &before : nullptr);
-    if (motionVectors) coupeBefore = std::move(coupe), headBefore = std::move(posedHead);
+    const FrameBefore frameBefore = motionVectors ? before.before(frame) : FrameBefore{};
+    RenderOutput image = renderStage(common, config, *gl, frame.coupe, frame.head ? &*frame.head : nullptr,
+                                     renderOptions, stats, motionVectors ? &frameBefore : nullptr);
+    if (motionVectors) before.keep(std::move(frame));
     clock.lap();
     writeRenderOutputs(config, image, framePath(exrPattern, f).string(), "",
                        framePath(pngPattern, f).string());
