@@ -230,6 +230,34 @@ RenderOptions renderOptionsOf(const RenderArgs& args) {
   return renderOptions;
 }
 
+// A --hair file as the render stage takes it: with --translate, converted (--units, --up-axis, --scale)
+// and moved here, since the move comes after the conversion.
+Strands readHair(const RenderArgs& args, const RenderOptions& renderOptions, const std::string& file) {
+  Strands h = readStrands(file);
+  if (!args.translate.empty()) {
+    conform(h, renderOptions.zUp, renderOptions.scale);
+    const glm::vec3 offset(args.translate[0], args.translate[1], args.translate[2]);
+    for (glm::vec3& p : h.points) p += offset;
+  }
+  return h;
+}
+
+// A frame's hair can be rendered: the same strands as the frame before (for motion vectors), and the
+// volume normals a volumetric ShadingModel needs.
+void checkFrameHair(const Config& config, const Strands& hair, const std::string& hairFile,
+                    const FrameBefore& before, const std::string& hairFileBefore) {
+  if (before.hair && !sameStrands(hair, *before.hair))
+    throw InputError({hairFile, 0}, "has other strands than " + hairFileBefore +
+                                        " (frames of a sequence have the same strands and points), so "
+                                        "no motion vectors can be drawn between them");
+  if (config.render.shadingModel == ShadingModel::kVolumetric && config.render.volumetricBlend > 0.0 &&
+      hair.normals.empty())
+    throw InputError({hairFile, 0},
+                     "ShadingModel volumetric needs the coupe's volume normals, and this one "
+                     "has none; run `hairgen shade SETUP --hair " +
+                         hairFile + " -o shaded.hair` and render that");
+}
+
 // Renders the frames (one image without --frames) and writes each: its hair a coupe file, or with
 // --guides the shot's frame from its guides (stages/shot.h, the stage `run` calls, so the image is
 // run's). One device for every frame.
@@ -254,22 +282,13 @@ void renderFrames(const RenderArgs& args, const Config& config, const ShotInputs
   // --translate moves the hair after its conversion, so the stage gets it converted and moved.
   RenderOptions frameOptions = renderOptions;
   if (!args.translate.empty()) frameOptions.zUp = false, frameOptions.scale = 1.0;
-  auto readHair = [&](const std::string& file) {
-    Strands h = readStrands(file);
-    if (!args.translate.empty()) {
-      conform(h, renderOptions.zUp, renderOptions.scale);
-      const glm::vec3 offset(args.translate[0], args.translate[1], args.translate[2]);
-      for (glm::vec3& p : h.points) p += offset;
-    }
-    return h;
-  };
   // A frame's hair and head. In a sequence the head moves with its keys (Dynamics Info), as the hair's
   // roots did; a single image has the head at rest.
   const std::string& pattern = args.fromGuides() ? args.guides : args.hair;
   auto loadFrame = [&](int f, std::string& file) {
     file = args.file(pattern, f);
     if (args.fromGuides()) return shotFrame(shot, f, readStrands(file), file);
-    return ShotFrame{readHair(file), sequence ? shotHead(shot, f) : std::nullopt};
+    return ShotFrame{readHair(args, renderOptions, file), sequence ? shotHead(shot, f) : std::nullopt};
   };
   // A sequence aims an auto camera (or --frame) at its shot's first frame, so the camera holds still
   // and a range split into jobs sees through the same camera; when that frame's file is gone, at the
@@ -292,16 +311,7 @@ void renderFrames(const RenderArgs& args, const Config& config, const ShotInputs
     Strands& hair = frame.coupe;
     if (args.motion && !before.started()) hairFileBefore = hairFile;  // no motion at the shot's start
     const FrameBefore frameBefore = args.motion ? before.before(frame) : FrameBefore{};
-    if (frameBefore.hair && !sameStrands(hair, *frameBefore.hair))
-      throw InputError({hairFile, 0}, "has other strands than " + hairFileBefore +
-                                          " (frames of a sequence have the same strands and points), so "
-                                          "no motion vectors can be drawn between them");
-    if (config.render.shadingModel == ShadingModel::kVolumetric && config.render.volumetricBlend > 0.0 &&
-        hair.normals.empty())
-      throw InputError({hairFile, 0},
-                       "ShadingModel volumetric needs the coupe's volume normals, and this one "
-                       "has none; run `hairgen shade SETUP --hair " +
-                           hairFile + " -o shaded.hair` and render that");
+    checkFrameHair(config, hair, hairFile, frameBefore, hairFileBefore);
     stats.add("read", clock.lap());
     // Without motion vectors the frame's hair has no use once the render reads it no more: freed
     // then (after the upload where the device copies it, so the passes run without a second copy
