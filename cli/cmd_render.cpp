@@ -17,6 +17,7 @@
 #include "stages/interpolate.h"
 #include "stages/render.h"
 #include "stages/shade.h"
+#include "stages/shot.h"
 #include "stages/simulate.h"
 
 namespace hairgen::cli {
@@ -111,16 +112,249 @@ void writeRenderOutputs(const Config& config, const RenderOutput& out, const std
   if (!preview.empty()) writePreview(preview, out.beauty, config.render.background);
 }
 
-void registerRender(CLI::App& app, int& exitCode) {
-  struct Options {
-    CommonOptions common;
-    std::string setup, hair, output, dom, preview, frames, guides, rest;
-    UnitOptions units;
-    double scale = 1.0;
-    std::vector<double> translate;
-    bool frame = false, motion = false;
+namespace {
+
+struct RenderArgs {
+  CommonOptions common;
+  std::string setup, hair, output, dom, preview, frames, guides, rest;
+  UnitOptions units;
+  double scale = 1.0;
+  std::vector<double> translate;
+  bool frame = false, motion = false;
+  bool sequence() const { return !frames.empty(); }
+  bool fromGuides() const { return !guides.empty(); }
+  // A file of the command: with --frames, frame `f`'s file of its pattern.
+  std::string file(const std::string& pattern, int f) const {
+    return sequence() && !pattern.empty() ? framePath(pattern, f).string() : pattern;
+  }
+};
+
+void addRenderFlags(CLI::App& cmd, RenderArgs& args) {
+  cmd.add_option("SETUP", args.setup, "The Setup file (Visuality and Render Info, the head)")->required();
+  cmd.add_option("--hair", args.hair,
+                 "The coupe: .hair (also cyHair files made elsewhere), .gltf, .glb, .ply or .data")
+      ->type_name("FILE");
+  cmd.add_option("-o,--output", args.output,
+                 "Image to write: .exr with R G B A (half, premultiplied), Z, opacity.Y, shadow.Y")
+      ->type_name("FILE.exr")
+      ->required();
+  cmd.add_option("--dom", args.dom,
+                 "Also write the light's maps: Z where the hair begins and the 4 opacity layers")
+      ->type_name("FILE.exr");
+  cmd.add_option("--preview", args.preview, "Also write an sRGB preview, over Render Info's Background")
+      ->type_name("FILE.png");
+  addUnitFlags(cmd, args.units, "the hair file");
+  CLI::Option* scale =
+      cmd.add_option("--scale", args.scale,
+                     "Multiply the hair's positions and widths by FACTOR > 0: --units as a factor")
+          ->type_name("FACTOR")
+          ->check(kFiniteNonNegative & CLI::PositiveNumber);
+  scale->excludes(cmd.get_option("--units"));
+  cmd.add_option("--translate", args.translate,
+                 "Move the hair by X Y Z metres (each within +-10 km) after --units/--up-axis/--scale, to "
+                 "sit it on the "
+                 "head")
+      ->expected(3)
+      ->type_name("X Y Z")
+      ->check(CLI::Range(-1e4, 1e4));
+  cmd.add_flag("--frame", args.frame, "Aim the camera and light at the hair and fit it in the view");
+  cmd.add_option(
+         "--frames", args.frames,
+         "Render these frames of a sequence in one process, one device: --hair, -o, --dom and --preview "
+         "are patterns with ####, and the head moves with the Setup's HeadKeys")
+      ->type_name("A-B");
+  cmd.add_flag("--motion", args.motion,
+               "With --frames, motion vectors too: the layer motion.u, motion.v, pixels moved since the "
+               "frame before (from the --hair pattern's previous frame while it is in the shot)");
+  cmd.add_option(
+         "--guides", args.guides,
+         "With --frames, instead of --hair: a simulated sequence's guides (sim/guides.####.hair), each "
+         "frame interpolated and, when the Setup shades, re-posed from --rest in memory, as `run` "
+         "does: a farm's frame chunk writes no per-frame coupes")
+      ->type_name("PATTERN")
+      ->excludes("--hair")
+      ->needs("--frames");
+  cmd.add_option("--rest", args.rest,
+                 "With --guides: the shaded rest coupe whose normals and colours each frame takes (`shade` "
+                 "--rest); needed when the Setup shades")
+      ->type_name("FILE")
+      ->needs("--guides");
+}
+
+// What needs no Setup: something to render, and files of the kinds written.
+void checkRenderArgs(const RenderArgs& args) {
+  if (args.hair.empty() && !args.fromGuides())
+    throw InputError("render needs --hair FILE (or --frames with --guides PATTERN): the coupe to render");
+  requireExtension(args.output, ".exr", "-o");
+  if (!args.dom.empty()) requireExtension(args.dom, ".exr", "--dom");
+  if (!args.preview.empty()) requireExtension(args.preview, ".png", "--preview");
+}
+
+// The frames rendered (a single image: frame 0), their patterns checked; where it will write, before
+// the work (a sequence's first frame's files).
+FrameRange renderedFrames(const RenderArgs& args) {
+  if (args.motion && !args.sequence())
+    throw InputError("--motion needs --frames: motion vectors are the movement since the frame before");
+  const FrameRange frames = args.sequence() ? parseFrameRange(args.frames, "--frames") : FrameRange{0, 0};
+  if (args.sequence())
+    for (const std::string* pattern : {&args.hair, &args.guides, &args.output, &args.dom, &args.preview})
+      if (!pattern->empty() && !isFramePattern(*pattern))
+        throw InputError(*pattern + ": with --frames, write #### where the frame number goes");
+  for (const std::string* file : {&args.output, &args.dom, &args.preview})
+    if (!file->empty()) requireWritableOutput(args.file(*file, frames.first));
+  return frames;
+}
+
+// With --guides, the shaded rest coupe each frame takes its normals and colours from (`shade --rest`),
+// when the Setup shades; empty otherwise.
+Strands readShadedRest(const RenderArgs& args, bool shaded) {
+  if (args.fromGuides() && shaded && args.rest.empty())
+    throw InputError(
+        "--guides: this Setup shades, so each frame takes its normals from the shaded rest "
+        "coupe: name it with --rest shaded.hair");
+  if (args.fromGuides() && !shaded && !args.rest.empty())
+    throw InputError("--rest: this Setup does not shade; each frame is rendered as interpolated");
+  return args.rest.empty() ? Strands{} : readStrands(args.rest);
+}
+
+// --units, --up-axis and --scale describe the hair file alone: the head is read as the Setup says
+// (MeshUnits, MeshUpAxis), so foreign hair sits on the bundled head; a head in the hair's units is asked
+// for with --set Setup.MeshUnits=U (docs/real-heads.md).
+RenderOptions renderOptionsOf(const RenderArgs& args) {
+  RenderOptions renderOptions;
+  renderOptions.frame = args.frame;
+  const UnitConversion conversion = unitConversion(args.units);
+  renderOptions.zUp = conversion.upAxis == UpAxis::kZ;
+  renderOptions.scale = conversion.metresPerUnit.value_or(args.scale);
+  renderOptions.keepDom = !args.dom.empty();
+  return renderOptions;
+}
+
+// A --hair file as the render stage takes it: with --translate, converted (--units, --up-axis, --scale)
+// and moved here, since the move comes after the conversion.
+Strands readHair(const RenderArgs& args, const RenderOptions& renderOptions, const std::string& file) {
+  Strands h = readStrands(file);
+  if (!args.translate.empty()) {
+    conform(h, renderOptions.zUp, renderOptions.scale);
+    const glm::vec3 offset(args.translate[0], args.translate[1], args.translate[2]);
+    for (glm::vec3& p : h.points) p += offset;
+  }
+  return h;
+}
+
+// A frame's hair can be rendered: the same strands as the frame before (for motion vectors), and the
+// volume normals a volumetric ShadingModel needs.
+void checkFrameHair(const Config& config, const Strands& hair, const std::string& hairFile,
+                    const FrameBefore& before, const std::string& hairFileBefore) {
+  if (before.hair && !sameStrands(hair, *before.hair))
+    throw InputError({hairFile, 0}, "has other strands than " + hairFileBefore +
+                                        " (frames of a sequence have the same strands and points), so "
+                                        "no motion vectors can be drawn between them");
+  if (config.render.shadingModel == ShadingModel::kVolumetric && config.render.volumetricBlend > 0.0 &&
+      hair.normals.empty())
+    throw InputError({hairFile, 0},
+                     "ShadingModel volumetric needs the coupe's volume normals, and this one "
+                     "has none; run `hairgen shade SETUP --hair " +
+                         hairFile + " -o shaded.hair` and render that");
+}
+
+// Renders the frames (one image without --frames) and writes each: its hair a coupe file, or with
+// --guides the shot's frame from its guides (stages/shot.h, the stage `run` calls, so the image is
+// run's). One device for every frame.
+void renderFrames(const RenderArgs& args, const Config& config, const ShotInputs& shot, FrameRange frames,
+                  Stats& stats, Stopwatch& clock) {
+  const bool sequence = args.sequence();
+  const RenderOptions renderOptions = renderOptionsOf(args);
+  // One context for every frame, opened once the first frame's hair has been read: bad input is
+  // exit 2 on a machine without a device too, not 3.
+  std::unique_ptr<GlContext> gl;
+  // Motion vectors of frame f are the movement from frame f - 1 whenever that frame is in the shot
+  // (Dynamics Info's Frames; without one, the frames rendered), so a range split across jobs gives
+  // the same vectors as one job; the shot's first frame has nothing before it and moves by 0.
+  const int shotStart = config.dynamics.given ? config.dynamics.firstFrame : frames.first;
+  ShotMotion before;  // with --motion, the frame before
+  std::string hairFileBefore;
+  if (args.motion && !config.dynamics.given)
+    note(args.common, "hairgen render: no Dynamics Info names the shot's first frame, so frame " +
+                          std::to_string(frames.first) +
+                          " is taken as the first and moves by 0; a range split into jobs gives other "
+                          "vectors where it is split (name the shot's DynamicsInfo in the Setup)");
+  // --translate moves the hair after its conversion, so the stage gets it converted and moved.
+  RenderOptions frameOptions = renderOptions;
+  if (!args.translate.empty()) frameOptions.zUp = false, frameOptions.scale = 1.0;
+  // A frame's hair and head. In a sequence the head moves with its keys (Dynamics Info), as the hair's
+  // roots did; a single image has the head at rest.
+  const std::string& pattern = args.fromGuides() ? args.guides : args.hair;
+  auto loadFrame = [&](int f, std::string& file) {
+    file = args.file(pattern, f);
+    if (args.fromGuides()) return shotFrame(shot, f, readStrands(file), file);
+    return ShotFrame{readHair(args, renderOptions, file), sequence ? shotHead(shot, f) : std::nullopt};
   };
-  auto options = std::make_shared<Options>();
+  // A sequence aims an auto camera (or --frame) at its shot's first frame, so the camera holds still
+  // and a range split into jobs sees through the same camera; when that frame's file is gone, at the
+  // range's first.
+  std::optional<Strands> framing;
+  if (sequence && (args.frame || config.render.cameraAuto)) {
+    std::string file;
+    framing =
+        loadFrame(fs::is_regular_file(args.file(pattern, shotStart)) ? shotStart : frames.first, file).coupe;
+    frameOptions.framing = &*framing;
+  }
+  if (args.motion && frames.first - 1 >= shotStart) before.keep(loadFrame(frames.first - 1, hairFileBefore));
+  Progress progress("render", "frames", size_t(frames.count()), sequence && !args.common.quiet);
+  // One image: its passes are the progress (a 1080p coupe spends seconds in each on llvmpipe).
+  Progress passes("render", "passes", renderPassCount(args.motion), !sequence && !args.common.quiet);
+  if (!sequence) frameOptions.progress = &passes;
+  for (int f = frames.first; f <= frames.last; ++f) {
+    std::string hairFile;
+    ShotFrame frame = loadFrame(f, hairFile);
+    Strands& hair = frame.coupe;
+    if (args.motion && !before.started()) hairFileBefore = hairFile;  // no motion at the shot's start
+    const FrameBefore frameBefore = args.motion ? before.before(frame) : FrameBefore{};
+    checkFrameHair(config, hair, hairFile, frameBefore, hairFileBefore);
+    stats.add("read", clock.lap());
+    // Without motion vectors the frame's hair has no use once the render reads it no more: freed
+    // then (after the upload where the device copies it, so the passes run without a second copy
+    // of a 150,000-strand coupe's 230 MB).
+    frameOptions.uploaded = nullptr;
+    if (!args.motion) frameOptions.uploaded = [&hair] { hair = Strands{}; };
+    if (!gl) gl = openDevice(args.common, config, stats);
+    RenderOutput out = renderStage(args.common, config, *gl, hair,
+                                   frame.head  ? &*frame.head
+                                   : shot.head ? shot.head
+                                               : nullptr,
+                                   frameOptions, stats, args.motion ? &frameBefore : nullptr);
+    clock.lap();
+    // The image's config digest is the Setup's, as `run` and a farm plan write and expect it (an auto
+    // camera is part of the Setup: the same inputs aim it the same way). --frame, which is not,
+    // aims the camera and light itself: then the digest is that of the ones it rendered with.
+    Config rendered = config;
+    if (args.frame) rendered.render = out.settings;
+    writeRenderOutputs(rendered, out, args.file(args.output, f), args.file(args.dom, f),
+                       args.file(args.preview, f));
+    if (sequence) keepCommittedOutputs();  // a finished frame stays, whatever a later one does
+    stats.add("write", clock.lap());
+    if (args.motion) {
+      hairFileBefore = hairFile;
+      before.keep(std::move(frame));
+    }
+    progress.advance();
+  }
+  progress.finish();
+  passes.finish();
+}
+
+// What was written: a sequence names its first and last frames' files, as run does.
+std::string writtenFiles(const RenderArgs& args, FrameRange frames, const std::string& files) {
+  return args.sequence() && frames.last > frames.first
+             ? args.file(files, frames.first) + " to " + args.file(files, frames.last)
+             : args.file(files, frames.last);
+}
+
+}  // namespace
+
+void registerRender(CLI::App& app, int& exitCode) {
+  auto options = std::make_shared<RenderArgs>();
   std::string models;  // from the one list the config reader takes
   for (ShadingModel model : kShadingModels) models += std::string(models.empty() ? "" : ", ") + name(model);
   CLI::App* cmd = app.add_subcommand(
@@ -128,237 +362,34 @@ void registerRender(CLI::App& app, int& exitCode) {
       "Render a coupe headless (EGL) to EXR: the hair lit by Render Info's ShadingModel (" + models +
           "), a Lambert head, deep opacity map shadows. With --frames, a sequence in one process: per-frame "
           "coupes (--hair PATTERN) or a simulated shot's guides (--guides PATTERN)");
-  cmd->add_option("SETUP", options->setup, "The Setup file (Visuality and Render Info, the head)")
-      ->required();
-  cmd->add_option("--hair", options->hair,
-                  "The coupe: .hair (also cyHair files made elsewhere), .gltf, .glb, .ply or .data")
-      ->type_name("FILE");
-  cmd->add_option("-o,--output", options->output,
-                  "Image to write: .exr with R G B A (half, premultiplied), Z, opacity.Y, shadow.Y")
-      ->type_name("FILE.exr")
-      ->required();
-  cmd->add_option("--dom", options->dom,
-                  "Also write the light's maps: Z where the hair begins and the 4 opacity layers")
-      ->type_name("FILE.exr");
-  cmd->add_option("--preview", options->preview, "Also write an sRGB preview, over Render Info's Background")
-      ->type_name("FILE.png");
-  addUnitFlags(*cmd, options->units, "the hair file");
-  CLI::Option* scale =
-      cmd->add_option("--scale", options->scale,
-                      "Multiply the hair's positions and widths by FACTOR > 0: --units as a factor")
-          ->type_name("FACTOR")
-          ->check(kFiniteNonNegative & CLI::PositiveNumber);
-  scale->excludes(cmd->get_option("--units"));
-  cmd->add_option("--translate", options->translate,
-                  "Move the hair by X Y Z metres (each within +-10 km) after --units/--up-axis/--scale, to "
-                  "sit it on the "
-                  "head")
-      ->expected(3)
-      ->type_name("X Y Z")
-      ->check(CLI::Range(-1e4, 1e4));
-  cmd->add_flag("--frame", options->frame, "Aim the camera and light at the hair and fit it in the view");
-  cmd->add_option(
-         "--frames", options->frames,
-         "Render these frames of a sequence in one process, one device: --hair, -o, --dom and --preview "
-         "are patterns with ####, and the head moves with the Setup's HeadKeys")
-      ->type_name("A-B");
-  cmd->add_flag("--motion", options->motion,
-                "With --frames, motion vectors too: the layer motion.u, motion.v, pixels moved since the "
-                "frame before (from the --hair pattern's previous frame while it is in the shot)");
-  cmd->add_option(
-         "--guides", options->guides,
-         "With --frames, instead of --hair: a simulated sequence's guides (sim/guides.####.hair), each "
-         "frame interpolated and, when the Setup shades, re-posed from --rest in memory, as `run` "
-         "does: a farm's frame chunk writes no per-frame coupes")
-      ->type_name("PATTERN")
-      ->excludes("--hair")
-      ->needs("--frames");
-  cmd->add_option("--rest", options->rest,
-                  "With --guides: the shaded rest coupe whose normals and colours each frame takes (`shade` "
-                  "--rest); needed when the Setup shades")
-      ->type_name("FILE")
-      ->needs("--guides");
+  addRenderFlags(*cmd, *options);
   addCommonFlags(*cmd, options->common, true);
   addStandaloneFlag(*cmd, "--list-devices",
                     "List the EGL devices and platforms found, and exit (no SETUP needed)",
                     [options] { return runCommand("render", options->common, listDevices); });
   cmd->callback([options, &exitCode] {
     exitCode = runCommand("render", options->common, [&] {
-      const bool fromGuides = !options->guides.empty();
-      if (options->hair.empty() && !fromGuides)
-        throw InputError("render needs --hair FILE (or --frames with --guides PATTERN): the coupe to render");
-      requireExtension(options->output, ".exr", "-o");
-      if (!options->dom.empty()) requireExtension(options->dom, ".exr", "--dom");
-      if (!options->preview.empty()) requireExtension(options->preview, ".png", "--preview");
+      const RenderArgs& args = *options;
+      checkRenderArgs(args);
       Stats stats("render");
       Stopwatch clock;
-      Config config = loadStageConfig(options->setup, options->common,
-                                      fromGuides ? SetupUse::kRun : SetupUse::kRender, stats);
-      const bool sequence = !options->frames.empty();
-      if (options->motion && !sequence)
-        throw InputError("--motion needs --frames: motion vectors are the movement since the frame before");
-      const FrameRange frames = sequence ? parseFrameRange(options->frames, "--frames") : FrameRange{0, 0};
-      if (sequence)
-        for (const std::string* pattern :
-             {&options->hair, &options->guides, &options->output, &options->dom, &options->preview})
-          if (!pattern->empty() && !isFramePattern(*pattern))
-            throw InputError(*pattern + ": with --frames, write #### where the frame number goes");
-      auto frameFile = [&](const std::string& pattern, int f) {
-        return sequence && !pattern.empty() ? framePath(pattern, f).string() : pattern;
-      };
-      // Where it will write, before the work (a sequence's first frame's files).
-      for (const std::string* file : {&options->output, &options->dom, &options->preview})
-        if (!file->empty()) requireWritableOutput(frameFile(*file, frames.first));
-      Scene scene = readScene(options->common, config, fromGuides, true, stats);
-      std::optional<Mesh> head = std::move(scene.head);
-      const HeadMotion motion = headMotionOf(config);
-      // From guides: what `run` does to a frame of a shot, in the same order, so the images are its.
+      Config config = loadStageConfig(args.setup, args.common,
+                                      args.fromGuides() ? SetupUse::kRun : SetupUse::kRender, stats);
+      const FrameRange frames = renderedFrames(args);
+      Scene scene = readScene(args.common, config, args.fromGuides(), true, stats);
       const bool shaded = wantsShade(config.visuality, config.render);
-      if (fromGuides && shaded && options->rest.empty())
-        throw InputError(
-            "--guides: this Setup shades, so each frame takes its normals from the shaded rest "
-            "coupe: name it with --rest shaded.hair");
-      if (fromGuides && !shaded && !options->rest.empty())
-        throw InputError("--rest: this Setup does not shade; each frame is rendered as interpolated");
-      Strands rest;
-      if (!options->rest.empty()) rest = readStrands(options->rest);
+      const Strands rest = readShadedRest(args, shaded);
       stats.time("read", clock.lap());
-      RenderOptions renderOptions;
-      renderOptions.frame = options->frame;
-      const UnitConversion conversion = unitConversion(options->units);
-      renderOptions.zUp = conversion.upAxis == UpAxis::kZ;
-      renderOptions.scale = conversion.metresPerUnit.value_or(options->scale);
-      // --units, --up-axis and --scale describe the hair file alone: the head is read as the Setup says
-      // (MeshUnits, MeshUpAxis), so foreign hair sits on the bundled head; a head in the hair's units
-      // is asked for with --set Setup.MeshUnits=U (docs/real-heads.md).
-      renderOptions.keepDom = !options->dom.empty();
-      // One context for every frame, opened once the first frame's hair has been read: bad input is
-      // exit 2 on a machine without a device too, not 3.
-      std::unique_ptr<GlContext> gl;
-      // Motion vectors of frame f are the movement from frame f - 1 whenever that frame is in the shot
-      // (Dynamics Info's Frames; without one, the frames rendered), so a range split across jobs gives
-      // the same vectors as one job; the shot's first frame has nothing before it and moves by 0.
-      const int shotStart = config.dynamics.given ? config.dynamics.firstFrame : frames.first;
-      std::optional<Strands> hairBefore;
-      std::optional<Mesh> headBefore;
-      std::string hairFileBefore;
-      auto poseHead = [&](int f) -> std::optional<Mesh> {
-        if (head && sequence && !motion.still()) return posedMesh(*head, motion.pose(f));
-        return std::nullopt;
-      };
-      if (options->motion && !config.dynamics.given)
-        note(options->common,
-             "hairgen render: no Dynamics Info names the shot's first frame, so frame " +
-                 std::to_string(frames.first) +
-                 " is taken as the first and moves by 0; a range split into jobs gives other "
-                 "vectors where it is split (name the shot's DynamicsInfo in the Setup)");
-      // --translate moves the hair after its conversion, so the stage gets it converted and moved.
-      RenderOptions frameOptions = renderOptions;
-      if (!options->translate.empty()) frameOptions.zUp = false, frameOptions.scale = 1.0;
-      auto readHair = [&](const std::string& file) {
-        Strands h = readStrands(file);
-        if (!options->translate.empty()) {
-          conform(h, renderOptions.zUp, renderOptions.scale);
-          const glm::vec3 offset(options->translate[0], options->translate[1], options->translate[2]);
-          for (glm::vec3& p : h.points) p += offset;
-        }
-        return h;
-      };
-      // A frame's hair: its coupe file, or with --guides its guides interpolated (and re-posed from the
-      // shaded rest) as `run` does it, so the image is run's.
-      const std::string& pattern = fromGuides ? options->guides : options->hair;
-      auto loadFrame = [&](int f, std::string& file) {
-        file = frameFile(pattern, f);
-        if (!fromGuides) return readHair(file);
-        const InterpolateOptions interpolation{config.digest(), file, nullptr, options->common.force,
-                                               motion.pose(f).matrix()};
-        Strands coupe =
-            interpolate(*scene.wick, readStrands(file), config.hairstyle, config.collision, interpolation);
-        if (shaded) coupe = repose(rest, coupe);
-        return coupe;
-      };
-      // A sequence aims an auto camera (or --frame) at its shot's first frame, so the camera holds still
-      // and a range split into jobs sees through the same camera; when that frame's file is gone, at the
-      // range's first.
-      std::optional<Strands> framing;
-      if (sequence && (options->frame || config.render.cameraAuto)) {
-        std::string file;
-        framing =
-            loadFrame(fs::is_regular_file(frameFile(pattern, shotStart)) ? shotStart : frames.first, file);
-        frameOptions.framing = &*framing;
-      }
-      if (options->motion && frames.first - 1 >= shotStart) {
-        hairBefore = loadFrame(frames.first - 1, hairFileBefore);
-        headBefore = poseHead(frames.first - 1);
-      }
-      Progress progress("render", "frames", size_t(frames.count()), sequence && !options->common.quiet);
-      // One image: its passes are the progress (a 1080p coupe spends seconds in each on llvmpipe).
-      Progress passes("render", "passes", renderPassCount(options->motion),
-                      !sequence && !options->common.quiet);
-      if (!sequence) frameOptions.progress = &passes;
-      for (int f = frames.first; f <= frames.last; ++f) {
-        std::string hairFile;
-        Strands hair = loadFrame(f, hairFile);
-        if (options->motion && !hairBefore) {
-          hairBefore = hair;  // nothing before the shot: no motion
-          hairFileBefore = hairFile;
-          headBefore = poseHead(f);
-        }
-        if (hairBefore && !sameStrands(hair, *hairBefore))
-          throw InputError({hairFile, 0}, "has other strands than " + hairFileBefore +
-                                              " (frames of a sequence have the same strands and points), so "
-                                              "no motion vectors can be drawn between them");
-        if (config.render.shadingModel == ShadingModel::kVolumetric && config.render.volumetricBlend > 0.0 &&
-            hair.normals.empty())
-          throw InputError({hairFile, 0},
-                           "ShadingModel volumetric needs the coupe's volume normals, and this one "
-                           "has none; run `hairgen shade SETUP --hair " +
-                               hairFile + " -o shaded.hair` and render that");
-        // In a sequence the head moves with its keys (Dynamics Info), as the hair's roots did.
-        std::optional<Mesh> posedHead = poseHead(f);
-        stats.add("read", clock.lap());
-        // Without motion vectors the frame's hair has no use once the render reads it no more: freed
-        // then (after the upload where the device copies it, so the passes run without a second copy
-        // of a 150,000-strand coupe's 230 MB).
-        frameOptions.uploaded = nullptr;
-        if (!options->motion) frameOptions.uploaded = [&hair] { hair = Strands{}; };
-        FrameBefore before{hairBefore ? &*hairBefore : nullptr, headBefore ? &*headBefore
-                                                                : head     ? &*head
-                                                                           : nullptr};
-        if (!gl) gl = openDevice(options->common, config, stats);
-        RenderOutput out = renderStage(options->common, config, *gl, hair,
-                                       posedHead ? &*posedHead
-                                       : head    ? &*head
-                                                 : nullptr,
-                                       frameOptions, stats, options->motion ? &before : nullptr);
-        clock.lap();
-        // The image's config digest is the Setup's, as `run` and a farm plan write and expect it (an auto
-        // camera is part of the Setup: the same inputs aim it the same way). --frame, which is not,
-        // aims the camera and light itself: then the digest is that of the ones it rendered with.
-        Config rendered = config;
-        if (options->frame) rendered.render = out.settings;
-        writeRenderOutputs(rendered, out, frameFile(options->output, f), frameFile(options->dom, f),
-                           frameFile(options->preview, f));
-        if (sequence) keepCommittedOutputs();  // a finished frame stays, whatever a later one does
-        stats.add("write", clock.lap());
-        if (options->motion) {
-          hairBefore = std::move(hair);
-          hairFileBefore = hairFile;
-          headBefore = std::move(posedHead);
-        }
-        progress.advance();
-      }
-      progress.finish();
-      passes.finish();
-      // A sequence names its first and last frames' files, as run does.
-      auto written = [&](const std::string& files) {
-        return sequence && frames.last > frames.first
-                   ? frameFile(files, frames.first) + " to " + frameFile(files, frames.last)
-                   : frameFile(files, frames.last);
-      };
-      note(options->common, "render: wrote " + written(options->output) +
-                                (options->preview.empty() ? "" : " and " + written(options->preview)));
-      stats.write(options->common);
+      const ShotInputs shot{&config,
+                            scene.wick ? &*scene.wick : nullptr,
+                            shaded ? &rest : nullptr,
+                            scene.head ? &*scene.head : nullptr,
+                            headMotionOf(config),
+                            args.common.force};
+      renderFrames(args, config, shot, frames, stats, clock);
+      note(args.common, "render: wrote " + writtenFiles(args, frames, args.output) +
+                            (args.preview.empty() ? "" : " and " + writtenFiles(args, frames, args.preview)));
+      stats.write(args.common);
     });
   });
 }

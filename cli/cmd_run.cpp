@@ -22,6 +22,7 @@
 #include "stages/estimate.h"
 #include "stages/interpolate.h"
 #include "stages/shade.h"
+#include "stages/shot.h"
 #include "stages/simulate.h"
 
 namespace hairgen::cli {
@@ -64,10 +65,12 @@ void runShot(const CommonOptions& common, const Config& config, const Mesh& wick
              bool motionVectors, Stats& stats) {
   const Dynamics& d = config.dynamics;
   const FrameRange frames{d.firstFrame, wanted.last};  // simulated
-  const HeadMotion motion = headMotionOf(config);
-  const bool shaded = wantsShade(config.visuality, config.render);
   std::optional<Mesh> head;
   if (render && config.setup.headModel.given()) head = readHead(config);
+  const bool shaded = wantsShade(config.visuality, config.render);
+  const ShotInputs inputs{
+      &config,     &wick, shaded ? &restCoupe : nullptr, head ? &*head : nullptr, headMotionOf(config),
+      common.force};
   std::unique_ptr<GlContext> gl;
   if (render) gl = openDevice(common, config, stats);
   const fs::path simPattern = out / "sim" / "guides.####.hair", exrPattern = out / "beauty.####.exr",
@@ -76,8 +79,8 @@ void runShot(const CommonOptions& common, const Config& config, const Mesh& wick
                    " at " + formatReal(d.frameRate) + " fps");
   Progress progress("run", "frames", size_t(frames.count()), !common.quiet);
   Stopwatch clock;
-  std::optional<Strands> coupeBefore, firstCoupe;
-  std::optional<Mesh> headBefore;
+  std::optional<Strands> firstCoupe;
+  ShotMotion before;            // with motion vectors, the frame before
   RenderOptions renderOptions;  // an auto camera aims at the shot's first frame and holds still
   SimulateOptions simOptions;
   simOptions.configDigest = config.digest();
@@ -97,23 +100,17 @@ void runShot(const CommonOptions& common, const Config& config, const Mesh& wick
     }
     const bool needed = written || f == frames.first || (motionVectors && f == wanted.first - 1);
     if (!render || !needed) return progress.advance();
-    InterpolateOptions interpolation{config.digest(), framePath(simPattern, f).string(), nullptr,
-                                     common.force, motion.pose(f).matrix()};
-    Strands coupe = interpolate(wick, frameGuides, config.hairstyle, config.collision, interpolation);
-    if (shaded) coupe = repose(restCoupe, coupe);
+    ShotFrame frame = shotFrame(inputs, f, frameGuides, framePath(simPattern, f).string());
     stats.add("interpolate", clock.lap());
-    std::optional<Mesh> posedHead;
-    if (head) posedHead = motion.still() ? *head : posedMesh(*head, motion.pose(f));
-    if (motionVectors && !coupeBefore) coupeBefore = coupe, headBefore = posedHead;
-    if (!firstCoupe) renderOptions.framing = &firstCoupe.emplace(coupe);
+    if (!firstCoupe) renderOptions.framing = &firstCoupe.emplace(frame.coupe);
     if (!written) {  // only what a written frame needs
-      if (motionVectors) coupeBefore = std::move(coupe), headBefore = std::move(posedHead);
+      if (motionVectors) before.keep(std::move(frame));
       return progress.advance();
     }
-    const FrameBefore before{coupeBefore ? &*coupeBefore : nullptr, headBefore ? &*headBefore : nullptr};
-    RenderOutput image = renderStage(common, config, *gl, coupe, posedHead ? &*posedHead : nullptr,
-                                     renderOptions, stats, motionVectors ? &before : nullptr);
-    if (motionVectors) coupeBefore = std::move(coupe), headBefore = std::move(posedHead);
+    const FrameBefore frameBefore = motionVectors ? before.before(frame) : FrameBefore{};
+    RenderOutput image = renderStage(common, config, *gl, frame.coupe, frame.head ? &*frame.head : nullptr,
+                                     renderOptions, stats, motionVectors ? &frameBefore : nullptr);
+    if (motionVectors) before.keep(std::move(frame));
     clock.lap();
     writeRenderOutputs(config, image, framePath(exrPattern, f).string(), "",
                        framePath(pngPattern, f).string());
@@ -141,6 +138,90 @@ void runShot(const CommonOptions& common, const Config& config, const Mesh& wick
     std::cerr << "hairgen run: warning: no preview movie: " << oneLine(e.what()) << "; the frames are kept\n";
   }
   stats.add("movie", clock.lap());
+}
+
+// DIR made, and writable: a name that is already something else (or a link to nothing) is bad usage;
+// a folder that cannot be made (read-only file system, permissions) is the work failing to write.
+void makeOutputFolder(const fs::path& out) {
+  try {
+    createOutputFolder(out);
+  } catch (const Error& e) {
+    throw Error(e.code(), {}, "-o " + out.string() + ": cannot create the output folder: " + e.what());
+  }
+  // The first file it writes, before minutes of growing: a folder it cannot write in is found now.
+  requireWritableOutput(out / "guides.hair");
+}
+
+// What a run renders: the wick and the guides grown on it (none when the Setup Loads a coupe), and the
+// coupe.
+struct RunCoupe {
+  Mesh wick;
+  Strands guides;
+  Strands coupe;
+};
+
+// The coupe loaded, or grown and interpolated (DIR/guides.hair, DIR/coupe.hair); shaded when the Setup
+// asks (DIR/shaded.hair) and saved where it says Save.
+RunCoupe runCoupe(const CommonOptions& common, Config& config, const fs::path& out, bool render, Stats& stats,
+                  Stopwatch& clock) {
+  RunCoupe made;
+  Strands& coupe = made.coupe;
+  Mesh& wick = made.wick;
+  if (config.setup.load && config.dynamics.given)
+    throw InputError(config.setup.file.string() +
+                     ": Load and DynamicsInfo together: a shot simulates the guides, "
+                     "which a loaded coupe does not have; grow them (Load false)");
+  if (config.setup.load) {
+    coupe = readStrands(config.setup.loadFile.path);
+    note(common, "run: loaded " + config.setup.loadFile.path.string() + " (" +
+                     std::to_string(coupe.strandCount()) + " strands)");
+  } else {
+    wick = *readScene(common, config, true, false, stats).wick;
+    stats.add("read", clock.lap());
+    if (wick.triangles.empty())  // refused before minutes of growing, not after
+      throw InputError({config.setup.wickModel.path.string(), 0},
+                       "the wick has no faces, only points (roots): `hairgen grow` grows guides on them, "
+                       "but run interpolates strands over a surface and needs one (a scalp mesh)");
+    // Every stage's work is estimated before the first starts: a coupe that cannot be rendered is
+    // refused before minutes of growing.
+    for (const WorkEstimate& e : estimateRun(config, wick, wantsShade(config.visuality, config.render),
+                                             render, size_t(tbb::this_task_arena::max_concurrency())))
+      requireFits(e, common.force);
+    made.guides = growStage(common, config, wick, stats).guides;
+    const fs::path guidesFile = out / "guides.hair";
+    clock.lap();
+    writeStrands(guidesFile, made.guides);
+    double writing = clock.lap();
+    coupe = interpolateStage(common, config, wick, made.guides, guidesFile.string(), stats);
+    clock.lap();
+    writeStrands(out / "coupe.hair", coupe);
+    stats.time("write", writing + clock.lap());
+    note(common, "run: wrote " + guidesFile.string() + " and " + (out / "coupe.hair").string());
+  }
+  if (wantsShade(config.visuality, config.render)) {
+    coupe = shadeStage(common, config, std::move(coupe), stats).coupe;
+    clock.lap();
+    writeStrands(out / "shaded.hair", coupe);
+    stats.add("write", clock.lap());
+  }
+  if (config.setup.save) {
+    writeStrands(config.setup.saveFile.path, coupe);
+    note(common, "run: saved the coupe to " + config.setup.saveFile.path.string());
+  }
+  return made;
+}
+
+// A still: DIR/beauty.exr and DIR/beauty.png.
+void runStill(const CommonOptions& common, const Config& config, const Strands& coupe, const fs::path& out,
+              Stats& stats, Stopwatch& clock) {
+  std::optional<Mesh> head;
+  if (config.setup.headModel.given()) head = readHead(config);
+  const std::unique_ptr<GlContext> gl = openDevice(common, config, stats);
+  RenderOutput image = renderStage(common, config, *gl, coupe, head ? &*head : nullptr, {}, stats);
+  clock.lap();
+  writeRenderOutputs(config, image, (out / "beauty.exr").string(), "", (out / "beauty.png").string());
+  stats.add("write", clock.lap());
+  note(common, "run: wrote " + (out / "beauty.exr").string() + " and " + (out / "beauty.png").string());
 }
 
 // run --frames A-B (none: Dynamics Frames, on a still too), within the shot's frames.
@@ -198,76 +279,13 @@ void registerRun(CLI::App& app, int& exitCode) {
         throw InputError(setup.string() + ": --motion renders motion vectors of a shot, and " +
                          (options->noRender ? "--no-render renders nothing"
                                             : "this Setup names no Dynamics Info (DynamicsInfo FILE)"));
-      // A name that is already something else (or a link to nothing) is bad usage; a folder that cannot
-      // be made (read-only file system, permissions) is the work failing to write.
-      try {
-        createOutputFolder(out);
-      } catch (const Error& e) {
-        throw Error(e.code(), {}, "-o " + out.string() + ": cannot create the output folder: " + e.what());
-      }
-      // The first file it writes, before minutes of growing: a folder it cannot write in is found now.
-      requireWritableOutput(out / "guides.hair");
-
-      Strands coupe;
-      Mesh wick;
-      GrowResult grown;
-      if (config.setup.load && config.dynamics.given)
-        throw InputError(config.setup.file.string() +
-                         ": Load and DynamicsInfo together: a shot simulates the guides, "
-                         "which a loaded coupe does not have; grow them (Load false)");
-      if (config.setup.load) {
-        coupe = readStrands(config.setup.loadFile.path);
-        note(options->common, "run: loaded " + config.setup.loadFile.path.string() + " (" +
-                                  std::to_string(coupe.strandCount()) + " strands)");
-      } else {
-        wick = *readScene(options->common, config, true, false, stats).wick;
-        stats.add("read", clock.lap());
-        if (wick.triangles.empty())  // refused before minutes of growing, not after
-          throw InputError({config.setup.wickModel.path.string(), 0},
-                           "the wick has no faces, only points (roots): `hairgen grow` grows guides on them, "
-                           "but run interpolates strands over a surface and needs one (a scalp mesh)");
-        // Every stage's work is estimated before the first starts: a coupe that cannot be rendered is
-        // refused before minutes of growing.
-        for (const WorkEstimate& e :
-             estimateRun(config, wick, wantsShade(config.visuality, config.render), !options->noRender,
-                         size_t(tbb::this_task_arena::max_concurrency())))
-          requireFits(e, options->common.force);
-        grown = growStage(options->common, config, wick, stats);
-        const fs::path guidesFile = out / "guides.hair";
-        clock.lap();
-        writeStrands(guidesFile, grown.guides);
-        double writing = clock.lap();
-        coupe = interpolateStage(options->common, config, wick, grown.guides, guidesFile.string(), stats);
-        clock.lap();
-        writeStrands(out / "coupe.hair", coupe);
-        stats.time("write", writing + clock.lap());
-        note(options->common, "run: wrote " + guidesFile.string() + " and " + (out / "coupe.hair").string());
-      }
-      if (wantsShade(config.visuality, config.render)) {
-        coupe = shadeStage(options->common, config, std::move(coupe), stats).coupe;
-        clock.lap();
-        writeStrands(out / "shaded.hair", coupe);
-        stats.add("write", clock.lap());
-      }
-      if (config.setup.save) {
-        writeStrands(config.setup.saveFile.path, coupe);
-        note(options->common, "run: saved the coupe to " + config.setup.saveFile.path.string());
-      }
-      if (config.dynamics.given) {
-        runShot(options->common, config, wick, grown.guides, coupe, out, frames, !options->noRender,
+      makeOutputFolder(out);
+      const RunCoupe made = runCoupe(options->common, config, out, !options->noRender, stats, clock);
+      if (config.dynamics.given)
+        runShot(options->common, config, made.wick, made.guides, made.coupe, out, frames, !options->noRender,
                 options->motion, stats);
-      } else if (!options->noRender) {
-        std::optional<Mesh> head;
-        if (config.setup.headModel.given()) head = readHead(config);
-        const std::unique_ptr<GlContext> gl = openDevice(options->common, config, stats);
-        RenderOutput image =
-            renderStage(options->common, config, *gl, coupe, head ? &*head : nullptr, {}, stats);
-        clock.lap();
-        writeRenderOutputs(config, image, (out / "beauty.exr").string(), "", (out / "beauty.png").string());
-        stats.add("write", clock.lap());
-        note(options->common,
-             "run: wrote " + (out / "beauty.exr").string() + " and " + (out / "beauty.png").string());
-      }
+      else if (!options->noRender)
+        runStill(options->common, config, made.coupe, out, stats, clock);
       stats.write(options->common);
     });
   });
