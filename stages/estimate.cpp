@@ -11,7 +11,7 @@
 #include "libcore/util/error.h"
 #include "libcore/util/resources.h"
 #include "libcore/util/text.h"
-#include "libcore/volume/hair_volume.h"
+#include "libcore/volume/splat.h"
 
 namespace hairgen {
 namespace {

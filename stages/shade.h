@@ -15,7 +15,7 @@
 
 #include "libcore/config/params.h"
 #include "libcore/model/strands.h"
-#include "libcore/volume/hair_volume.h"
+#include "libcore/volume/shell.h"
 
 namespace hairgen {
 

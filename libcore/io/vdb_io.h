@@ -3,7 +3,7 @@
 
 #include <filesystem>
 
-#include "libcore/volume/hair_volume.h"
+#include "libcore/volume/shell.h"
 
 namespace hairgen {
 

@@ -40,7 +40,7 @@
 //   splatted on fixed grids per spacing: eight of them, the same grid shifted by half a cell along every
 //   combination of axes, and E is the mean of the eight grids' energies (one grid's E depends on where
 //   its cell walls fall; the mean much less). A particle's acceleration is DensityStrength times the
-//   mean of the eight grids' memo's F (densityForce in libcore/volume/hair_volume.h), so −∂E/∂P, over
+//   mean of the eight grids' memo's F (densityForce in libcore/volume/density_target.h), so −∂E/∂P, over
 //   the target's mean density where it has any, so the strength means the same on every grid: the
 //   acceleration of a point where the density is wrong by the target's mean from one node to the next.
 //   Spacings go from coarse to fine: at each frame the hair uses the finest spacing all of whose
@@ -63,7 +63,8 @@
 #include "libcore/config/params.h"
 #include "libcore/model/strands.h"
 #include "libcore/physics/head_motion.h"
-#include "libcore/volume/hair_volume.h"
+#include "libcore/volume/density_target.h"
+#include "libcore/volume/splat.h"
 
 namespace hairgen {
 
