@@ -1,5 +1,5 @@
 // hairgen farm plan SETUP -o DIR | submit PLAN --scheduler slurm [--wait] [--dry-run]: the work of
-// `hairgen run` split into tasks (stages/farm_plan.h), and the plan handed to a scheduler (farm/: the
+// `hairgen run` split into tasks (farm/plan.h), and the plan handed to a scheduler (farm/: the
 // done check every back end shares, the Slurm back end, the process runner and the shell quoting).
 //
 // A task is done when all its outputs exist and carry the plan's config digest (farm/done.h), so
@@ -18,13 +18,11 @@
 #include "cli/commands.h"
 #include "cli/common.h"
 #include "farm/done.h"
+#include "farm/plan.h"
 #include "farm/slurm.h"
-#include "libcore/io/hair_io.h"
 #include "libcore/io/obj_io.h"
 #include "libcore/util/file_util.h"
 #include "libcore/util/json.h"
-#include "libcore/util/text.h"
-#include "stages/farm_plan.h"
 
 namespace hairgen::cli {
 namespace {
@@ -83,22 +81,33 @@ void submit(const FarmPlan& plan, const std::string& planFile, bool dryRun, bool
   if (!dryRun && wait) scheduler->wait(plan);
 }
 
-}  // namespace
+struct PlanOptions {
+  CommonOptions common;
+  std::string setup, outDir, frames;
+  int shards = 4, chunk = 5, cpus = 4;
+};
 
-void registerFarm(CLI::App& app, int& exitCode) {
-  CLI::App* farm = app.add_subcommand(
-      "farm",
-      "The work of `hairgen run` as tasks for a render farm: `farm plan` writes them, `farm submit` "
-      "hands them to a scheduler (Slurm)");
-  farm->require_subcommand(1);
+// What planFarm needs from the command line: this program, absolute paths, the overrides every task
+// repeats, the limits.
+FarmPlanOptions farmPlanOptions(const PlanOptions& o) {
+  FarmPlanOptions options;
+  options.hairgen = executablePath();
+  options.setup = fs::absolute(o.setup).lexically_normal().string();
+  options.directory = fs::absolute(o.outDir).lexically_normal().string();
+  if (options.directory.size() > 1 && options.directory.back() == '/') options.directory.pop_back();
+  for (const std::string& s : o.common.sets) options.overrides.insert(options.overrides.end(), {"--set", s});
+  if (o.common.seed)
+    options.overrides.insert(options.overrides.end(), {"--seed", std::to_string(*o.common.seed)});
+  options.shards = o.shards;
+  options.chunk = o.chunk;
+  options.maxCpus = o.cpus;
+  options.threads = size_t(tbb::this_task_arena::max_concurrency());
+  return options;
+}
 
-  struct PlanOptions {
-    CommonOptions common;
-    std::string setup, outDir, frames;
-    int shards = 4, chunk = 5, cpus = 4;
-  };
+void registerFarmPlan(CLI::App& farm, int& exitCode) {
   auto planOptions = std::make_shared<PlanOptions>();
-  CLI::App* plan = farm->add_subcommand(
+  CLI::App* plan = farm.add_subcommand(
       "plan",
       "Write DIR/plan.json: the tasks of `hairgen run` on SETUP (guides and coupe in shards, merged; a shot "
       "simulated, then interpolated, shaded and rendered in chunks of frames), each with its command, "
@@ -136,19 +145,7 @@ void registerFarm(CLI::App& app, int& exitCode) {
       Config config = loadStageConfig(o.setup, o.common, SetupUse::kRun, stats);
       if (!o.frames.empty()) requireShotForFrames(config, o.setup);
       Mesh wick = readWick(config);  // as the stages read it: MeshUnits, MeshUpAxis, WickGroup, roots alone
-      FarmPlanOptions options;
-      options.hairgen = executablePath();
-      options.setup = fs::absolute(o.setup).lexically_normal().string();
-      options.directory = fs::absolute(o.outDir).lexically_normal().string();
-      if (options.directory.size() > 1 && options.directory.back() == '/') options.directory.pop_back();
-      for (const std::string& s : o.common.sets)
-        options.overrides.insert(options.overrides.end(), {"--set", s});
-      if (o.common.seed)
-        options.overrides.insert(options.overrides.end(), {"--seed", std::to_string(*o.common.seed)});
-      options.shards = o.shards;
-      options.chunk = o.chunk;
-      options.maxCpus = o.cpus;
-      options.threads = size_t(tbb::this_task_arena::max_concurrency());
+      const FarmPlanOptions options = farmPlanOptions(o);
       const FarmPlan farmPlan = planFarm(config, wick, options);
       fs::create_directories(options.directory);
       const fs::path file = fs::path(options.directory) / "plan.json";
@@ -159,14 +156,16 @@ void registerFarm(CLI::App& app, int& exitCode) {
       stats.write(o.common);
     });
   });
+}
 
+void registerFarmSubmit(CLI::App& farm, int& exitCode) {
   struct SubmitOptions {
     CommonOptions common;
     std::string plan, scheduler;
     bool wait = false, dryRun = false;
   };
   auto submitOptions = std::make_shared<SubmitOptions>();
-  CLI::App* submitCmd = farm->add_subcommand(
+  CLI::App* submitCmd = farm.add_subcommand(
       "submit",
       "Submit a plan's tasks that are not done (their outputs missing or made with another config) to the "
       "scheduler as job arrays with afterok/aftercorr dependencies, and print the job ids; tasks are "
@@ -196,6 +195,18 @@ void registerFarm(CLI::App& app, int& exitCode) {
       submit(farmPlan, fs::absolute(o.plan).string(), o.dryRun, o.wait, o.common);
     });
   });
+}
+
+}  // namespace
+
+void registerFarm(CLI::App& app, int& exitCode) {
+  CLI::App* farm = app.add_subcommand(
+      "farm",
+      "The work of `hairgen run` as tasks for a render farm: `farm plan` writes them, `farm submit` "
+      "hands them to a scheduler (Slurm)");
+  farm->require_subcommand(1);
+  registerFarmPlan(*farm, exitCode);
+  registerFarmSubmit(*farm, exitCode);
 }
 
 }  // namespace hairgen::cli

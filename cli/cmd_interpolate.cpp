@@ -13,12 +13,50 @@
 
 namespace hairgen::cli {
 
+namespace {
+
+struct Options {
+  CommonOptions common;
+  std::string setup, guides, output, frames, shard;
+  UnitOptions units;
+};
+
+// --frames: every frame of a simulated sequence, each with the same strands, ids and weights.
+void interpolateSequence(const Options& o, const Config& config, const Mesh& wick, Stats& stats) {
+  Stopwatch clock;
+  const FrameRange frames = parseFrameRange(o.frames, "--frames");
+  for (const std::string* pattern : {&o.guides, &o.output})
+    if (!isFramePattern(*pattern))
+      throw InputError(*pattern + ": with --frames, write #### where the frame number goes");
+  requireWritableOutput(framePath(o.output, frames.first));
+  const HeadMotion head = headMotionOf(config);
+  Progress progress("interpolate", "frames", size_t(frames.count()), !o.common.quiet);
+  // Every frame has the same strands: each is written over the last one's arrays.
+  Strands coupe;
+  for (int f = frames.first; f <= frames.last; ++f) {
+    const std::filesystem::path in = framePath(o.guides, f);
+    const Strands guides = readStrandsAs(in, o.units);
+    stats.add("read", clock.lap());
+    InterpolateOptions frameOptions{config.digest(), in.string(), nullptr, o.common.force,
+                                    head.pose(f).matrix()};
+    interpolateInto(wick, guides, config.hairstyle, config.collision, frameOptions, coupe);
+    stats.add("interpolate", clock.lap());
+    writeStrands(framePath(o.output, f), coupe);
+    keepCommittedOutputs();  // a finished frame stays, whatever a later one does
+    stats.add("write", clock.lap());
+    stats.counts()["strands"] = coupe.strandCount();
+    stats.counts()["points"] = coupe.pointCount();
+    progress.advance();
+  }
+  progress.finish();
+  stats.counts()["frames"] = frames.count();
+  note(o.common, "interpolate: wrote " + framePath(o.output, frames.first).string() + " to " +
+                     framePath(o.output, frames.last).filename().string());
+}
+
+}  // namespace
+
 void registerInterpolate(CLI::App& app, int& exitCode) {
-  struct Options {
-    CommonOptions common;
-    std::string setup, guides, output, frames, shard;
-    UnitOptions units;
-  };
   auto options = std::make_shared<Options>();
   CLI::App* cmd = app.add_subcommand(
       "interpolate",
@@ -70,34 +108,7 @@ void registerInterpolate(CLI::App& app, int& exitCode) {
         stats.write(options->common);
         return;
       }
-      const FrameRange frames = parseFrameRange(options->frames, "--frames");
-      for (const std::string* pattern : {&options->guides, &options->output})
-        if (!isFramePattern(*pattern))
-          throw InputError(*pattern + ": with --frames, write #### where the frame number goes");
-      requireWritableOutput(framePath(options->output, frames.first));
-      const HeadMotion head = headMotionOf(config);
-      Progress progress("interpolate", "frames", size_t(frames.count()), !options->common.quiet);
-      // Every frame has the same strands: each is written over the last one's arrays.
-      Strands coupe;
-      for (int f = frames.first; f <= frames.last; ++f) {
-        const std::filesystem::path in = framePath(options->guides, f);
-        const Strands guides = readStrandsAs(in, options->units);
-        stats.add("read", clock.lap());
-        InterpolateOptions frameOptions{config.digest(), in.string(), nullptr, options->common.force,
-                                        head.pose(f).matrix()};
-        interpolateInto(wick, guides, config.hairstyle, config.collision, frameOptions, coupe);
-        stats.add("interpolate", clock.lap());
-        writeStrands(framePath(options->output, f), coupe);
-        keepCommittedOutputs();  // a finished frame stays, whatever a later one does
-        stats.add("write", clock.lap());
-        stats.counts()["strands"] = coupe.strandCount();
-        stats.counts()["points"] = coupe.pointCount();
-        progress.advance();
-      }
-      progress.finish();
-      stats.counts()["frames"] = frames.count();
-      note(options->common, "interpolate: wrote " + framePath(options->output, frames.first).string() +
-                                " to " + framePath(options->output, frames.last).filename().string());
+      interpolateSequence(*options, config, wick, stats);
       stats.write(options->common);
     });
   });

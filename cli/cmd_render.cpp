@@ -14,7 +14,6 @@
 #include "libcore/util/frames.h"
 #include "libcore/util/progress.h"
 #include "libcore/util/text.h"
-#include "stages/interpolate.h"
 #include "stages/render.h"
 #include "stages/shade.h"
 #include "stages/shot.h"

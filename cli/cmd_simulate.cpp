@@ -12,11 +12,35 @@
 
 namespace hairgen::cli {
 
+namespace {
+
+struct Options {
+  CommonOptions common;
+  std::string setup, guides, output, frames;
+};
+
+// What a simulation reads: the rest guides, the frame before a resumed range (when it was written), and
+// Model springs' DensityTarget.
+struct Inputs {
+  Strands rest;
+  std::optional<Strands> restart, target;
+  std::string restartName;
+};
+
+Inputs readInputs(const Options& o, const Dynamics& d, const FrameRange& frames) {
+  Inputs in{readStrands(o.guides), {}, {}, {}};
+  if (frames.first > d.firstFrame) {
+    in.restartName = framePath(o.output, frames.first - 1).string();
+    if (std::filesystem::exists(in.restartName)) in.restart = readStrands(in.restartName);
+  }
+  if (d.model == DynamicsModel::kSprings && d.densityTarget.given())
+    in.target = readStrands(d.densityTarget.path);
+  return in;
+}
+
+}  // namespace
+
 void registerSimulate(CLI::App& app, int& exitCode) {
-  struct Options {
-    CommonOptions common;
-    std::string setup, guides, output, frames;
-  };
   auto options = std::make_shared<Options>();
   CLI::App* cmd = app.add_subcommand(
       "simulate",
@@ -49,16 +73,8 @@ void registerSimulate(CLI::App& app, int& exitCode) {
       const FrameRange frames = options->frames.empty() ? FrameRange{d.firstFrame, d.lastFrame}
                                                         : parseFrameRange(options->frames, "--frames");
       requireWritableOutput(framePath(options->output, frames.first));
-      const Strands rest = readStrands(options->guides);
-      std::optional<Strands> restart;
-      std::string restartName;
-      if (frames.first > d.firstFrame) {
-        restartName = framePath(options->output, frames.first - 1).string();
-        if (std::filesystem::exists(restartName)) restart = readStrands(restartName);
-      }
-      std::optional<Strands> target;  // Model springs' DensityTarget
-      if (d.model == DynamicsModel::kSprings && d.densityTarget.given())
-        target = readStrands(d.densityTarget.path);
+      const Inputs in = readInputs(*options, d, frames);
+      const Strands& rest = in.rest;
       stats.time("read", clock.lap());
       note(options->common, "simulate: " + std::to_string(rest.strandCount()) + " guides, frames " +
                                 std::to_string(frames.first) + "-" + std::to_string(frames.last) + " at " +
@@ -67,11 +83,11 @@ void registerSimulate(CLI::App& app, int& exitCode) {
       Progress progress("simulate", "frames", size_t(frames.count()), !options->common.quiet);
       SimulateOptions simOptions{config.digest(),
                                  frames,
-                                 restart ? &*restart : nullptr,
-                                 restartName,
+                                 in.restart ? &*in.restart : nullptr,
+                                 in.restartName,
                                  &progress,
                                  options->common.force,
-                                 target ? &*target : nullptr};
+                                 in.target ? &*in.target : nullptr};
       double writing = 0.0;
       simulate(rest, config, simOptions, [&](int frame, const Strands& guides) {
         Stopwatch write;

@@ -12,6 +12,27 @@
 #include "cli/common.h"
 #include "libcore/util/text.h"
 
+namespace {
+
+// A first word that is no command (a typo): named, with the nearest command, rather than CLI11's "A
+// subcommand is required". True when `word` was refused.
+bool refuseUnknownCommand(const CLI::App& app, const std::string& word) {
+  if (word.empty() || word[0] == '-') return false;
+  std::vector<std::string> names;
+  for (const CLI::App* sub : app.get_subcommands([](const CLI::App*) { return true; }))
+    names.push_back(sub->get_name());
+  if (std::find(names.begin(), names.end(), word) != names.end()) return false;
+  const std::string close = hairgen::closestMatch(word, names);
+  std::string all;
+  for (const std::string& n : names) all += (all.empty() ? "" : ", ") + n;
+  std::cerr << "hairgen: error: unknown command '" << word << "'"
+            << (close.empty() ? "; the commands are " + all : "; did you mean '" + close + "'?") << "\n"
+            << "Run 'hairgen --help' for usage.\n";
+  return true;
+}
+
+}  // namespace
+
 int main(int argc, char** argv) {
   using namespace hairgen::cli;
   CLI::App app{
@@ -44,22 +65,7 @@ int main(int argc, char** argv) {
   registerAssets(app, exitCode);
   pointAtExitCodes(app);
 
-  // A first word that is no command (a typo): named, with the nearest command, rather than CLI11's
-  // "A subcommand is required".
-  if (argc > 1 && argv[1][0] != '-') {
-    std::vector<std::string> names;
-    for (const CLI::App* sub : app.get_subcommands([](const CLI::App*) { return true; }))
-      names.push_back(sub->get_name());
-    if (std::find(names.begin(), names.end(), argv[1]) == names.end()) {
-      const std::string close = hairgen::closestMatch(argv[1], names);
-      std::string all;
-      for (const std::string& n : names) all += (all.empty() ? "" : ", ") + n;
-      std::cerr << "hairgen: error: unknown command '" << argv[1] << "'"
-                << (close.empty() ? "; the commands are " + all : "; did you mean '" + close + "'?") << "\n"
-                << "Run 'hairgen --help' for usage.\n";
-      return 2;
-    }
-  }
+  if (argc > 1 && refuseUnknownCommand(app, argv[1])) return 2;
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {

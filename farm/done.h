@@ -6,7 +6,7 @@
 #include <string>
 #include <vector>
 
-#include "stages/farm_plan.h"
+#include "farm/plan.h"
 
 namespace hairgen::farm {
 

@@ -1,4 +1,4 @@
-// What a farm back end does with a plan (stages/farm_plan.h): hand its tasks that are not done to a
+// What a farm back end does with a plan (farm/plan.h): hand its tasks that are not done to a
 // scheduler, each after the tasks it reads, then optionally wait for them. Slurm is one
 // (farm/slurm.h); a Deadline or OpenCue back end would be another. The done set comes from
 // farm/done.h, the same for every back end, so a scheduler never decides what is done.
@@ -7,7 +7,7 @@
 #include <cstddef>
 #include <vector>
 
-#include "stages/farm_plan.h"
+#include "farm/plan.h"
 
 namespace hairgen::farm {
 

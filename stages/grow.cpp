@@ -1,6 +1,7 @@
 // grow: follicle frames (§4.1.4.1), minimisation of each guide's energy from its rest shape by
 // Rosenbrock's search (§4.1.3) or BFGS on its gradient (Minimiser bfgs), then sampling of the
-// Super-Helix every VisualityStep (§4.1.4.2).
+// Super-Helix every VisualityStep (§4.1.4.2); or, for Model cantilever, Anjyo's beams bent from each wick
+// vertex (libcore/physics/cantilever.h).
 #include "stages/grow.h"
 
 #include <algorithm>
@@ -11,9 +12,9 @@
 #include <tbb/parallel_for.h>
 #include <tbb/task_arena.h>
 
+#include "libcore/physics/cantilever.h"
 #include "libcore/util/error.h"
-#include "stages/cantilever.h"
-#include "stages/estimate.h"
+#include "stages/preflight/estimate.h"
 
 namespace hairgen {
 
@@ -133,6 +134,47 @@ GrowResult grow(const Mesh& wick, const Hairstyle& style, const Collision& colli
     result.evaluations += report.evaluations;
   }
   guides.defaultThickness = static_cast<float>(style.hairRadius1 + style.hairRadius2);  // a diameter
+  guides.provenance = madeByHairgen("grow", style.seed, options.configDigest);
+  guides.provenance.shard = options.shard;
+  return result;
+}
+
+GrowResult growCantilever(const Mesh& wick, const Hairstyle& style, const Collision& collision,
+                          const GrowOptions& options) {
+  const size_t count = wick.vertexCount();
+  const size_t first = options.shard ? options.shard->first : 0,
+               end = options.shard ? options.shard->end : count;
+  const CollisionShape* head = headShape(collision);  // a Sphere head is an ellipsoid of equal semi-axes
+  std::vector<std::vector<glm::dvec3>> hairs(end - first);
+  tbb::parallel_for(first, end, [&](size_t i) {
+    std::vector<glm::dvec3>& hair = hairs[i - first];
+    const glm::dvec3 rootPos(wick.positions[i]);
+    hair = bendHair(rootPos, style.growDirection(rootPos, glm::dvec3(wick.normals[i])), style, head);
+    cutHair(hair, style, head);
+    if (options.progress) options.progress->advance();
+  });
+  if (options.progress) options.progress->finish();
+
+  GrowResult result;
+  result.reports.resize(end - first);
+  Strands& guides = result.guides;
+  for (size_t i = first; i < end; ++i) {
+    const std::vector<glm::dvec3>& h = hairs[i - first];
+    for (size_t n = 0; n < h.size(); ++n) {
+      if (!std::isfinite(h[n].x) || !std::isfinite(h[n].y) || !std::isfinite(h[n].z))
+        throw NumericError("hair " + std::to_string(i) + " has a non-finite node");
+      guides.points.push_back(glm::vec3(h[n]));
+      glm::dvec3 t = h.size() < 2
+                         ? style.growDirection(glm::dvec3(wick.positions[i]), glm::dvec3(wick.normals[i]))
+                         : (n + 1 < h.size() ? h[n + 1] - h[n] : h[n] - h[n - 1]);
+      guides.tangents.push_back(glm::vec3(glm::normalize(t)));
+    }
+    guides.firstPoint.push_back(static_cast<uint32_t>(guides.points.size()));
+    guides.strandId.push_back(static_cast<uint32_t>(i));
+    result.reports[i - first].follicle = static_cast<uint32_t>(i);
+    result.reports[i - first].stop = MinimiserStop::kEpsilon;
+  }
+  guides.defaultThickness = static_cast<float>(style.hairRadius1 + style.hairRadius2);
   guides.provenance = madeByHairgen("grow", style.seed, options.configDigest);
   guides.provenance.shard = options.shard;
   return result;

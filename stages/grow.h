@@ -56,4 +56,9 @@ std::vector<double> follicleEnvelopes(const Mesh& wick);
 GuideReport growGuide(const RodFrame& root, double envelope, const Hairstyle& style,
                       const Collision& collision);
 
+// The whole grow stage for Model cantilever: one hair per wick vertex, its nodes as the guide's points.
+// grow() checks the wick and dispatches here.
+GrowResult growCantilever(const Mesh& wick, const Hairstyle& style, const Collision& collision,
+                          const GrowOptions& options);
+
 }  // namespace hairgen

@@ -15,8 +15,9 @@
 #include "libcore/util/error.h"
 #include "libcore/util/huge_pages.h"
 #include "libcore/util/random.h"
+#include "libcore/util/text.h"
 #include "libcore/util/vectorise.h"
-#include "stages/estimate.h"
+#include "stages/preflight/estimate.h"
 
 namespace hairgen {
 namespace {
@@ -71,10 +72,9 @@ void checkGuides(const Mesh& wick, const Strands& guides, const std::string& nam
     const glm::dvec3 vertex(pose * glm::dvec4(glm::dvec3(wick.positions[i]), 1.0));
     double gap = glm::length(glm::dvec3(guides.points[guides.firstPoint[i]]) - vertex);
     if (!(gap <= 1e-4)) {
-      char mm[32];
-      std::snprintf(mm, sizeof mm, "%.3g mm", gap * 1e3);
-      throw InputError(where, "guide " + std::to_string(i) + " starts " + mm + " from wick vertex " +
-                                  std::to_string(i) + "; these guides were not grown from this Setup's wick");
+      throw InputError(where, "guide " + std::to_string(i) + " starts " + formatSignificant(gap * 1e3) +
+                                  " mm from wick vertex " + std::to_string(i) +
+                                  "; these guides were not grown from this Setup's wick");
     }
   }
 }

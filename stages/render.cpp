@@ -6,8 +6,8 @@
 #include "libcore/model/units.h"
 #include "libcore/render/views.h"
 #include "libcore/util/error.h"
-#include "stages/estimate.h"
-#include "stages/scene.h"
+#include "stages/preflight/estimate.h"
+#include "stages/preflight/scene.h"
 
 namespace hairgen {
 

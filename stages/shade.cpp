@@ -11,7 +11,7 @@
 #include "libcore/util/error.h"
 #include "libcore/util/random.h"
 #include "libcore/util/stopwatch.h"
-#include "stages/estimate.h"
+#include "stages/preflight/estimate.h"
 
 namespace hairgen {
 namespace {

@@ -9,7 +9,7 @@
 #include "libcore/physics/spring_dynamics.h"
 #include "libcore/util/error.h"
 #include "libcore/util/text.h"
-#include "stages/estimate.h"
+#include "stages/preflight/estimate.h"
 
 namespace hairgen {
 
@@ -38,13 +38,6 @@ bool stepHair(SpringHair& hair, const AccelerationField& field, double dt, int, 
   return false;
 }
 
-// `value` to 3 significant digits, for a message.
-std::string significant(double value) {
-  char text[32];
-  std::snprintf(text, sizeof text, "%.3g", value);
-  return text;
-}
-
 // How the hair left its validity, where it did (the strand and its point or segment), or nothing
 // while it is valid.
 std::optional<std::string> faultOf(const SpringHair& hair) {
@@ -57,7 +50,7 @@ std::optional<std::string> faultOf(const SpringHair& hair) {
              "% off its rest length (the bound is " + formatReal(100.0 * kMaxSpringStretch) +
              "%): the stretch solve did not converge";
     case SpringHair::Fault::kSpeed:
-      return where + " moves at " + significant(f->value) + " m/s (the bound is " +
+      return where + " moves at " + formatSignificant(f->value) + " m/s (the bound is " +
              formatReal(kMaxSpringSpeed) + " m/s)";
     case SpringHair::Fault::kNotFinite:
       break;
@@ -68,7 +61,7 @@ std::optional<std::string> faultOf(const AnjyoHair& hair) {
   const std::optional<AnjyoHair::Fault> f = hair.fault();
   if (!f) return std::nullopt;
   return "strand " + std::to_string(f->strand) + ", segment " + std::to_string(f->segment) + " holds " +
-         (f->angle ? "an angle" : "a turn") + " of " + significant(f->value) + " rad (the bound is " +
+         (f->angle ? "an angle" : "a turn") + " of " + formatSignificant(f->value) + " rad (the bound is " +
          formatReal(f->angle ? kMaxAnjyoAngle : kMaxAnjyoTurn) + (f->angle ? " rad" : " rad a substep") +
          "): the step overflowed";
 }
@@ -96,9 +89,10 @@ Driver strongestForce(const Config& config, double gravity) {
   const Driver force = strongestForce(config, gravity);
   throw SimulationDiverged(
       "frame " + std::to_string(frame) + ": the simulation left its validity: " + what + ", in steps of " +
-      significant(1.0 / (d.frameRate * d.substeps)) + " s (Dynamics.FrameRate " + formatReal(d.frameRate) +
-      " frames/s, Dynamics.Substeps " + std::to_string(d.substeps) + ") under " + force.key + " " +
-      formatReal(force.value) + " " + force.unit + "; nothing of frame " + std::to_string(frame) +
+      formatSignificant(1.0 / (d.frameRate * d.substeps)) + " s (Dynamics.FrameRate " +
+      formatReal(d.frameRate) + " frames/s, Dynamics.Substeps " + std::to_string(d.substeps) + ") under " +
+      force.key + " " + formatReal(force.value) + " " + force.unit + "; nothing of frame " +
+      std::to_string(frame) +
       " is written. Raise Dynamics.Substeps (or Dynamics.FrameRate) for shorter steps, or lower " +
       force.key);
 }

@@ -21,7 +21,7 @@
 #include "libcore/io/hair_cache.h"
 #include "libcore/io/obj_io.h"
 #include "libcore/model/shape_fit.h"
-#include "stages/scene.h"
+#include "stages/preflight/scene.h"
 
 namespace fs = std::filesystem;
 using namespace hairgen;

@@ -6,7 +6,8 @@
 
 #include "libcore/config/setup.h"
 #include "libcore/io/obj_io.h"
-#include "stages/cantilever.h"
+#include "libcore/physics/cantilever.h"
+#include "stages/grow.h"
 #include "stages/shade.h"
 #include "tests/test_util.h"
 

@@ -9,11 +9,11 @@
 #include <set>
 
 #include "farm/done.h"
+#include "farm/plan.h"
 #include "farm/scheduler.h"
 #include "libcore/io/hair_io.h"
 #include "libcore/model/shards.h"
 #include "libcore/util/error.h"
-#include "stages/farm_plan.h"
 #include "stages/interpolate.h"
 #include "tests/test_util.h"
 

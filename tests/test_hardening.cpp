@@ -19,8 +19,8 @@
 #include "libcore/util/checked.h"
 #include "libcore/util/file_util.h"
 #include "libcore/util/json.h"
-#include "stages/estimate.h"
 #include "stages/interpolate.h"
+#include "stages/preflight/estimate.h"
 #include "tests/test_util.h"
 
 namespace hairgen {

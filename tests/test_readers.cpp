@@ -12,8 +12,8 @@
 #include "libcore/render/views.h"
 #include "libcore/util/error.h"
 #include "libcore/util/text.h"
-#include "stages/estimate.h"
-#include "stages/scene.h"
+#include "stages/preflight/estimate.h"
+#include "stages/preflight/scene.h"
 #include "tests/test_util.h"
 
 namespace hairgen {

@@ -8,7 +8,7 @@
 #include "libcore/io/obj_io.h"
 #include "libcore/model/shape_fit.h"
 #include "libcore/util/error.h"
-#include "stages/scene.h"
+#include "stages/preflight/scene.h"
 
 namespace hairgen {
 namespace {

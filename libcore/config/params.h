@@ -54,8 +54,8 @@ struct RootFlow {
   enum class Kind { kDown, kDirection, kAwayFrom };
   Kind kind = Kind::kDown;
   glm::dvec3 value{0.0, -1.0, 0.0};  // kDirection: a unit vector; kAwayFrom: a point, metres
-  // `away-from auto`: the point is the whorl of the head as it is read (fitRootFlow, stages/scene.h),
-  // `resolved` once it is; at() refuses to lean toward a point not yet found.
+  // `away-from auto`: the point is the whorl of the head as it is read (fitRootFlow,
+  // stages/preflight/scene.h), `resolved` once it is; at() refuses to lean toward a point not yet found.
   bool fitted = false, resolved = false;
   // The direction at a follicle at `root`: down (−y), the fixed vector, or away from the point.
   glm::dvec3 at(const glm::dvec3& root) const;

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <charconv>
+#include <cstdio>
 
 namespace hairgen {
 
@@ -71,6 +72,12 @@ std::string formatReal(double value) {
   char buffer[64];
   auto [end, ec] = std::to_chars(buffer, buffer + sizeof buffer, value);
   return ec == std::errc() ? std::string(buffer, end) : std::string("nan");
+}
+
+std::string formatSignificant(double value, int digits) {
+  char text[48];
+  std::snprintf(text, sizeof text, "%.*g", std::clamp(digits, 1, 17), value);
+  return text;
 }
 
 std::string formatFloat(float value) {

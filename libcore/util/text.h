@@ -28,6 +28,8 @@ std::string closestMatch(std::string_view word, const std::vector<std::string>& 
 // Shortest text that parses back to the same double (std::to_chars).
 std::string formatReal(double value);
 std::string formatFloat(float value);  // shortest text that parses back to the same float
+// `value` to `digits` significant digits (printf's %g), for a message: 0.000123, 4.56e+07.
+std::string formatSignificant(double value, int digits = 3);
 
 // `text` with every line end replaced by a space: library messages (a compiler's log, a parser's
 // warnings) in hairgen's one-line errors.

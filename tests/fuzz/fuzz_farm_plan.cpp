@@ -1,4 +1,4 @@
-// Fuzzes the farm plan reader (stages/farm_plan.h): the input is a plan's JSON text. farmPlanFromJson
+// Fuzzes the farm plan reader (farm/plan.h): the input is a plan's JSON text. farmPlanFromJson
 // reads it and checks it by validateFarmPlan's rules (names, control characters, paths inside the
 // plan's folder, a hairgen executable, bounded counts). A plan it accepts must keep what `farm submit`
 // relies on: no string with a control character (it would split a script's line), ids that are array
@@ -10,7 +10,7 @@
 
 #include <nlohmann/json.hpp>
 
-#include "stages/farm_plan.h"
+#include "farm/plan.h"
 #include "tests/fuzz/fuzz_target.h"
 
 namespace {

@@ -5,8 +5,8 @@
 #include "cli/common.h"
 #include "libcore/io/obj_io.h"
 #include "libcore/util/resources.h"
-#include "stages/estimate.h"
-#include "stages/scene.h"
+#include "stages/preflight/estimate.h"
+#include "stages/preflight/scene.h"
 #include "stages/shade.h"
 
 namespace hairgen::cli {

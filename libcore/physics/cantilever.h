@@ -1,4 +1,4 @@
-// Anjyo et al. 1992 §2 and §3.2.3 as a second styling model for `hairgen grow` (Model cantilever):
+// Anjyo et al. 1992 §2 and §3.2.3, the second styling model of `hairgen grow` (Model cantilever):
 // each hair a chain of equal segments from its pore, bent node by node by the segment-constant
 // moments of a cantilever beam under gravity and force fields, kept out of the head (headShape), its
 // joint angles limited, and cut by pore position and height.
@@ -10,7 +10,6 @@
 
 #include "libcore/config/params.h"
 #include "libcore/model/mesh.h"
-#include "stages/grow.h"
 
 namespace hairgen {
 
@@ -28,10 +27,5 @@ glm::dvec2 porePolar(const glm::dvec3& pore, const CollisionShape* head);
 // Cuts a bent hair: when a Cut selects its pore, it ends at its last node before the first one below
 // the Cut's height. Returns the number of nodes kept.
 size_t cutHair(std::vector<glm::dvec3>& nodes, const Hairstyle& style, const CollisionShape* head);
-
-// The whole grow stage for Model cantilever: one hair per wick vertex, its nodes as the guide's points.
-// grow() checks the wick and dispatches here.
-GrowResult growCantilever(const Mesh& wick, const Hairstyle& style, const Collision& collision,
-                          const GrowOptions& options);
 
 }  // namespace hairgen

@@ -1,7 +1,8 @@
 // The farm plan: the tasks of `hairgen run`, split. Shards are equal ranges of wick vertices (grow) and
 // triangles (interpolate); chunks are runs of `chunk` frames. CPU and memory requests come from the
-// work estimates `hairgen check` prints (stages/estimate.h), scaled to each task's share of the work.
-#include "stages/farm_plan.h"
+// work estimates `hairgen check` prints (stages/preflight/estimate.h), scaled to each task's share of the
+// work.
+#include "farm/plan.h"
 
 #include <algorithm>
 #include <cmath>
@@ -9,7 +10,7 @@
 #include "libcore/util/error.h"
 #include "libcore/util/json.h"
 #include "libcore/util/text.h"
-#include "stages/estimate.h"
+#include "stages/preflight/estimate.h"
 #include "stages/shade.h"
 
 namespace hairgen {

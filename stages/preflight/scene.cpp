@@ -1,4 +1,4 @@
-#include "stages/scene.h"
+#include "stages/preflight/scene.h"
 
 #include <algorithm>
 #include <cmath>

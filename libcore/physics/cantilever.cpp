@@ -1,11 +1,7 @@
 // Cantilever-beam styling, Anjyo, Usami and Kurihara 1992, §2.1-2.2 and §3.2.3.
-#include "stages/cantilever.h"
+#include "libcore/physics/cantilever.h"
 
 #include <cmath>
-
-#include <tbb/parallel_for.h>
-
-#include "libcore/util/error.h"
 
 namespace hairgen {
 namespace {
@@ -131,47 +127,6 @@ size_t cutHair(std::vector<glm::dvec3>& nodes, const Hairstyle& style, const Col
       }
   }
   return nodes.size();
-}
-
-GrowResult growCantilever(const Mesh& wick, const Hairstyle& style, const Collision& collision,
-                          const GrowOptions& options) {
-  const size_t count = wick.vertexCount();
-  const size_t first = options.shard ? options.shard->first : 0,
-               end = options.shard ? options.shard->end : count;
-  const CollisionShape* head = headShape(collision);  // a Sphere head is an ellipsoid of equal semi-axes
-  std::vector<std::vector<glm::dvec3>> hairs(end - first);
-  tbb::parallel_for(first, end, [&](size_t i) {
-    std::vector<glm::dvec3>& hair = hairs[i - first];
-    const glm::dvec3 rootPos(wick.positions[i]);
-    hair = bendHair(rootPos, style.growDirection(rootPos, glm::dvec3(wick.normals[i])), style, head);
-    cutHair(hair, style, head);
-    if (options.progress) options.progress->advance();
-  });
-  if (options.progress) options.progress->finish();
-
-  GrowResult result;
-  result.reports.resize(end - first);
-  Strands& guides = result.guides;
-  for (size_t i = first; i < end; ++i) {
-    const std::vector<glm::dvec3>& h = hairs[i - first];
-    for (size_t n = 0; n < h.size(); ++n) {
-      if (!std::isfinite(h[n].x) || !std::isfinite(h[n].y) || !std::isfinite(h[n].z))
-        throw NumericError("hair " + std::to_string(i) + " has a non-finite node");
-      guides.points.push_back(glm::vec3(h[n]));
-      glm::dvec3 t = h.size() < 2
-                         ? style.growDirection(glm::dvec3(wick.positions[i]), glm::dvec3(wick.normals[i]))
-                         : (n + 1 < h.size() ? h[n + 1] - h[n] : h[n] - h[n - 1]);
-      guides.tangents.push_back(glm::vec3(glm::normalize(t)));
-    }
-    guides.firstPoint.push_back(static_cast<uint32_t>(guides.points.size()));
-    guides.strandId.push_back(static_cast<uint32_t>(i));
-    result.reports[i - first].follicle = static_cast<uint32_t>(i);
-    result.reports[i - first].stop = MinimiserStop::kEpsilon;
-  }
-  guides.defaultThickness = static_cast<float>(style.hairRadius1 + style.hairRadius2);
-  guides.provenance = madeByHairgen("grow", style.seed, options.configDigest);
-  guides.provenance.shard = options.shard;
-  return result;
 }
 
 }  // namespace hairgen

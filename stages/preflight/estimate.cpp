@@ -1,7 +1,7 @@
 // Cost models of the stages. The constants are per-unit costs measured on the project's 2-core
 // reference machine (`scripts/bench.sh`); an estimate is meant to be right within a factor of a few,
 // which is all a refusal needs: the configs it stops are wrong by factors of thousands.
-#include "stages/estimate.h"
+#include "stages/preflight/estimate.h"
 
 #include <algorithm>
 #include <cmath>

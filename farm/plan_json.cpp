@@ -9,8 +9,8 @@
 #include <set>
 #include <string_view>
 
+#include "farm/plan.h"
 #include "libcore/util/error.h"
-#include "stages/farm_plan.h"
 
 namespace hairgen {
 namespace {
