@@ -4,6 +4,8 @@
 #include <cstdio>
 #include <numbers>
 
+#include "libcore/util/text.h"
+
 namespace hairgen {
 namespace {
 
@@ -13,10 +15,9 @@ std::string number(double v) {
   return text;
 }
 
+// Exactly, since roots are compared bit for bit.
 std::string point(const glm::vec3& p) {
-  char text[96];
-  std::snprintf(text, sizeof text, "(%.9g, %.9g, %.9g)", double(p.x), double(p.y), double(p.z));
-  return text;
+  return "(" + formatFloat(p.x) + ", " + formatFloat(p.y) + ", " + formatFloat(p.z) + ")";
 }
 
 HairDiff failed(HairDiff d, std::string reason) {
