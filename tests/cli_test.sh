@@ -461,7 +461,7 @@ hardening_flags)
   # Flags are validated like config values: no sign wrapping, no NaN passing a range.
   expect_rc 2 "$hairgen" check "$src/configs/default/setup.txt" --seed -5
   grep -q -- "--seed: '-5' is not a non-negative integer" "$tmp/err" || fail "seed: $(cat "$tmp/err")"
-  ref="$src/golden/coupe1/reference.exr"
+  ref="$src/golden/default/reference.exr"
   expect_rc 2 "$hairgen" diff "$ref" "$ref" --fail nan
   expect_rc 2 "$hairgen" diff "$ref" "$ref" --hardfail inf
   # Names and provenance that are not UTF-8 are written into JSON, not thrown on.
