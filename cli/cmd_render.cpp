@@ -81,8 +81,12 @@ std::unique_ptr<GlContext> openDevice(const CommonOptions& common, const Config&
 }
 
 void writeRenderOutputs(const Config& config, const RenderOutput& out, const std::string& exr,
-                        const std::string& dom, const std::string& preview) {
+                        const std::string& dom, const std::string& preview, std::optional<int> frame) {
   ExrMetadata meta;
+  if (frame) {
+    meta.ints["hairgen:frame"] = *frame;
+    meta.framesPerSecond = config.dynamics.frameRate;
+  }
   meta.strings["producer"] = "hairgen " HAIRGEN_VERSION;
   meta.strings["hairgen:configDigest"] = config.digest();
   meta.strings["hairgen:shadingModel"] = name(config.render.shadingModel);
@@ -100,12 +104,14 @@ void writeRenderOutputs(const Config& config, const RenderOutput& out, const std
   if (!dom.empty()) {
     ExrMetadata domMeta;
     domMeta.strings = meta.strings;
+    domMeta.ints = meta.ints;
+    domMeta.framesPerSecond = meta.framesPerSecond;
     domMeta.strings["hairgen:layerSizes"] =
         std::to_string(config.render.layerSizes.x) + " " + std::to_string(config.render.layerSizes.y) + " " +
         std::to_string(config.render.layerSizes.z) + " " + std::to_string(config.render.layerSizes.w);
     domMeta.camera = true;
-    domMeta.worldToCamera = out.worldToLight;
-    domMeta.worldToNdc = out.worldToLight;
+    domMeta.worldToCamera = out.lightWorldToCamera;
+    domMeta.worldToNdc = out.lightWorldToNdc;
     writeExr(dom, out.dom, domMeta);
   }
   if (!preview.empty()) writePreview(preview, out.beauty, config.render.background);
@@ -330,7 +336,7 @@ void renderFrames(const RenderArgs& args, const Config& config, const ShotInputs
     Config rendered = config;
     if (args.frame) rendered.render = out.settings;
     writeRenderOutputs(rendered, out, args.file(args.output, f), args.file(args.dom, f),
-                       args.file(args.preview, f));
+                       args.file(args.preview, f), sequence ? std::optional<int>(f) : std::nullopt);
     if (sequence) keepCommittedOutputs();  // a finished frame stays, whatever a later one does
     stats.add("write", clock.lap());
     if (args.motion) {

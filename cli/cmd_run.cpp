@@ -113,7 +113,7 @@ void runShot(const CommonOptions& common, const Config& config, const Mesh& wick
     if (motionVectors) before.keep(std::move(frame));
     clock.lap();
     writeRenderOutputs(config, image, framePath(exrPattern, f).string(), "",
-                       framePath(pngPattern, f).string());
+                       framePath(pngPattern, f).string(), f);
     keepCommittedOutputs();
     stats.add("write", clock.lap());
     progress.advance();

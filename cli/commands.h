@@ -3,6 +3,7 @@
 // single-stage commands, so both give the same files.
 #pragma once
 
+#include <optional>
 #include <string>
 
 #include <CLI/CLI.hpp>
@@ -49,8 +50,10 @@ std::unique_ptr<GlContext> openDevice(const CommonOptions& common, const Config&
 RenderOutput renderStage(const CommonOptions& common, const Config& config, GlContext& gl,
                          const Strands& hair, const Mesh* head, const RenderOptions& options, Stats& stats,
                          const FrameBefore* before = nullptr);
-// Writes the EXR, and the light's maps and the preview where named (empty: not wanted).
+// Writes the EXR, and the light's maps and the preview where named (empty: not wanted). A sequence's
+// `frame` goes into the EXRs' headers (hairgen:frame) with Dynamics FrameRate as framesPerSecond.
 void writeRenderOutputs(const Config& config, const RenderOutput& out, const std::string& exr,
-                        const std::string& dom, const std::string& preview);
+                        const std::string& dom, const std::string& preview,
+                        std::optional<int> frame = std::nullopt);
 
 }  // namespace hairgen::cli

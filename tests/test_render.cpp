@@ -8,8 +8,11 @@
 
 #include <tbb/global_control.h>
 
+#include <OpenEXR/ImfInputFile.h>
+#include <OpenEXR/ImfStandardAttributes.h>
 #include <glm/gtc/matrix_transform.hpp>
 
+#include "libcore/io/exr_io.h"
 #include "libcore/io/obj_io.h"
 #include "libcore/render/gl_context.h"
 #include "libcore/render/gl_resources.h"
@@ -813,7 +816,7 @@ TEST(Render, TheCpusLightMapsAreOpenGlsToTheirEdges) {
       hair += a || b;
       differ += a != b;
       for (int layer = 0; layer < 4; ++layer) {
-        const std::string name = "layer" + std::to_string(layer + 1);
+        const std::string name = kChannelDomLayers[layer];
         cpuSum[layer] += cpu.dom.at(name, x, y);
         oglSum[layer] += ogl.dom.at(name, x, y);
       }
@@ -836,6 +839,60 @@ TEST(Render, TheCpusLightMapsAreOpenGlsToTheirEdges) {
 
 // After framing, the camera looks at the hair's centre from the same direction, and the hair's
 // bounding sphere lies inside the narrower field of view.
+// OpenEXR's camera attributes (issue 34): world points projected with the written header's matrices
+// as a compositor does it, with Imath's row vectors (p' = p M, then the divide by w), land on the
+// pixels where the points were drawn, and worldToCamera puts them in front of the camera (z > 0) at
+// the depth the Z channel holds. An oblique camera and a wide image, so a transposed matrix, a flipped
+// axis or a lost aspect ratio each moves a point by many pixels.
+TEST(Render, TheExrCameraAttributesFindDrawnPointsAtTheirPixels) {
+  RenderSettings r = frontCamera(64, 1);
+  r.resolution = {160, 90};
+  r.cameraPosition = {0.06, 0.04, 0.3};
+  r.cameraTarget = {0.01, -0.01, 0.0};
+  r.cameraUp = {0.1, 1.0, 0.0};
+  const glm::vec3 points[] = {{-0.05f, 0.03f, 0.0f},
+                              {0.05f, -0.02f, 0.02f},
+                              {0.0f, 0.0f, -0.03f},
+                              {0.045f, 0.035f, -0.01f},
+                              {-0.04f, -0.04f, 0.03f}};
+  test::TempDir dir("exr-camera");
+  for (const glm::vec3& p : points) {
+    // A cross of two strands 2 cm long centred on the point (3 pixels at this distance): the centre of
+    // what they cover is the point's pixel, to a small fraction of one.
+    Strands s;
+    addStraight(s, p - glm::vec3(0.01f, 0.0f, 0.0f), p + glm::vec3(0.01f, 0.0f, 0.0f));
+    addStraight(s, p - glm::vec3(0.0f, 0.01f, 0.0f), p + glm::vec3(0.0f, 0.01f, 0.0f));
+    const RenderOutput out = renderStrands(s, r);
+    ExrMetadata meta;
+    meta.camera = true;
+    meta.worldToCamera = out.worldToCamera;
+    meta.worldToNdc = out.worldToNdc;
+    writeExr(dir / "dot.exr", out.beauty, meta);
+    Imf::InputFile file((dir / "dot.exr").c_str());
+    ASSERT_TRUE(Imf::hasWorldToNDC(file.header()) && Imf::hasWorldToCamera(file.header()));
+    const Imath::M44f toNdc = Imf::worldToNDC(file.header()), toCamera = Imf::worldToCamera(file.header());
+    Imath::V3f ndc, camera;
+    toNdc.multVecMatrix(Imath::V3f(p.x, p.y, p.z), ndc);
+    toCamera.multVecMatrix(Imath::V3f(p.x, p.y, p.z), camera);
+    // Where it was drawn: the coverage-weighted centre of the pixels it covers (pixel x's centre x + ½).
+    double weight = 0.0, x = 0.0, y = 0.0;
+    for (int j = 0; j < r.resolution.y; ++j)
+      for (int i = 0; i < r.resolution.x; ++i)
+        if (const double a = out.beauty.at("A", i, j); a > 0.0) {
+          weight += a;
+          x += a * (i + 0.5);
+          y += a * (j + 0.5);
+        }
+    ASSERT_GT(weight, 0.0) << "the dot at " << p.x << "," << p.y << "," << p.z << " was not drawn";
+    EXPECT_NEAR(ndc.x * r.resolution.x, x / weight, 1.0) << "point " << p.x << "," << p.y << "," << p.z;
+    EXPECT_NEAR(ndc.y * r.resolution.y, y / weight, 1.0) << "point " << p.x << "," << p.y << "," << p.z;
+    EXPECT_GT(camera.z, 0.0f) << "in front of the camera";
+    const int i = int(std::floor(ndc.x * r.resolution.x)), j = int(std::floor(ndc.y * r.resolution.y));
+    ASSERT_TRUE(i >= 0 && i < r.resolution.x && j >= 0 && j < r.resolution.y);
+    EXPECT_NEAR(camera.z, out.beauty.at("Z", i, j), 1e-3) << "the Z channel's depth at the point's pixel";
+  }
+}
+
 TEST(Render, FrameHairAimsAtTheHairAndFitsItInTheView) {
   Strands s;
   addStraight(s, {1.0f, 2.0f, 3.0f}, {1.5f, 2.2f, 3.1f});

@@ -12,8 +12,10 @@
 #include <OpenEXR/ImfFrameBuffer.h>
 #include <OpenEXR/ImfHeader.h>
 #include <OpenEXR/ImfInputFile.h>
+#include <OpenEXR/ImfIntAttribute.h>
 #include <OpenEXR/ImfMatrixAttribute.h>
 #include <OpenEXR/ImfOutputFile.h>
+#include <OpenEXR/ImfRationalAttribute.h>
 #include <OpenEXR/ImfStandardAttributes.h>
 #include <OpenEXR/ImfStringAttribute.h>
 #include <OpenEXR/ImfThreading.h>
@@ -39,6 +41,15 @@ Imath::M44f toImath(const glm::dmat4& m) {
   for (int row = 0; row < 4; ++row)
     for (int col = 0; col < 4; ++col) r[row][col] = static_cast<float>(m[row][col]);
   return r;
+}
+
+// A frame rate as OpenEXR's rational: NTSC's rates (23.976, 29.97, 59.94 as written in a Setup) as
+// the exact n·1000/1001 they stand for, any other as Imath's nearest rational.
+Imf::Rational framesPerSecond(double rate) {
+  const double ntsc = std::round(rate * 1.001);
+  if (std::abs(rate - ntsc * 1000.0 / 1001.0) < 5e-4 && std::abs(rate - std::round(rate)) > 1e-3)
+    return Imf::Rational(int(ntsc) * 1000, 1001);
+  return Imf::Rational(rate);
 }
 
 // Far beyond any frame hairgen renders (Resolution is at most 16384), and small enough that a header
@@ -212,6 +223,9 @@ void writeExr(const fs::path& file, const Image& image, const ExrMetadata& metad
   for (const auto& [key, value] : metadata.floats) header.insert(key, Imf::FloatAttribute(value));
   for (const auto& [key, value] : metadata.sizes)
     header.insert(key, Imf::V2iAttribute(Imath::V2i(value.x, value.y)));
+  for (const auto& [key, value] : metadata.ints) header.insert(key, Imf::IntAttribute(value));
+  if (metadata.framesPerSecond > 0.0)
+    Imf::addFramesPerSecond(header, framesPerSecond(metadata.framesPerSecond));
   if (metadata.camera) {
     Imf::addWorldToCamera(header, toImath(metadata.worldToCamera));
     Imf::addWorldToNDC(header, toImath(metadata.worldToNdc));

@@ -19,6 +19,12 @@ struct ExrMetadata {
   std::map<std::string, std::string> strings;  // e.g. "producer", "hairgen:configDigest"
   std::map<std::string, float> floats;         // e.g. "hairgen:fieldOfView"
   std::map<std::string, glm::ivec2> sizes;     // V2i attributes, e.g. "hairgen:resolution"
+  std::map<std::string, int> ints;             // e.g. "hairgen:frame", a sequence's frame number
+  double framesPerSecond = 0.0;                // > 0: OpenEXR's framesPerSecond, as a rational
+  // OpenEXR's camera attributes (ImfStandardAttributes.h), given as glm matrices for column vectors
+  // (p' = M p) and written transposed for Imath's row vectors (p' = p M): worldToCamera into camera
+  // space with +z forward, worldToNDC to (0, 0) at the image's top-left corner and (1, 1) at its
+  // bottom-right after the divide by w (views.h: openExrWorldToCamera, openExrWorldToNdc).
   glm::dmat4 worldToCamera{1.0}, worldToNdc{1.0};
   bool camera = false;  // write worldToCamera / worldToNDC
 };

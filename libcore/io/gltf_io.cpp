@@ -3,8 +3,13 @@
 #include <cctype>
 #include <cmath>
 #include <cstring>
+#include <functional>
+#include <limits>
 #include <optional>
+#include <ostream>
 #include <sstream>
+#include <string_view>
+#include <utility>
 
 #include <tiny_gltf.h>
 #include <nlohmann/json.hpp>
@@ -19,78 +24,8 @@ namespace {
 
 using tinygltf::Value;
 
-struct Builder {
-  tinygltf::Model model;
-  std::vector<unsigned char> buffer;
-
-  // Appends a tightly packed accessor; returns its index.
-  template <typename T, class A>
-  int add(const std::vector<T, A>& values, int componentType, int type, int target, bool minMax = false) {
-    while (buffer.size() % 4) buffer.push_back(0);
-    tinygltf::BufferView view;
-    view.buffer = 0;
-    view.byteOffset = buffer.size();
-    view.byteLength = values.size() * sizeof(T);
-    view.target = target;
-    const unsigned char* bytes = reinterpret_cast<const unsigned char*>(values.data());
-    buffer.insert(buffer.end(), bytes, bytes + view.byteLength);
-    model.bufferViews.push_back(view);
-
-    tinygltf::Accessor accessor;
-    accessor.bufferView = static_cast<int>(model.bufferViews.size() - 1);
-    accessor.componentType = componentType;
-    accessor.type = type;
-    accessor.count = values.size() * sizeof(T) / tinygltf::GetComponentSizeInBytes(componentType) /
-                     tinygltf::GetNumComponentsInType(type);
-    if (minMax) {
-      int n = tinygltf::GetNumComponentsInType(type);
-      const float* f = reinterpret_cast<const float*>(values.data());
-      accessor.minValues.assign(n, 1e300);
-      accessor.maxValues.assign(n, -1e300);
-      for (size_t i = 0; i < accessor.count; ++i)
-        for (int c = 0; c < n; ++c) {
-          accessor.minValues[c] = std::min<double>(accessor.minValues[c], f[i * n + c]);
-          accessor.maxValues[c] = std::max<double>(accessor.maxValues[c], f[i * n + c]);
-        }
-    }
-    model.accessors.push_back(accessor);
-    return static_cast<int>(model.accessors.size() - 1);
-  }
-};
-
-template <typename T>
-std::vector<T> perVertex(const Strands& s, const std::vector<T>& perStrand) {
-  std::vector<T> out(s.pointCount());
-  for (size_t i = 0; i < s.strandCount(); ++i)
-    for (uint32_t p = s.firstPoint[i]; p < s.firstPoint[i + 1]; ++p) out[p] = perStrand[i];
-  return out;
-}
-
-// glTF forbids UNSIGNED_INT vertex attributes, so integer ids travel as floats: exact below 2^24.
+// Old files (before per-strand accessors) stored ids on every vertex as floats: exact below 2^24.
 constexpr uint32_t kMaxExactId = 1u << 24;
-
-std::vector<float> asFloat(const std::vector<uint32_t>& ids, const char* what) {
-  std::vector<float> out(ids.size());
-  for (size_t i = 0; i < ids.size(); ++i) {
-    if (ids[i] >= kMaxExactId)
-      throw InputError(std::string(what) + " " + std::to_string(ids[i]) +
-                       " is too large for a glTF float attribute (exact below 16777216); use .hair");
-    out[i] = static_cast<float>(ids[i]);
-  }
-  return out;
-}
-
-std::vector<glm::vec3> asFloat(const std::vector<glm::uvec3>& ids, const char* what) {
-  std::vector<glm::vec3> out(ids.size());
-  for (size_t i = 0; i < ids.size(); ++i)
-    for (int c = 0; c < 3; ++c) {
-      if (ids[i][c] >= kMaxExactId)
-        throw InputError(std::string(what) + " " + std::to_string(ids[i][c]) +
-                         " is too large for a glTF float attribute (exact below 16777216); use .hair");
-      out[i][c] = static_cast<float>(ids[i][c]);
-    }
-  return out;
-}
 
 // The id stored as a float at `value`, checked to be a whole number in range.
 uint32_t idFrom(float value, const std::string& what, const std::string& name) {
@@ -98,10 +33,6 @@ uint32_t idFrom(float value, const std::string& what, const std::string& name) {
     throw InputError({name, 0},
                      what + " holds " + std::to_string(value) + ", not a whole number in [0, 2^24)");
   return static_cast<uint32_t>(value);
-}
-
-Value vec3Value(const glm::vec3& v) {
-  return Value(Value::Array{Value(double(v.x)), Value(double(v.y)), Value(double(v.z))});
 }
 
 // A checked view of one accessor's elements.
@@ -311,137 +242,376 @@ bool skipImage(tinygltf::Image*, const int, std::string*, std::string*, int, int
 
 }  // namespace
 
-std::vector<uint8_t> encodeGltf(const Strands& s, bool binary) {
+namespace {
+
+// ------------------------------------------------------------------------------------------------ writing
+//
+// The file is written in one pass straight from the strands: the JSON first (every accessor's size
+// follows from the counts), then each array into the binary chunk (or a .gltf's base64 data: URI),
+// contiguous arrays as they lie and converted ones (unit normals, clamped colours, indices) through a
+// small buffer, so no array is copied whole.
+
+constexpr int kFloatComponent = TINYGLTF_COMPONENT_TYPE_FLOAT;
+constexpr int kUintComponent = TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT;
+// Elements converted at a time on their way out: small next to any coupe, large enough that the
+// stream's calls cost nothing.
+constexpr size_t kChunkElements = size_t(1) << 16;
+// _STRAND is a float vertex attribute (glTF allows no UNSIGNED_INT one): exact below 2^24 strands.
+constexpr size_t kMaxStrands = size_t(1) << 24;
+
+// Where the buffer's bytes go: the stream as they are (.glb), or as base64 (a .gltf's data: URI).
+class Sink {
+ public:
+  Sink(std::ostream& out, bool base64) : out_(out), base64_(base64) {}
+
+  void write(const void* data, size_t size) {
+    const auto* bytes = static_cast<const uint8_t*>(data);
+    if (!base64_) {
+      out_.write(reinterpret_cast<const char*>(bytes), static_cast<std::streamsize>(size));
+      return;
+    }
+    size_t i = 0;
+    while (carried_ > 0 && carried_ < 3 && i < size) carry_[carried_++] = bytes[i++];
+    if (carried_ == 3) {
+      encode(carry_, 3);
+      carried_ = 0;
+    }
+    for (; i + 3 <= size; i += 3) encode(bytes + i, 3);
+    while (i < size) carry_[carried_++] = bytes[i++];
+  }
+
+  // base64's last group, padded with '='.
+  void finish() {
+    if (carried_ > 0) encode(carry_, carried_);
+    carried_ = 0;
+    out_.write(text_.data(), static_cast<std::streamsize>(text_.size()));
+    text_.clear();
+  }
+
+ private:
+  void encode(const uint8_t* in, int n) {
+    static constexpr char kAlphabet[] = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+    const uint32_t v = uint32_t(in[0]) << 16 | (n > 1 ? uint32_t(in[1]) << 8 : 0u) | (n > 2 ? in[2] : 0u);
+    const char group[4] = {kAlphabet[v >> 18 & 63], kAlphabet[v >> 12 & 63],
+                           n > 1 ? kAlphabet[v >> 6 & 63] : '=', n > 2 ? kAlphabet[v & 63] : '='};
+    text_.append(group, 4);
+    if (text_.size() >= 4 * kChunkElements) {
+      out_.write(text_.data(), static_cast<std::streamsize>(text_.size()));
+      text_.clear();
+    }
+  }
+
+  std::ostream& out_;
+  bool base64_;
+  uint8_t carry_[3] = {};
+  int carried_ = 0;
+  std::string text_;
+};
+
+// Values pushed one at a time, written to the sink kChunkElements at a time.
+template <typename T>
+class Chunked {
+ public:
+  explicit Chunked(Sink& sink) : sink_(sink) { buffer_.reserve(kChunkElements); }
+  void push(const T& value) {
+    buffer_.push_back(value);
+    if (buffer_.size() == kChunkElements) flush();
+  }
+  void flush() {
+    sink_.write(buffer_.data(), buffer_.size() * sizeof(T));
+    buffer_.clear();
+  }
+
+ private:
+  Sink& sink_;
+  std::vector<T> buffer_;
+};
+
+// The strands a glTF holds: those of two points or more. A one-point strand (a bare follicle) would be
+// a vertex no segment joins, which generic readers attach to the strand before it.
+struct Kept {
+  std::vector<uint32_t> strands;                    // their indices in the Strands
+  std::vector<std::pair<uint32_t, uint32_t>> runs;  // their points, as runs [begin, end) of indices
+  size_t points = 0;
+};
+
+Kept keptStrands(const Strands& s) {
+  Kept kept;
+  for (size_t i = 0; i < s.strandCount(); ++i) {
+    const uint32_t begin = s.firstPoint[i], end = s.firstPoint[i + 1];
+    if (end - begin < 2) continue;
+    kept.strands.push_back(static_cast<uint32_t>(i));
+    if (!kept.runs.empty() && kept.runs.back().second == begin)
+      kept.runs.back().second = end;
+    else
+      kept.runs.emplace_back(begin, end);
+    kept.points += end - begin;
+  }
+  return kept;
+}
+
+// One accessor and its tightly packed bufferView. Every component hairgen writes is 4 bytes.
+struct Array {
+  Array(int componentType_, int components_, size_t count_, int target_, std::function<void(Sink&)> write_)
+      : componentType(componentType_),
+        components(components_),
+        count(count_),
+        target(target_),
+        write(std::move(write_)) {}
+  int componentType;
+  int components;
+  size_t count;
+  int target;  // 0 for per-strand data, which no vertex stage reads
+  std::function<void(Sink&)> write;
+  nlohmann::ordered_json min, max;  // POSITION's bounds; null elsewhere
+  size_t bytes() const { return count * size_t(components) * 4; }
+};
+
+// A per-vertex array as it lies in memory, run by run.
+template <typename T>
+std::function<void(Sink&)> vertexBytes(const Kept& kept, const T* values) {
+  return [&kept, values](Sink& sink) {
+    for (const auto& [begin, end] : kept.runs) sink.write(values + begin, (end - begin) * sizeof(T));
+  };
+}
+
+// A per-vertex array converted on its way out: value(p) for each point p kept.
+template <typename T, class Value>
+std::function<void(Sink&)> vertexValues(const Kept& kept, Value value) {
+  return [&kept, value](Sink& sink) {
+    Chunked<T> out(sink);
+    for (const auto& [begin, end] : kept.runs)
+      for (uint32_t p = begin; p < end; ++p) out.push(value(p));
+    out.flush();
+  };
+}
+
+// A per-strand array, the kept strands' entries.
+template <typename T>
+std::function<void(Sink&)> strandBytes(const Kept& kept, const std::vector<T>& values) {
+  return [&kept, &values](Sink& sink) {
+    if (kept.strands.size() == values.size()) return sink.write(values.data(), values.size() * sizeof(T));
+    Chunked<T> out(sink);
+    for (uint32_t i : kept.strands) out.push(values[i]);
+    out.flush();
+  };
+}
+
+const char* typeName(int components) {
+  return components == 1 ? "SCALAR" : components == 2 ? "VEC2" : "VEC3";
+}
+
+}  // namespace
+
+void encodeGltf(std::ostream& out, const Strands& s, bool binary, size_t* droppedStrands) {
   s.validate("strands to write");
   if (s.pointCount() == 0) throw InputError("no points to write; a glTF accessor cannot be empty");
   if (s.pointCount() > UINT32_MAX - 1) throw InputError("too many points for uint32 glTF indices");
-  Builder b;
-  std::vector<uint32_t> indices;
-  for (size_t i = 0; i < s.strandCount(); ++i)
-    for (uint32_t p = s.firstPoint[i]; p + 1 < s.firstPoint[i + 1]; ++p) {
-      indices.push_back(p);
-      indices.push_back(p + 1);
-    }
-  if (indices.empty())
+  const Kept kept = keptStrands(s);
+  if (kept.strands.empty())
     throw InputError("no strand has two points; a LINES primitive needs at least one segment");
+  if (kept.strands.size() >= kMaxStrands)
+    throw InputError(
+        std::to_string(kept.strands.size()) +
+        " strands are too many for glTF's float _STRAND attribute (exact below 16777216); use .hair");
+  if (droppedStrands) *droppedStrands = s.strandCount() - kept.strands.size();
+  const size_t strands = kept.strands.size(), points = kept.points;
 
-  tinygltf::Primitive prim;
-  prim.mode = TINYGLTF_MODE_LINE;
-  prim.indices = b.add(indices, TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT, TINYGLTF_TYPE_SCALAR,
-                       TINYGLTF_TARGET_ELEMENT_ARRAY_BUFFER);
-  constexpr int kFloat = TINYGLTF_COMPONENT_TYPE_FLOAT;
-  constexpr int kArray = TINYGLTF_TARGET_ARRAY_BUFFER;
-  prim.attributes["POSITION"] = b.add(s.points, kFloat, TINYGLTF_TYPE_VEC3, kArray, true);
-  if (!s.normals.empty()) {
-    std::vector<glm::vec3> unit(s.normals);
-    // glTF requires unit normals; ones already unit to float precision are kept bit for bit.
-    for (glm::vec3& n : unit) {
-      float length = glm::length(n);
-      if (!(length > 0.0f))
-        n = glm::vec3(0.0f, 1.0f, 0.0f);
-      else if (std::abs(length - 1.0f) > 1e-5f)
-        n /= length;
+  std::vector<Array> arrays;
+  nlohmann::ordered_json attributes = nlohmann::ordered_json::object();
+  nlohmann::ordered_json perStrand = nlohmann::ordered_json::object();
+  auto add = [&](Array array) {
+    arrays.push_back(std::move(array));
+    return arrays.size() - 1;
+  };
+  auto vertex = [&](const char* name, int components, std::function<void(Sink&)> write) {
+    attributes[name] =
+        add(Array(kFloatComponent, components, points, TINYGLTF_TARGET_ARRAY_BUFFER, std::move(write)));
+  };
+  auto strand = [&](const char* name, int componentType, int components, std::function<void(Sink&)> write) {
+    perStrand[name] = add(Array(componentType, components, strands, 0, std::move(write)));
+  };
+
+  // Indices: each strand's consecutive vertices joined, (v, v + 1).
+  const size_t indices = add(
+      Array(kUintComponent, 1, 2 * (points - strands), TINYGLTF_TARGET_ELEMENT_ARRAY_BUFFER, [&](Sink& sink) {
+        Chunked<uint32_t> index(sink);
+        uint32_t first = 0;
+        for (uint32_t i : kept.strands) {
+          const uint32_t n = s.firstPoint[i + 1] - s.firstPoint[i];
+          for (uint32_t v = first; v + 1 < first + n; ++v) {
+            index.push(v);
+            index.push(v + 1);
+          }
+          first += n;
+        }
+        index.flush();
+      }));
+  Array position(kFloatComponent, 3, points, TINYGLTF_TARGET_ARRAY_BUFFER,
+                 vertexBytes(kept, s.points.data()));
+  glm::vec3 lo(std::numeric_limits<float>::max()), hi(std::numeric_limits<float>::lowest());
+  for (const auto& [begin, end] : kept.runs)
+    for (uint32_t p = begin; p < end; ++p) {
+      lo = glm::min(lo, s.points[p]);
+      hi = glm::max(hi, s.points[p]);
     }
-    prim.attributes["NORMAL"] = b.add(unit, kFloat, TINYGLTF_TYPE_VEC3, kArray);
-  }
+  position.min = {double(lo.x), double(lo.y), double(lo.z)};
+  position.max = {double(hi.x), double(hi.y), double(hi.z)};
+  attributes["POSITION"] = add(std::move(position));
+  if (!s.normals.empty())
+    // glTF requires unit normals; ones already unit to float precision are kept bit for bit.
+    vertex("NORMAL", 3, vertexValues<glm::vec3>(kept, [&](uint32_t p) {
+             const glm::vec3 n = s.normals[p];
+             const float length = glm::length(n);
+             if (!(length > 0.0f)) return glm::vec3(0.0f, 1.0f, 0.0f);
+             return std::abs(length - 1.0f) > 1e-5f ? n / length : n;
+           }));
   if (!s.colors.empty()) {
     // glTF colours lie in [0, 1]. A shaded coupe's per-strand ambient coefficient may pass 1: COLOR_0
     // holds the colours clamped, and _COLOR the values themselves, which a reader prefers.
-    std::vector<glm::vec3> clamped(s.colors);
+    vertex("COLOR_0", 3,
+           vertexValues<glm::vec3>(kept, [&](uint32_t p) { return glm::clamp(s.colors[p], 0.0f, 1.0f); }));
     bool outside = false;
-    for (glm::vec3& c : clamped) {
-      glm::vec3 in = glm::clamp(c, 0.0f, 1.0f);
-      outside = outside || in != c;
-      c = in;
-    }
-    prim.attributes["COLOR_0"] = b.add(clamped, kFloat, TINYGLTF_TYPE_VEC3, kArray);
-    if (outside) prim.attributes["_COLOR"] = b.add(s.colors, kFloat, TINYGLTF_TYPE_VEC3, kArray);
+    for (const auto& [begin, end] : kept.runs)
+      for (uint32_t p = begin; p < end && !outside; ++p)
+        outside = glm::clamp(s.colors[p], 0.0f, 1.0f) != s.colors[p];
+    if (outside) vertex("_COLOR", 3, vertexBytes(kept, s.colors.data()));
   }
-  if (!s.transparency.empty())
-    prim.attributes["_TRANSPARENCY"] = b.add(s.transparency, kFloat, TINYGLTF_TYPE_SCALAR, kArray);
-  if (!s.tangents.empty())
-    prim.attributes["_TANGENT"] = b.add(s.tangents, kFloat, TINYGLTF_TYPE_VEC3, kArray);
+  if (!s.transparency.empty()) vertex("_TRANSPARENCY", 1, vertexBytes(kept, s.transparency.data()));
+  if (!s.tangents.empty()) vertex("_TANGENT", 3, vertexBytes(kept, s.tangents.data()));
   // Every vertex has a width, the default where the strands carry none, so an importer that reads
   // _THICKNESS never sees zero; asset.extras.thicknessFromDefault tells hairgen to drop it again.
-  prim.attributes["_THICKNESS"] =
-      b.add(s.thickness.empty() ? std::vector<float>(s.pointCount(), s.defaultThickness) : s.thickness,
-            kFloat, TINYGLTF_TYPE_SCALAR, kArray);
-  if (!s.strandId.empty())
-    prim.attributes["_STRAND_ID"] =
-        b.add(asFloat(perVertex(s, s.strandId), "strand id"), kFloat, TINYGLTF_TYPE_SCALAR, kArray);
-  if (!s.rootUv.empty())
-    prim.attributes["_ROOT_UV"] = b.add(perVertex(s, s.rootUv), kFloat, TINYGLTF_TYPE_VEC2, kArray);
-  if (!s.guideIds.empty())
-    prim.attributes["_GUIDE_IDS"] =
-        b.add(asFloat(perVertex(s, s.guideIds), "guide id"), kFloat, TINYGLTF_TYPE_VEC3, kArray);
+  if (s.thickness.empty())
+    vertex("_THICKNESS", 1, vertexValues<float>(kept, [&](uint32_t) { return s.defaultThickness; }));
+  else
+    vertex("_THICKNESS", 1, vertexBytes(kept, s.thickness.data()));
+  // Each vertex's strand: the index of its strand's entry in the per-strand accessors.
+  vertex("_STRAND", 1, [&](Sink& sink) {
+    Chunked<float> strandOf(sink);
+    for (size_t k = 0; k < strands; ++k) {
+      const uint32_t i = kept.strands[k];
+      for (uint32_t p = s.firstPoint[i]; p < s.firstPoint[i + 1]; ++p) strandOf.push(static_cast<float>(k));
+    }
+    strandOf.flush();
+  });
+  // Per-strand data once per strand: accessors no vertex stage reads, named in the primitive's extras.
+  // Not vertex attributes, so ids are UNSIGNED_INT and exact whatever their size.
+  if (!s.strandId.empty()) strand("_STRAND_ID", kUintComponent, 1, strandBytes(kept, s.strandId));
+  if (!s.rootUv.empty()) strand("_ROOT_UV", kFloatComponent, 2, strandBytes(kept, s.rootUv));
+  if (!s.guideIds.empty()) strand("_GUIDE_IDS", kUintComponent, 3, strandBytes(kept, s.guideIds));
   if (!s.guideWeights.empty())
-    prim.attributes["_GUIDE_WEIGHTS"] =
-        b.add(perVertex(s, s.guideWeights), kFloat, TINYGLTF_TYPE_VEC3, kArray);
-  if (!s.rootTriangle.empty())
-    prim.attributes["_ROOT_TRIANGLE"] =
-        b.add(asFloat(perVertex(s, s.rootTriangle), "root triangle"), kFloat, TINYGLTF_TYPE_SCALAR, kArray);
-  if (!s.rootBary.empty())
-    prim.attributes["_ROOT_BARY"] = b.add(perVertex(s, s.rootBary), kFloat, TINYGLTF_TYPE_VEC3, kArray);
+    strand("_GUIDE_WEIGHTS", kFloatComponent, 3, strandBytes(kept, s.guideWeights));
+  if (!s.rootTriangle.empty()) strand("_ROOT_TRIANGLE", kUintComponent, 1, strandBytes(kept, s.rootTriangle));
+  if (!s.rootBary.empty()) strand("_ROOT_BARY", kFloatComponent, 3, strandBytes(kept, s.rootBary));
 
-  tinygltf::Model& m = b.model;
+  nlohmann::ordered_json accessors = nlohmann::ordered_json::array(), views = nlohmann::ordered_json::array();
+  size_t offset = 0;
+  for (size_t i = 0; i < arrays.size(); ++i) {
+    const Array& a = arrays[i];
+    nlohmann::ordered_json view = {{"buffer", 0}, {"byteOffset", offset}, {"byteLength", a.bytes()}};
+    if (a.target) view["target"] = a.target;
+    views.push_back(std::move(view));
+    nlohmann::ordered_json accessor = {{"bufferView", i},
+                                       {"componentType", a.componentType},
+                                       {"count", a.count},
+                                       {"type", typeName(a.components)}};
+    if (!a.min.is_null()) {
+      accessor["min"] = a.min;
+      accessor["max"] = a.max;
+    }
+    accessors.push_back(std::move(accessor));
+    offset += a.bytes();
+  }
+  const size_t bufferBytes = offset;
+
   // The hair's colour as the material's, so a DCC shows it: the header's default colour, or white
   // when COLOR_0 holds the colours (glTF multiplies the two).
-  tinygltf::Material material;
-  material.name = "hair";
   const glm::vec3 base = s.colors.empty() ? glm::clamp(s.defaultColor, 0.0f, 1.0f) : glm::vec3(1.0f);
-  material.pbrMetallicRoughness.baseColorFactor = {double(base.x), double(base.y), double(base.z), 1.0};
-  material.pbrMetallicRoughness.metallicFactor = 0.0;
-  material.pbrMetallicRoughness.roughnessFactor = 0.6;
-  material.doubleSided = true;
-  m.materials.push_back(material);
-  prim.material = 0;
-  tinygltf::Buffer buffer;
-  buffer.data = std::move(b.buffer);
-  m.buffers.push_back(std::move(buffer));
-  tinygltf::Mesh mesh;
-  mesh.name = "hair";
-  mesh.primitives.push_back(prim);
-  m.meshes.push_back(mesh);
-  tinygltf::Node node;
-  node.name = "hair";
-  node.mesh = 0;
-  m.nodes.push_back(node);
-  tinygltf::Scene scene;
-  scene.nodes.push_back(0);
-  m.scenes.push_back(scene);
-  m.defaultScene = 0;
-  m.asset.version = "2.0";
-  m.asset.generator = "hairgen " HAIRGEN_VERSION;
-  // Text from the strands' files goes through printableText: JSON must be UTF-8 (tinygltf's writer throws
-  // on anything else) and a control character has no business in it.
-  const auto text = [](const std::string& value) { return Value(printableText(value)); };
-  Value::Object extras;
-  extras["producer"] =
-      text(s.provenance.producer.empty() ? std::string("hairgen " HAIRGEN_VERSION) : s.provenance.producer);
-  extras["strands"] = Value(static_cast<double>(s.strandCount()));
-  extras["points"] = Value(static_cast<double>(s.pointCount()));
-  extras["stage"] = text(s.provenance.stage);
-  extras["seed"] = Value(std::to_string(s.provenance.seed));
-  extras["configDigest"] = text(s.provenance.configDigest);
-  extras["defaultThickness"] = Value(static_cast<double>(s.defaultThickness));
-  extras["defaultTransparency"] = Value(static_cast<double>(s.defaultTransparency));
-  extras["defaultColor"] = vec3Value(s.defaultColor);
-  // glTF's own units are metres with +y up; a file whose source did not say is not claimed to be.
+  // Text from the strands' files goes through printableText: JSON must be UTF-8 and a control
+  // character has no business in it.
+  const auto text = [](const std::string& value) { return printableText(value); };
   const Provenance& p = s.provenance;
-  extras["units"] = Value(std::string(p.metres ? "metres" : "unknown: the source file's own, not metres"));
-  extras["upAxis"] = Value(std::string(p.yUp ? "+y" : "unknown: the source file's own"));
-  extras["thickness"] = Value(std::string("_THICKNESS is each vertex's diameter, in the units above"));
-  extras["thicknessFromDefault"] = Value(s.thickness.empty());
+  nlohmann::ordered_json extras;
+  extras["producer"] = text(p.producer.empty() ? std::string("hairgen " HAIRGEN_VERSION) : p.producer);
+  extras["strands"] = strands;
+  extras["points"] = points;
+  extras["stage"] = text(p.stage);
+  extras["seed"] = std::to_string(p.seed);
+  extras["configDigest"] = text(p.configDigest);
+  extras["defaultThickness"] = double(s.defaultThickness);
+  extras["defaultTransparency"] = double(s.defaultTransparency);
+  extras["defaultColor"] = {double(s.defaultColor.x), double(s.defaultColor.y), double(s.defaultColor.z)};
+  // glTF's own units are metres with +y up; a file whose source did not say is not claimed to be.
+  extras["units"] = p.metres ? "metres" : "unknown: the source file's own, not metres";
+  extras["upAxis"] = p.yUp ? "+y" : "unknown: the source file's own";
+  extras["thickness"] = "_THICKNESS is each vertex's diameter, in the units above";
+  extras["thicknessFromDefault"] = s.thickness.empty();
   if (!p.source.empty()) extras["source"] = text(p.source);
   if (!p.sourceInfo.empty()) extras["sourceInfo"] = text(p.sourceInfo);
   if (!p.conversion.empty()) extras["conversion"] = text(p.conversion);
-  m.asset.extras = Value(std::move(extras));
+  if (strands < s.strandCount()) extras["onePointStrandsDropped"] = s.strandCount() - strands;
 
-  tinygltf::TinyGLTF writer;
+  nlohmann::ordered_json primitive = {
+      {"attributes", attributes}, {"indices", indices}, {"material", 0}, {"mode", TINYGLTF_MODE_LINE}};
+  primitive["extras"] = {
+      {"strandAttribute", "_STRAND"},
+      {"perStrand", perStrand},
+      {"note", "_STRAND is each vertex's strand: the index of its entry in the perStrand accessors"}};
+  nlohmann::ordered_json doc;
+  doc["asset"] = {{"version", "2.0"}, {"generator", "hairgen " HAIRGEN_VERSION}, {"extras", extras}};
+  doc["scene"] = 0;
+  doc["scenes"] = {{{"nodes", {0}}}};
+  doc["nodes"] = {{{"name", "hair"}, {"mesh", 0}}};
+  doc["meshes"] = {{{"name", "hair"}, {"primitives", {primitive}}}};
+  doc["materials"] = {{{"name", "hair"},
+                       {"pbrMetallicRoughness",
+                        {{"baseColorFactor", {double(base.x), double(base.y), double(base.z), 1.0}},
+                         {"metallicFactor", 0.0},
+                         {"roughnessFactor", 0.6}}},
+                       {"doubleSided", true}}};
+  doc["accessors"] = std::move(accessors);
+  doc["bufferViews"] = std::move(views);
+  // The data: URI's base64 is streamed in place of this mark; "buffers" comes last, so the mark's last
+  // occurrence is the buffer's whatever text the extras hold.
+  constexpr std::string_view kMark = "@hairgen-buffer@";
+  doc["buffers"] = {{{"byteLength", bufferBytes}}};
+  if (!binary) doc["buffers"][0]["uri"] = "data:application/octet-stream;base64," + std::string(kMark);
+  // Bytes that are not UTF-8 were made printable above; replace keeps dump() from throwing on any left.
+  std::string json = doc.dump(binary ? -1 : 2, ' ', false, nlohmann::ordered_json::error_handler_t::replace);
+
+  if (binary) {
+    while (json.size() % 4) json += ' ';
+    const uint64_t total = 12 + 8 + json.size() + 8 + bufferBytes;
+    if (total > UINT32_MAX)
+      throw InputError("the coupe needs " + std::to_string(total) +
+                       " bytes of .glb, past its 4 GiB limit; use .hair");
+    auto word = [&](uint32_t v) { out.write(reinterpret_cast<const char*>(&v), 4); };
+    out.write("glTF", 4);
+    word(2);
+    word(static_cast<uint32_t>(total));
+    word(static_cast<uint32_t>(json.size()));
+    word(0x4E4F534Au);  // "JSON"
+    out.write(json.data(), static_cast<std::streamsize>(json.size()));
+    word(static_cast<uint32_t>(bufferBytes));
+    word(0x004E4942u);  // "BIN\0"
+    Sink sink(out, false);
+    for (const Array& a : arrays) a.write(sink);
+  } else {
+    const size_t mark = json.rfind(kMark);
+    out.write(json.data(), static_cast<std::streamsize>(mark));
+    Sink sink(out, true);
+    for (const Array& a : arrays) a.write(sink);
+    sink.finish();
+    out.write(json.data() + mark + kMark.size(),
+              static_cast<std::streamsize>(json.size() - mark - kMark.size()));
+    out.put('\n');
+  }
+}
+
+std::vector<uint8_t> encodeGltf(const Strands& strands, bool binary, size_t* droppedStrands) {
   std::ostringstream out;
-  if (!writer.WriteGltfSceneToStream(&m, out, /*prettyPrint=*/!binary, binary))
-    throw IoError("tinygltf could not serialise the model");
-  std::string bytes = out.str();
+  encodeGltf(out, strands, binary, droppedStrands);
+  const std::string bytes = std::move(out).str();
   return std::vector<uint8_t>(bytes.begin(), bytes.end());
 }
 
@@ -561,37 +731,72 @@ Strands decodeGltf(const uint8_t* data, size_t size, const std::string& name,
         s.thickness.resize(n);
         for (size_t i = 0; i < n; ++i) s.thickness[i] = v->f(i, 0);
       }
-      // Per-strand values are stored on every vertex; the root's copy is the strand's value.
+      // Per-strand values: an accessor of one entry per strand named in the primitive's extras
+      // (perStrand, ids UNSIGNED_INT), or in files written before it a FLOAT attribute repeated on
+      // every vertex, whose root's copy is the strand's value.
       const size_t strands = s.strandCount();
-      auto root = [&](size_t strand) { return s.firstPoint[strand]; };
-      if (auto v = attribute("_STRAND_ID")) {
-        v->expect(TINYGLTF_COMPONENT_TYPE_FLOAT, 1);
+      const Value* named =
+          prim.extras.IsObject() && prim.extras.Has("perStrand") && prim.extras.Get("perStrand").IsObject()
+              ? &prim.extras.Get("perStrand")
+              : nullptr;
+      struct PerStrand {
+        AccessorView view;
+        bool onVertices;
+      };
+      auto perStrand = [&](const char* key, int components) -> std::optional<PerStrand> {
+        if (named && named->Has(key)) {
+          const Value& index = named->Get(key);
+          if (!index.IsInt())
+            throw InputError({name, 0}, std::string("perStrand.") + key + " is not an accessor index");
+          AccessorView view(m, index.Get<int>(), key, name);
+          if (view.count() != strands)
+            throw InputError({name, 0}, std::string(key) + " has " + std::to_string(view.count()) +
+                                            " entries for " + std::to_string(strands) + " strands");
+          if (view.componentType() != TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT)
+            view.expect(TINYGLTF_COMPONENT_TYPE_FLOAT, components);
+          view.expect(view.componentType(), components);
+          return PerStrand{view, false};
+        }
+        if (auto view = attribute(key)) {
+          view->expect(TINYGLTF_COMPONENT_TYPE_FLOAT, components);
+          return PerStrand{*view, true};
+        }
+        return std::nullopt;
+      };
+      // Strand i's entry: the accessor's i-th, or its root vertex's.
+      auto entry = [&](const PerStrand& v, size_t i) -> size_t { return v.onVertices ? s.firstPoint[i] : i; };
+      auto id = [&](const PerStrand& v, size_t i, int c, const char* key) {
+        return v.view.componentType() == TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT
+                   ? v.view.u(entry(v, i), c)
+                   : idFrom(v.view.f(entry(v, i), c), key, name);
+      };
+      auto floats = [&](const PerStrand& v, size_t i, int c) {
+        if (v.view.componentType() != TINYGLTF_COMPONENT_TYPE_FLOAT)
+          throw InputError({name, 0}, "a per-strand value of integers where floats belong");
+        return v.view.f(entry(v, i), c);
+      };
+      if (auto v = perStrand("_STRAND_ID", 1)) {
         s.strandId.resize(strands);
-        for (size_t i = 0; i < strands; ++i) s.strandId[i] = idFrom(v->f(root(i), 0), "_STRAND_ID", name);
+        for (size_t i = 0; i < strands; ++i) s.strandId[i] = id(*v, i, 0, "_STRAND_ID");
       }
-      if (auto v = attribute("_ROOT_TRIANGLE")) {
-        v->expect(TINYGLTF_COMPONENT_TYPE_FLOAT, 1);
+      if (auto v = perStrand("_ROOT_TRIANGLE", 1)) {
         s.rootTriangle.resize(strands);
-        for (size_t i = 0; i < strands; ++i)
-          s.rootTriangle[i] = idFrom(v->f(root(i), 0), "_ROOT_TRIANGLE", name);
+        for (size_t i = 0; i < strands; ++i) s.rootTriangle[i] = id(*v, i, 0, "_ROOT_TRIANGLE");
       }
-      if (auto v = attribute("_GUIDE_IDS")) {
-        v->expect(TINYGLTF_COMPONENT_TYPE_FLOAT, 3);
+      if (auto v = perStrand("_GUIDE_IDS", 3)) {
         s.guideIds.resize(strands);
         for (size_t i = 0; i < strands; ++i)
-          for (int c = 0; c < 3; ++c) s.guideIds[i][c] = idFrom(v->f(root(i), c), "_GUIDE_IDS", name);
+          for (int c = 0; c < 3; ++c) s.guideIds[i][c] = id(*v, i, c, "_GUIDE_IDS");
       }
-      if (auto v = attribute("_ROOT_UV")) {
-        v->expect(TINYGLTF_COMPONENT_TYPE_FLOAT, 2);
+      if (auto v = perStrand("_ROOT_UV", 2)) {
         s.rootUv.resize(strands);
-        for (size_t i = 0; i < strands; ++i) s.rootUv[i] = {v->f(root(i), 0), v->f(root(i), 1)};
+        for (size_t i = 0; i < strands; ++i) s.rootUv[i] = {floats(*v, i, 0), floats(*v, i, 1)};
       }
       auto strandVec3 = [&](const char* key, std::vector<glm::vec3>& out) {
-        if (auto v = attribute(key)) {
-          v->expect(TINYGLTF_COMPONENT_TYPE_FLOAT, 3);
+        if (auto v = perStrand(key, 3)) {
           out.resize(strands);
           for (size_t i = 0; i < strands; ++i)
-            out[i] = {v->f(root(i), 0), v->f(root(i), 1), v->f(root(i), 2)};
+            out[i] = {floats(*v, i, 0), floats(*v, i, 1), floats(*v, i, 2)};
         }
       };
       strandVec3("_GUIDE_WEIGHTS", s.guideWeights);
@@ -614,9 +819,11 @@ Strands readGltf(const std::filesystem::path& file) {
   return decodeGltf(bytes.data(), bytes.size(), file.string(), folder);
 }
 
-void writeGltf(const std::filesystem::path& file, const Strands& strands, bool binary) {
-  std::vector<uint8_t> bytes = namingFile(file.string(), [&] { return encodeGltf(strands, binary); });
-  writeFileAtomic(file, bytes.data(), bytes.size());
+void writeGltf(const std::filesystem::path& file, const Strands& strands, bool binary,
+               size_t* droppedStrands) {
+  AtomicFile out(file);
+  namingFile(file.string(), [&] { encodeGltf(out.stream(), strands, binary, droppedStrands); });
+  out.commit();
 }
 
 }  // namespace hairgen

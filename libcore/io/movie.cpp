@@ -176,12 +176,34 @@ bool writeMovie(const fs::path& pngPattern, const FrameRange& frames, const fs::
     });
   };
   // libx264's 4:2:0 needs even sizes: an odd width or height gets one black column or row (right,
-  // bottom), so a 1920x803 shot makes a 1920x804 movie.
-  encode(mp4, {"-vf", "pad=ceil(iw/2)*2:ceil(ih/2)*2", "-c:v", "libx264", "-pix_fmt", "yuv420p", "-crf", "18",
-               "-movflags", "+faststart", "-f", "mp4"});
-  const std::string filter =
-      "fps=" + formatReal(options.gifFrameRate) + ",scale=" + std::to_string(options.gifWidth) +
-      ":-1:flags=lanczos,split[a][b];[a]palettegen=stats_mode=diff[p];[b][p]paletteuse";
+  // bottom), so a 1920x803 shot makes a 1920x804 movie. The frames are sRGB, whose primaries are
+  // BT.709's: they are converted to Y'CbCr with BT.709's matrix in limited range (the scale filter's
+  // out_color_matrix; ffmpeg's default would be BT.601's) and the stream is tagged so, which players
+  // and browsers read to convert back.
+  encode(mp4, {"-vf",
+               "pad=ceil(iw/2)*2:ceil(ih/2)*2,scale=out_color_matrix=bt709:out_range=tv:flags=accurate_rnd,"
+               "format=yuv420p",
+               "-c:v",
+               "libx264",
+               "-pix_fmt",
+               "yuv420p",
+               "-colorspace",
+               "bt709",
+               "-color_primaries",
+               "bt709",
+               "-color_trc",
+               "bt709",
+               "-color_range",
+               "tv",
+               "-crf",
+               "18",
+               "-movflags",
+               "+faststart",
+               "-f",
+               "mp4"});
+  // The GIF at the frames' own size: people look at it beside the frames.
+  const std::string filter = "fps=" + formatReal(options.gifFrameRate) +
+                             ",split[a][b];[a]palettegen=stats_mode=diff[p];[b][p]paletteuse";
   encode(gif, {"-vf", filter, "-loop", "0", "-f", "gif"});
   return true;
 }

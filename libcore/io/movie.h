@@ -1,6 +1,7 @@
 // Preview movies of a frame sequence, made by Debian's ffmpeg (run as a separate program, its arguments
-// passed as a list, never through a shell): an MP4 (H.264, yuv420p, plays everywhere) at the shot's
-// frame rate, and a small looping GIF for READMEs and reviews. People look at motion, not at frame
+// passed as a list, never through a shell): an MP4 (H.264, yuv420p with BT.709's matrix, tagged
+// BT.709, plays everywhere) at the shot's frame rate, and a looping GIF at the frames' size for
+// READMEs and reviews. People look at motion, not at frame
 // numbers.
 #pragma once
 
@@ -13,7 +14,6 @@ namespace hairgen {
 
 struct MovieOptions {
   double frameRate = 24.0;
-  int gifWidth = 240;        // pixels; the GIF keeps the aspect
   double gifFrameRate = 12;  // frames per second of the GIF (every other frame at 24)
 };
 

@@ -450,7 +450,8 @@ void readBack(const ShadedImage& image, const Texture* motion, const LightDepth*
   if (depth && opacity) {
     Image& d = out.dom;
     d.width = d.height = depth->hairStart.width;
-    d.channels = {"Z", "layer1", "layer2", "layer3", "layer4"};
+    d.channels = {"Z", kChannelDomLayers[0], kChannelDomLayers[1], kChannelDomLayers[2],
+                  kChannelDomLayers[3]};
     d.planes.resize(5);
     readPlanes(depth->hairStart, {&d.planes[0]});
     readPlanes(*opacity, {&d.planes[1], &d.planes[2], &d.planes[3], &d.planes[4]});

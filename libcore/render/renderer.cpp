@@ -16,6 +16,7 @@
 #include "libcore/render/renderer.h"
 
 #include "libcore/render/passes.h"
+#include "libcore/render/views.h"
 #include "libcore/util/stopwatch.h"
 
 namespace hairgen {
@@ -37,9 +38,10 @@ RenderOutput renderHair(GlContext&, const RenderInput& in) {
   Scene scene(in);
   out.samples = scene.block * scene.block;
   out.settings = in.settings;
-  out.worldToCamera = scene.camera.view;
-  out.worldToNdc = scene.camera.proj * scene.camera.view;
-  out.worldToLight = scene.light.proj * scene.light.view;
+  out.worldToCamera = openExrWorldToCamera(scene.camera);
+  out.worldToNdc = openExrWorldToNdc(scene.camera);
+  out.lightWorldToCamera = openExrWorldToCamera(scene.light);
+  out.lightWorldToNdc = openExrWorldToNdc(scene.light);
   out.timings.upload = seconds(clock);
   out.hairReadInPlace = scene.hair.readsStrandsInPlace();
   out.lightMapsOnCpu = scene.lightRaster != nullptr;

@@ -35,15 +35,21 @@ inline constexpr const char* kChannelShadow = "shadow.Y";    // the light that a
 inline constexpr const char* kChannelMotionU = "motion.u";
 inline constexpr const char* kChannelMotionV = "motion.v";
 
+// The light's deep opacity maps (render --dom): beside Z, the layer dom's four channels, each the
+// opacity accumulated in one depth layer (Layer Sizes), so a compositor lists them under one layer.
+inline constexpr const char* kChannelDomLayers[4] = {"dom.layer1", "dom.layer2", "dom.layer3", "dom.layer4"};
+
 struct RenderTimings {
   double upload = 0.0, lightDepth = 0.0, opacity = 0.0, shading = 0.0, motion = 0.0, readback = 0.0;  // s
 };
 
 struct RenderOutput {
   Image beauty;  // R G B A (premultiplied), Z, kChannelOpacity, kChannelShadow[, kChannelMotionU, V]
-  Image dom;     // the light's view: Z (distance along the light's axis where hair begins), layer1-4
+  Image dom;     // the light's view: Z (distance along the light's axis where hair begins), kChannelDomLayers
+  // OpenEXR's worldToCamera and worldToNDC of the camera and of the light (views.h: openExrWorldToCamera,
+  // openExrWorldToNdc), for column vectors.
   glm::dmat4 worldToCamera{1.0}, worldToNdc{1.0};
-  glm::dmat4 worldToLight{1.0};
+  glm::dmat4 lightWorldToCamera{1.0}, lightWorldToNdc{1.0};
   RenderTimings timings;
   int samples = 1;               // the samples used (Samples, clamped to what the device offers)
   bool hairReadInPlace = false;  // whether the device read the hair where it lay (RenderInput::readInPlace)

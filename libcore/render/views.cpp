@@ -62,6 +62,22 @@ View lightView(const RenderSettings& r, const BoundingSphere& scene, int size) {
   return v;
 }
 
+glm::dmat4 openExrWorldToCamera(const View& v) {
+  // OpenGL's view space looks along −z: turning z round makes it OpenEXR's (and RenderMan's) camera.
+  return glm::scale(glm::dmat4(1.0), glm::dvec3(1.0, 1.0, -1.0)) * v.view;
+}
+
+glm::dmat4 openExrWorldToNdc(const View& v) {
+  // Clip space to OpenEXR's NDC before the divide: x' = (x + w)/2, y' = (w − y)/2, so after it
+  // OpenGL's [−1, 1] with y up becomes [0, 1] with y down; z and w are kept.
+  glm::dmat4 toNdc(1.0);
+  toNdc[0][0] = 0.5;
+  toNdc[1][1] = -0.5;
+  toNdc[3][0] = 0.5;  // column 3 multiplies w
+  toNdc[3][1] = 0.5;
+  return toNdc * v.proj * v.view;
+}
+
 View subpixelView(const View& camera, int block) {
   View fine = camera;
   fine.width = camera.width * block;

@@ -34,6 +34,16 @@ View cameraView(const RenderSettings& render, const BoundingSphere& scene);
 // (120° when the light is inside it).
 View lightView(const RenderSettings& render, const BoundingSphere& scene, int size);
 
+// OpenEXR's camera attributes of a view (ImfStandardAttributes.h), as glm matrices for column vectors
+// (p' = M p; the EXR writer transposes them for Imath's row vectors, p' = p M):
+//   worldToCamera: world to camera space, left-handed, +x right and +y up in the image, +z the viewing
+//                  direction, so a point in front of the camera has z > 0 (its distance along the axis,
+//                  the Z channel); metres.
+//   worldToNdc:    world to NDC, x right and y down, (0, 0) the image's top-left corner and (1, 1) its
+//                  bottom-right, after the divide by w: pixel (x, y)'s centre is at ((x + ½)/W, (y + ½)/H).
+glm::dmat4 openExrWorldToCamera(const View& view);
+glm::dmat4 openExrWorldToNdc(const View& view);
+
 // The same camera on a grid of block × block sub-pixels per pixel.
 View subpixelView(const View& camera, int block);
 

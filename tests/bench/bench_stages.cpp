@@ -48,6 +48,7 @@
 #include <tbb/info.h>
 
 #include "libcore/config/setup.h"
+#include "libcore/io/gltf_io.h"
 #include "libcore/io/hair_io.h"
 #include "libcore/io/obj_io.h"
 #include "libcore/physics/cantilever.h"
@@ -70,6 +71,7 @@ constexpr double kGrowCoupe3GuidesPerSecond = 5000.0, kGrowDefaultGuidesPerSecon
 constexpr double kInterpolateSeconds = 0.05, kShadeSeconds = 0.4, kReadCacheSeconds = 0.3;
 constexpr double kRender1080pSeconds = 4.0;   // 150,000 strands at 1920×1080 (the whole command's)
 constexpr double kRenderPeakOverCache = 3.0;  // its peak memory over the cache's size
+constexpr double kConvertGlbSeconds = 3.0;    // a 50,000-strand coupe, .hair to .glb (issue 36)
 constexpr double kAnjyoFramesPerSecond = 200.0, kSpringsFramesPerSecond = 24.0;
 
 // `done` things in `seconds` against a target of `perSecond` a second, `unit` naming them ("guides/s").
@@ -409,6 +411,20 @@ void WriteCache(benchmark::State& state) {
   std::filesystem::remove(file);
 }
 BENCHMARK(WriteCache)->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(3.0);
+
+// `hairgen convert coupe.hair coupe.glb` of a coupe the size of the default one: read, then write.
+void ConvertToGlb(benchmark::State& state) {
+  const std::filesystem::path hair = std::filesystem::temp_directory_path() / "hairgen_bench_convert.hair";
+  const std::filesystem::path glb = std::filesystem::temp_directory_path() / "hairgen_bench_convert.glb";
+  writeHair(hair, coupe3Strands(50000));
+  Stopwatch clock;
+  for (auto _ : state) writeGltf(glb, readHair(hair), true);
+  timeTarget(state, clock.lap(), kConvertGlbSeconds);
+  state.SetBytesProcessed(int64_t(state.iterations()) * int64_t(std::filesystem::file_size(glb)));
+  std::filesystem::remove(hair);
+  std::filesystem::remove(glb);
+}
+BENCHMARK(ConvertToGlb)->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(3.0);
 
 void Render(benchmark::State& state) {
   static GlContext gl;
