@@ -17,7 +17,7 @@ namespace hairgen {
   X(kWorkFailed, 1, "the work failed (I/O while writing, a numerical failure)") \
   X(kBadInput, 2, "bad usage or bad input (config, mesh, cache, command line)") \
   X(kNoDevice, 3, "no rendering device could be opened")                        \
-  X(kDiffFailed, 4, "`hairgen diff` found the images beyond the thresholds")
+  X(kDiffFailed, 4, "`hairgen diff` found the images or caches beyond the thresholds")
 
 enum class ExitCode : int {
 #define HAIRGEN_EXIT_ENUMERATOR(name, value, meaning) name = value,
