@@ -1,5 +1,6 @@
 #include "libcore/render/readback.h"
 
+#include <algorithm>
 #include <cstring>
 #include <memory>
 
@@ -39,12 +40,27 @@ constexpr size_t kRowsPerTask = 64;
 
 }  // namespace
 
-void readPlanes(const std::vector<PlaneRead>& reads) {
-  std::vector<size_t> offsets;
+void readPlanes(const std::vector<PlaneRead>& reads, ReadbackLayout layout) {
+  const bool wholeTextures =
+      layout == ReadbackLayout::kAuto ? softwareRasteriser() : layout == ReadbackLayout::kWholeTextures;
+  struct Slice {
+    const Texture* texture;
+    GLenum format;
+    size_t offset, components;  // floats a texel in the buffer
+  };
+  std::vector<Slice> slices;
+  std::vector<std::pair<size_t, size_t>> sources;  // per read: its slice, its component there
   size_t total = 0;
   for (const PlaneRead& r : reads) {
-    offsets.push_back(total);
-    total += size_t(r.texture->width) * size_t(r.texture->height) * sizeof(float);
+    auto same =
+        std::find_if(slices.begin(), slices.end(), [&](const Slice& s) { return s.texture == r.texture; });
+    if (!wholeTextures || same == slices.end()) {
+      const size_t components = wholeTextures ? 4 : 1;
+      slices.push_back({r.texture, wholeTextures ? GL_RGBA : kChannelFormats[r.channel], total, components});
+      total += size_t(r.texture->width) * size_t(r.texture->height) * components * sizeof(float);
+      same = slices.end() - 1;
+    }
+    sources.emplace_back(size_t(same - slices.begin()), wholeTextures ? size_t(r.channel) : 0);
   }
   if (total == 0) return;
   std::unique_ptr<PackBuffer> own;
@@ -63,11 +79,10 @@ void readPlanes(const std::vector<PlaneRead>& reads) {
   }
   glBindBuffer(GL_PIXEL_PACK_BUFFER, buffer->id);
   glPixelStorei(GL_PACK_ALIGNMENT, 4);
-  for (size_t i = 0; i < reads.size(); ++i) {
-    const PlaneRead& r = reads[i];
-    const size_t bytes = size_t(r.texture->width) * size_t(r.texture->height) * sizeof(float);
-    glGetTextureImage(r.texture->id, 0, kChannelFormats[r.channel], GL_FLOAT, static_cast<GLsizei>(bytes),
-                      reinterpret_cast<void*>(uintptr_t(offsets[i])));
+  for (const Slice& s : slices) {
+    const size_t bytes = size_t(s.texture->width) * size_t(s.texture->height) * s.components * sizeof(float);
+    glGetTextureImage(s.texture->id, 0, s.format, GL_FLOAT, static_cast<GLsizei>(bytes),
+                      reinterpret_cast<void*>(uintptr_t(s.offset)));
   }
   glBindBuffer(GL_PIXEL_PACK_BUFFER, 0);
   checkGl("reading the images into a pixel-pack buffer");
@@ -79,16 +94,24 @@ void readPlanes(const std::vector<PlaneRead>& reads) {
     r.plane->resize(size_t(r.texture->width) * size_t(r.texture->height));
     rows = std::max(rows, size_t(r.texture->height));
   }
-  // Plane by row block: each block's rows flipped into place.
+  // Plane by row block: each block's rows turned top to bottom.
   tbb::parallel_for(tbb::blocked_range2d<size_t>(0, reads.size(), 1, 0, rows, kRowsPerTask),
                     [&](const tbb::blocked_range2d<size_t>& range) {
                       for (size_t i = range.rows().begin(); i < range.rows().end(); ++i) {
                         const PlaneRead& r = reads[i];
+                        const Slice& s = slices[sources[i].first];
                         const size_t w = size_t(r.texture->width), h = size_t(r.texture->height);
-                        const size_t end = std::min(range.cols().end(), h);
-                        for (size_t y = range.cols().begin(); y < end; ++y)
-                          std::memcpy(r.plane->data() + (h - 1 - y) * w,
-                                      mapped + offsets[i] + y * w * sizeof(float), w * sizeof(float));
+                        const size_t end = std::min(range.cols().end(), h), n = s.components;
+                        for (size_t y = range.cols().begin(); y < end; ++y) {
+                          const auto* from = reinterpret_cast<const float*>(mapped + s.offset) + y * w * n;
+                          float* to = r.plane->data() + (h - 1 - y) * w;
+                          if (n == 1) {
+                            std::memcpy(to, from, w * sizeof(float));
+                            continue;
+                          }
+                          from += sources[i].second;
+                          for (size_t x = 0; x < w; ++x) to[x] = from[x * n];
+                        }
                       }
                     });
   if (!glUnmapNamedBuffer(buffer->id)) renderFailure("the pixel-pack buffer's contents were lost while read");
