@@ -31,8 +31,13 @@
 //                       (issue 34), peak memory (peak_MB) against 3× the cache (peak_of_target).
 //   RenderSequence/frames: the render stage frame after frame on one context (as `render --frames`),
 //                       the coupe moved between frames: seconds a frame (frame_s) against 0.1 s on a GPU.
+//   Readback/pbo:       the beauty's seven planes read back at 1920×1080: 0 as readBack did before,
+//                       1 and 2 through the pixel-pack buffer (readback.h), channel by channel and
+//                       whole textures.
 //   DeviceStart:        opening the EGL context and the first render of one strand (the programs
-//                       compiled): what `hairgen render` spends before its first pass.
+//                       compiled): what `hairgen render` spends before its first pass. Run it alone
+//                       (--benchmark_filter=DeviceStart): after another benchmark's context the display
+//                       is already initialised, and the label says so.
 // The render benchmarks find hairgen and the sources where they were built; HAIRGEN_BENCH_BINARY and
 // HAIRGEN_BENCH_SOURCE name others (a build carried to another machine: scripts/device-check.sh).
 // Every benchmark with a target gives `of_target` (its figure over the target: 1 or more meets it) and
@@ -64,6 +69,7 @@
 #include "libcore/io/obj_io.h"
 #include "libcore/render/gl_context.h"
 #include "libcore/render/gl_resources.h"
+#include "libcore/render/readback.h"
 #include "libcore/util/stopwatch.h"
 #include "stages/cantilever.h"
 #include "stages/grow.h"
@@ -442,8 +448,10 @@ BENCHMARK(WriteCache)->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(3.0
 
 // The render benchmarks' context, opened once (a sequence's, reused by every iteration), and whether it
 // rasterises on the CPU (the targets differ).
+bool benchContextOpened = false;
 GlContext& benchContext() {
   static GlContext gl;
+  benchContextOpened = true;
   return gl;
 }
 bool onGpu() {
@@ -624,7 +632,8 @@ void DeviceStart(benchmark::State& state) {
     start.devices += gl.startTimes().devices;
     start.display += gl.startTimes().display;
     start.context += gl.startTimes().context;
-    label = gl.renderer() + " (" + gl.platform() + ")";
+    label = gl.renderer() + " (" + gl.platform() + ")" +
+            (benchContextOpened ? ", the display already initialised by another benchmark's context" : "");
   }
   const double n = double(state.iterations());
   state.counters["open_s"] = opening / n;
@@ -633,9 +642,49 @@ void DeviceStart(benchmark::State& state) {
   state.counters["context_s"] = start.context / n;
   state.counters["first_render_s"] = first / n;
   state.SetLabel(label);
-  benchContext().makeCurrent();  // the other benchmarks' context, current again
+  if (benchContextOpened) benchContext().makeCurrent();  // the other benchmarks' context, current again
 }
 BENCHMARK(DeviceStart)->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(3);
+
+// The beauty image's readback at 1920×1080 (issue 34): R G B A, Z, opacity and shadow from two
+// RGBA32F textures as the resolve leaves them. pbo 0: what readBack did before (each texture whole
+// through a pageable glGetTextureImage, then split into planes on one thread); readPlanes through a
+// pixel-pack buffer, pbo 1 channel by channel (a GPU's layout), 2 whole textures (llvmpipe's).
+void Readback(benchmark::State& state) {
+  benchContext().makeCurrent();
+  const int w = 1920, h = 1080;
+  std::vector<float> texels(size_t(w) * h * 4);
+  for (size_t i = 0; i < texels.size(); ++i) texels[i] = float(i % 1021) * 0.25f;
+  const Texture color(GL_RGBA32F, w, h), data(GL_RGBA32F, w, h);
+  for (const Texture* t : {&color, &data})
+    glTextureSubImage2D(t->id, 0, 0, 0, w, h, GL_RGBA, GL_FLOAT, texels.data());
+  glFinish();
+  std::vector<std::vector<float>> planes(7);
+  for (auto _ : state) {
+    if (state.range(0) > 0) {
+      std::vector<PlaneRead> reads;
+      for (int c = 0; c < 4; ++c) reads.push_back({&color, c, &planes[size_t(c)]});
+      for (int c = 0; c < 3; ++c) reads.push_back({&data, c, &planes[size_t(4 + c)]});
+      readPlanes(reads, state.range(0) == 1 ? ReadbackLayout::kChannels : ReadbackLayout::kWholeTextures);
+    } else {
+      for (const Texture* t : {&color, &data}) {
+        std::vector<float> rgba(size_t(w) * h * 4);
+        glGetTextureImage(t->id, 0, GL_RGBA, GL_FLOAT, GLsizei(rgba.size() * sizeof(float)), rgba.data());
+        const int first = t == &color ? 0 : 4, count = t == &color ? 4 : 3;
+        for (int c = 0; c < count; ++c) {
+          std::vector<float>& plane = planes[size_t(first + c)];
+          plane.resize(size_t(w) * h);
+          for (int y = 0; y < h; ++y)
+            for (int x = 0; x < w; ++x) plane[size_t(h - 1 - y) * w + x] = rgba[(size_t(y) * w + x) * 4 + c];
+        }
+      }
+    }
+    benchmark::DoNotOptimize(planes[6].data());
+  }
+  state.SetBytesProcessed(int64_t(state.iterations()) * 7 * w * h * int64_t(sizeof(float)));
+  state.SetLabel(deviceLabel());
+}
+BENCHMARK(Readback)->ArgName("pbo")->DenseRange(0, 2)->Unit(benchmark::kMillisecond)->UseRealTime();
 
 // After the benchmarks' own lines, every figure that has a target in one table: the figure, the target,
 // the figure over the target and whether it is met (the README's Performance table gives the same
