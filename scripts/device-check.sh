@@ -9,6 +9,8 @@
 #       device README names, dispatch to its driver), into DIR/hairgen-pack.tar.xz. libstdc++ and
 #       libgcc_s go in as a fallback, used only where the machine's own are older. The image module's
 #       OpenImageIO libraries (~360 MB) stay behind: only `diff` and `info` of non-EXR images need them.
+#       This script goes into DIR too, for a checkout that lacks it: `bash DIR/device-check.sh run DIR OUT`
+#       from the repository's root.
 #   scripts/device-check.sh run DIR OUT
 #       There, from the repository's root (golden/, configs/, tests/golden_test.sh): unpacks DIR's
 #       archive into a temporary folder, then
@@ -66,9 +68,13 @@ pack() {
   # Which hairgen this is, for the summary.
   {
     echo "packed $(date -u +%FT%TZ) from $(cd "$build" && pwd)"
-    git -C "$(dirname "$0")/.." log -1 --format='commit %h %s' 2>/dev/null
+    local home
+    home=$(sed -n 's/^CMAKE_HOME_DIRECTORY:INTERNAL=//p' "$build/CMakeCache.txt")
+    git -C "$home" log -1 --format="commit %h %s (checkout $home)" 2>/dev/null
     echo "$("$build/hairgen" --version 2>/dev/null)"
   } >"$stage/PACKED"
+  # The script itself, so a checkout without it (main before this change) runs it from DIR.
+  cp "$0" "$dir/device-check.sh"
   rm -f "$dir/hairgen-pack.tar.xz"
   tar -C "$stage" -cf - . | xz -T0 -6 >"$dir/hairgen-pack.tar.xz" || die "could not write $dir/hairgen-pack.tar.xz"
   rm -rf "$stage"
@@ -86,8 +92,10 @@ json() { python3 -c "import json, sys; d = json.load(open(sys.argv[1])); print($
 
 run() {
   local dir=$1 out=$2
-  local src
-  src=$(cd "$(dirname "$0")/.." && pwd)
+  # The repository: the current folder where it holds golden/ (the device runs commands in its root),
+  # else the one this script is in.
+  local src=$PWD
+  [ -d "$src/golden" ] && [ -f "$src/tests/golden_test.sh" ] || src=$(cd "$(dirname "$0")/.." && pwd)
   [ -f "$dir/hairgen-pack.tar.xz" ] || die "$dir/hairgen-pack.tar.xz: pack it first (scripts/device-check.sh pack $dir)"
   mkdir -p "$out" || die "cannot write $out"
   local work
