@@ -3,10 +3,10 @@
 // Rendering goes into framebuffer objects only.
 //
 // One context serves a whole sequence (`render --frames`, `run` on a shot): what a frame makes that the
-// next would make again (a program from the same GLSL, the head's buffers for the same mesh) is kept in
-// the context's store under a key naming everything it was made from, and handed back to the next frame
-// that asks for the same key. A kept object is the one a fresh render would have made, so a frame of a
-// sequence equals the frame rendered alone, byte for byte.
+// next would make again (a program linked from the same GLSL, the readback's pixel-pack buffer) is
+// kept in the context's store under a key naming everything it was made from, and handed back to the
+// next frame that asks for the same key. A kept object is the one a fresh render would have made, so a
+// frame of a sequence equals the frame rendered alone, byte for byte.
 #pragma once
 
 #include <future>
