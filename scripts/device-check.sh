@@ -139,7 +139,7 @@ run() {
       failed=$((failed + 1))
       say "golden $case: FAILED ($((SECONDS - started)) s): $(tail -1 "$work/sheets/$case.log")"
       # hairgen diff's report, as golden_test.sh printed it.
-      grep -E '^  [A-Za-z.]+: mean|differ by|^(PASS|FAIL)' "$work/sheets/$case.log" | head -12 | sed 's/^/    /' >>"$summary"
+      grep -E '^  [A-Za-z.]+: mean|differ by|^(PASS|FAIL)' "$work/sheets/$case.log" | head -12 | sed 's/^/    /' | tee -a "$summary"
       [ -f "$golden/$case/sheet.png" ] && cp "$golden/$case/sheet.png" "$work/sheets/$case.png"
     fi
   done
@@ -210,7 +210,7 @@ run() {
         --benchmark_repetitions=5 --benchmark_report_aggregates_only=true 2>&1
       # The 48-frame sequence once (its figure is the median frame), unless a trial names its own.
       [ -z "${DEVICE_CHECK_BENCH:-}" ] && timeout 300 "$bin/hairgen_bench" --benchmark_filter="^RenderSequence" 2>&1
-    } | tee "$out/bench.txt" | grep -E '^\| |_median|^RenderSequence/' | tee -a "$summary" >/dev/null
+    } | tee "$out/bench.txt" | grep -E '^\| |_median|^RenderSequence/' | tee -a "$summary"
   else
     say "no hairgen_bench in the pack"
   fi
