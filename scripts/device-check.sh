@@ -116,7 +116,7 @@ run() {
   : >"$summary"
   say() { echo "$*" | tee -a "$summary"; }
 
-  say "== device-check $(date -u +%FT%TZ) on $(hostname): $(nproc) cores, load $(cut -d' ' -f1-3 /proc/loadavg)"
+  say "== device-check $(date -u +%FT%TZ) on $(cat /proc/sys/kernel/hostname): $(nproc) cores, load $(cut -d' ' -f1-3 /proc/loadavg)"
   say "$(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2 | sed 's/^ //')"
   command -v nvidia-smi >/dev/null && say "$(nvidia-smi --query-gpu=name,driver_version,memory.total --format=csv,noheader 2>&1)"
   say "$(cat "$work/PACKED")"
