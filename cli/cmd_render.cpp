@@ -67,13 +67,27 @@ RenderOutput renderStage(const CommonOptions& common, const Config& config, GlCo
   return out;
 }
 
-std::unique_ptr<GlContext> openDevice(const CommonOptions& common, const Config& config, Stats& stats) {
+std::unique_ptr<GlContext> openDevice(const CommonOptions& common, const Config& config, Stats& stats,
+                                      std::future<std::unique_ptr<GlContext>>* opening) {
   Stopwatch clock;
-  auto device = std::make_unique<GlContext>();
+  std::unique_ptr<GlContext> device;
+  if (opening) {
+    device = opening->get();
+    device->makeCurrent();
+  } else {
+    device = std::make_unique<GlContext>();
+  }
   const GlContext& gl = *device;
   stats.add("device", clock.lap());
-  stats.json()["device"] = {
-      {"platform", gl.platform()}, {"renderer", gl.renderer()}, {"version", gl.version()}};
+  const GlStartTimes& start = gl.startTimes();
+  stats.json()["device"] = {{"platform", gl.platform()},
+                            {"renderer", gl.renderer()},
+                            {"version", gl.version()},
+                            {"start",
+                             {{"devices", start.devices},
+                              {"display", start.display},
+                              {"context", start.context},
+                              {"background", opening != nullptr}}}};
   note(common, "render: " + gl.renderer() + " through EGL " + gl.platform() + " at " +
                    std::to_string(config.render.resolution.x) + "x" +
                    std::to_string(config.render.resolution.y));
@@ -267,11 +281,12 @@ void checkFrameHair(const Config& config, const Strands& hair, const std::string
 // --guides the shot's frame from its guides (stages/shot.h, the stage `run` calls, so the image is
 // run's). One device for every frame.
 void renderFrames(const RenderArgs& args, const Config& config, const ShotInputs& shot, FrameRange frames,
-                  Stats& stats, Stopwatch& clock) {
+                  Stats& stats, Stopwatch& clock, std::future<std::unique_ptr<GlContext>>& opening) {
   const bool sequence = args.sequence();
   const RenderOptions renderOptions = renderOptionsOf(args);
-  // One context for every frame, opened once the first frame's hair has been read: bad input is
-  // exit 2 on a machine without a device too, not 3.
+  // One context for every frame (its programs and buffers kept from frame to frame), opening in the
+  // background while the inputs are read and taken once the first frame's hair has been read: bad
+  // input is exit 2 on a machine without a device too, not 3.
   std::unique_ptr<GlContext> gl;
   // Motion vectors of frame f are the movement from frame f - 1 whenever that frame is in the shot
   // (Dynamics Info's Frames; without one, the frames rendered), so a range split across jobs gives
@@ -323,7 +338,7 @@ void renderFrames(const RenderArgs& args, const Config& config, const ShotInputs
     // of a 150,000-strand coupe's 230 MB).
     frameOptions.uploaded = nullptr;
     if (!args.motion) frameOptions.uploaded = [&hair] { hair = Strands{}; };
-    if (!gl) gl = openDevice(args.common, config, stats);
+    if (!gl) gl = openDevice(args.common, config, stats, &opening);
     RenderOutput out = renderStage(args.common, config, *gl, hair,
                                    frame.head  ? &*frame.head
                                    : shot.head ? shot.head
@@ -376,6 +391,8 @@ void registerRender(CLI::App& app, int& exitCode) {
     exitCode = runCommand("render", options->common, [&] {
       const RenderArgs& args = *options;
       checkRenderArgs(args);
+      // The device starts (tens of milliseconds in a GPU's driver) while the Setup and the hair are read.
+      std::future<std::unique_ptr<GlContext>> opening = GlContext::openInBackground();
       Stats stats("render");
       Stopwatch clock;
       Config config = loadStageConfig(args.setup, args.common,
@@ -391,7 +408,7 @@ void registerRender(CLI::App& app, int& exitCode) {
                             scene.head ? &*scene.head : nullptr,
                             headMotionOf(config),
                             args.common.force};
-      renderFrames(args, config, shot, frames, stats, clock);
+      renderFrames(args, config, shot, frames, stats, clock, opening);
       note(args.common, "render: wrote " + writtenFiles(args, frames, args.output) +
                             (args.preview.empty() ? "" : " and " + writtenFiles(args, frames, args.preview)));
       stats.write(args.common);

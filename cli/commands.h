@@ -3,6 +3,7 @@
 // single-stage commands, so both give the same files.
 #pragma once
 
+#include <future>
 #include <optional>
 #include <string>
 
@@ -45,8 +46,12 @@ ShadeResult shadeStage(const CommonOptions& common, const Config& config, Strand
                        bool volumeWritten = false);
 // Opens the device, reads the Setup's custom shader files and calls the render stage; records the
 // device and the passes' times in `stats`.
-// Opens the rendering device (once per command) and names it on stderr.
-std::unique_ptr<GlContext> openDevice(const CommonOptions& common, const Config& config, Stats& stats);
+// Opens the rendering device (once per command) and names it on stderr; with `opening`
+// (GlContext::openInBackground, started before the inputs were read), waits for that one instead and
+// makes it current here. Records the wait as the phase "device" and what the start cost in the JSON's
+// device.start (seconds: finding devices, the display's initialisation, the context's creation).
+std::unique_ptr<GlContext> openDevice(const CommonOptions& common, const Config& config, Stats& stats,
+                                      std::future<std::unique_ptr<GlContext>>* opening = nullptr);
 RenderOutput renderStage(const CommonOptions& common, const Config& config, GlContext& gl,
                          const Strands& hair, const Mesh* head, const RenderOptions& options, Stats& stats,
                          const FrameBefore* before = nullptr);

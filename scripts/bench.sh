@@ -21,7 +21,7 @@ case "$group" in
   cantilever) filter='CantileverStyling' ;;
   interpolate) filter='InterpolateCoupe3' ;;
   shade) filter='ShadeCoupe3' ;;
-  render) filter='Render' ;;
+  render) filter='Render|DeviceStart' ;;  # Render, RenderCommand, RenderSequence (issue 34's figures)
   simulate) filter='SimulateAnjyo|SimulateSprings' ;;
   cache) filter='ReadCache|WriteCache' ;;
   all) filter='.' ;;

@@ -2,6 +2,8 @@
 
 #include <cstdio>
 #include <cstring>
+#include <map>
+#include <mutex>
 
 #include <EGL/egl.h>
 #include <EGL/eglext.h>
@@ -9,6 +11,7 @@
 #include <GL/glcorearb.h>
 
 #include "libcore/util/error.h"
+#include "libcore/util/stopwatch.h"
 
 namespace hairgen {
 namespace {
@@ -56,26 +59,53 @@ std::string eglFailure(const char* call) {
   return std::string(call) + " failed (" + eglErrorName(error) + ", " + code + ")";
 }
 
-// Initialises `display` and makes a 4.5 core context current on it without a surface.
-bool openOn(EGLDisplay display, EGLContext& context, std::string& error) {
+// EGL gives every GlContext on a platform the same display, and eglTerminate ends it for all of them:
+// the contexts open on each display, so only the last one to close terminates it.
+std::mutex displaysMutex;
+std::map<EGLDisplay, int> openOnDisplay;
+
+void displayOpened(EGLDisplay display) {
+  std::lock_guard<std::mutex> lock(displaysMutex);
+  ++openOnDisplay[display];
+}
+
+void displayClosed(EGLDisplay display) {
+  std::lock_guard<std::mutex> lock(displaysMutex);
+  if (--openOnDisplay[display] > 0) return;
+  openOnDisplay.erase(display);
+  eglTerminate(display);
+}
+
+// Terminates a display no context is open on (what failed to open on it, or a probe, is given up).
+void terminateUnused(EGLDisplay display) {
+  std::lock_guard<std::mutex> lock(displaysMutex);
+  if (openOnDisplay.count(display) == 0) eglTerminate(display);
+}
+
+// Initialises `display` and makes a 4.5 core context current on it without a surface; adds the time
+// the display's initialisation took to `times->display` and the context's to `times->context`.
+bool openOn(EGLDisplay display, EGLContext& context, std::string& error, GlStartTimes* times = nullptr) {
+  Stopwatch clock;
   if (display == EGL_NO_DISPLAY) {
     error = eglFailure("eglGetPlatformDisplay");
     return false;
   }
   EGLint major = 0, minor = 0;
-  if (!eglInitialize(display, &major, &minor)) {
+  const bool initialised = eglInitialize(display, &major, &minor);
+  if (times) times->display += clock.lap();
+  if (!initialised) {
     error = eglFailure("eglInitialize");
     return false;
   }
   const char* extensions = eglQueryString(display, EGL_EXTENSIONS);
   if (!extensions || !std::strstr(extensions, "EGL_KHR_surfaceless_context")) {
     error = "no EGL_KHR_surfaceless_context";
-    eglTerminate(display);
+    terminateUnused(display);
     return false;
   }
   if (!eglBindAPI(EGL_OPENGL_API)) {
     error = eglFailure("eglBindAPI(EGL_OPENGL_API)");
-    eglTerminate(display);
+    terminateUnused(display);
     return false;
   }
   const EGLint configAttribs[] = {EGL_RENDERABLE_TYPE, EGL_OPENGL_BIT, EGL_NONE};
@@ -93,15 +123,16 @@ bool openOn(EGLDisplay display, EGLContext& context, std::string& error) {
       eglCreateContext(display, haveConfig ? config : EGL_NO_CONFIG_KHR, EGL_NO_CONTEXT, contextAttribs);
   if (context == EGL_NO_CONTEXT) {
     error = eglFailure("eglCreateContext(OpenGL 4.5 core)");
-    eglTerminate(display);
+    terminateUnused(display);
     return false;
   }
   if (!eglMakeCurrent(display, EGL_NO_SURFACE, EGL_NO_SURFACE, context)) {
     error = eglFailure("eglMakeCurrent");
     eglDestroyContext(display, context);
-    eglTerminate(display);
+    terminateUnused(display);
     return false;
   }
+  if (times) times->context += clock.lap();
   return true;
 }
 
@@ -142,22 +173,35 @@ struct GlContext::State {
   EGLDisplay display = EGL_NO_DISPLAY;
   EGLContext context = EGL_NO_CONTEXT;
   std::string platform;
+  GlStartTimes times;
 };
 
+namespace {
+
+// The GlContext whose context is current on this thread (EGL's current context is per thread).
+thread_local GlContext* currentContext = nullptr;
+
+}  // namespace
+
 GlContext::GlContext() : state_(std::make_unique<State>()) {
+  Stopwatch clock;
   Platforms p;
   std::string tried;
   if (!p.getPlatformDisplay)
     throw DeviceError("EGL has no eglGetPlatformDisplayEXT; cannot open a headless display");
+  const std::vector<EGLDeviceEXT> devices = p.devices();
+  state_->times.devices = clock.lap();
   // 1. The EGL device platform: every device but Mesa's software one (that is the surfaceless path).
-  for (EGLDeviceEXT device : p.devices()) {
+  for (EGLDeviceEXT device : devices) {
     std::string ext = p.describe(device);
     if (isSoftware(ext)) continue;
     std::string error;
     EGLDisplay display = p.getPlatformDisplay(EGL_PLATFORM_DEVICE_EXT, device, nullptr);
-    if (openOn(display, state_->context, error)) {
+    if (openOn(display, state_->context, error, &state_->times)) {
       state_->display = display;
       state_->platform = "device";
+      currentContext = this;
+      displayOpened(display);
       return;
     }
     tried += (tried.empty() ? "" : "; ") + ("EGL device (" + ext + "): " + error);
@@ -166,9 +210,11 @@ GlContext::GlContext() : state_(std::make_unique<State>()) {
   {
     std::string error;
     EGLDisplay display = p.getPlatformDisplay(EGL_PLATFORM_SURFACELESS_MESA, EGL_DEFAULT_DISPLAY, nullptr);
-    if (openOn(display, state_->context, error)) {
+    if (openOn(display, state_->context, error, &state_->times)) {
       state_->display = display;
       state_->platform = "surfaceless";
+      currentContext = this;
+      displayOpened(display);
       return;
     }
     tried += (tried.empty() ? "" : "; ") + ("Mesa surfaceless: " + error);
@@ -182,9 +228,43 @@ GlContext::GlContext() : state_(std::make_unique<State>()) {
 
 GlContext::~GlContext() {
   if (state_->display == EGL_NO_DISPLAY) return;
+  // The kept objects are deleted in this context: current here while they go (a context opened in
+  // the background may be current on no thread).
+  if (!kept_.empty()) {
+    makeCurrent();
+    kept_.clear();
+  }
   eglMakeCurrent(state_->display, EGL_NO_SURFACE, EGL_NO_SURFACE, EGL_NO_CONTEXT);
   eglDestroyContext(state_->display, state_->context);
-  eglTerminate(state_->display);
+  displayClosed(state_->display);
+  if (currentContext == this) currentContext = nullptr;
+}
+
+void GlContext::makeCurrent() {
+  if (!eglMakeCurrent(state_->display, EGL_NO_SURFACE, EGL_NO_SURFACE, state_->context))
+    throw DeviceError(eglFailure("eglMakeCurrent"));
+  currentContext = this;
+}
+
+void GlContext::release() {
+  eglMakeCurrent(state_->display, EGL_NO_SURFACE, EGL_NO_SURFACE, EGL_NO_CONTEXT);
+  if (currentContext == this) currentContext = nullptr;
+}
+
+GlContext* GlContext::current() {
+  return currentContext;
+}
+
+std::future<std::unique_ptr<GlContext>> GlContext::openInBackground() {
+  return std::async(std::launch::async, [] {
+    auto gl = std::make_unique<GlContext>();
+    gl->release();
+    return gl;
+  });
+}
+
+const GlStartTimes& GlContext::startTimes() const {
+  return state_->times;
 }
 
 const std::string& GlContext::platform() const {
@@ -215,7 +295,7 @@ std::vector<GlDeviceInfo> GlContext::probe() {
                   reinterpret_cast<const char*>(glGetString(GL_VERSION));
       eglMakeCurrent(display, EGL_NO_SURFACE, EGL_NO_SURFACE, EGL_NO_CONTEXT);
       eglDestroyContext(display, context);
-      eglTerminate(display);
+      terminateUnused(display);
     }
     out.push_back(info);
   };

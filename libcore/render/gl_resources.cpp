@@ -9,6 +9,7 @@
 #include <glm/gtc/type_ptr.hpp>
 
 #include "libcore/render/custom_shaders.h"
+#include "libcore/render/gl_context.h"
 #include "libcore/render/line_decimation.h"
 #include "libcore/render/shader_interface.h"
 #include "libcore/util/error.h"
@@ -80,7 +81,33 @@ GLuint compileStage(GLenum type, const StageSource& source, const char* program)
 
 }  // namespace
 
+namespace {
+
+// A linked program kept by the context (GlContext::kept) for every Program made from the same GLSL.
+struct LinkedProgram {
+  GLuint id = 0;
+  ~LinkedProgram() { glDeleteProgram(id); }
+};
+
+}  // namespace
+
 Program::Program(const StageSource& vertex, const StageSource& fragment, const char* name) {
+  GlContext* gl = GlContext::current();
+  if (!gl) {
+    id = link(vertex, fragment, name);
+    owned_ = true;
+    return;
+  }
+  // The same GLSL links to the same program: keyed by both stages' text, which is all a program is
+  // made from (a custom stage's file and Setup line only name it in errors, and an error keeps nothing).
+  id = gl->kept<LinkedProgram>(vertex.text + '\0' + fragment.text, [&] {
+           auto linked = std::make_unique<LinkedProgram>();
+           linked->id = link(vertex, fragment, name);
+           return linked;
+         }).id;
+}
+
+GLuint Program::link(const StageSource& vertex, const StageSource& fragment, const char* name) {
   const GLuint v = compileStage(GL_VERTEX_SHADER, vertex, name);
   GLuint f = 0;
   try {
@@ -89,7 +116,7 @@ Program::Program(const StageSource& vertex, const StageSource& fragment, const c
     glDeleteShader(v);
     throw;
   }
-  id = glCreateProgram();
+  const GLuint id = glCreateProgram();
   glAttachShader(id, v);
   glAttachShader(id, f);
   glLinkProgram(id);
@@ -97,7 +124,7 @@ Program::Program(const StageSource& vertex, const StageSource& fragment, const c
   glDeleteShader(f);
   GLint ok = 0;
   glGetProgramiv(id, GL_LINK_STATUS, &ok);
-  if (ok) return;
+  if (ok) return id;
   const CompilerMessage error = firstCompilerError(infoLog(id, true));
   glDeleteProgram(id);
   // A link error is about the two stages together: it names the custom one (the fragment stage's file
@@ -113,7 +140,7 @@ Program::Program(const StageSource& vertex, const StageSource& fragment, const c
 }
 
 Program::~Program() {
-  glDeleteProgram(id);
+  if (owned_) glDeleteProgram(id);
 }
 
 void Program::use() const {

@@ -38,6 +38,10 @@ struct StageSource {
 // A linked program of a vertex and a fragment stage. `name` ("hair shading") is for messages. A custom
 // stage that fails to compile, or a program with one that fails to link, throws InputError at the
 // custom file and the line the compiler names, on one line; hairgen's own stages failing throw Error.
+// With a GlContext current (GlContext::current), the program is compiled once per context: kept there
+// and shared by every Program of the same GLSL (a sequence's frames compile nothing after the first).
+// A pass sets the uniforms it reads before it draws, each frame the same ones, so a program a frame
+// before used draws as a fresh one would.
 class Program {
  public:
   Program(const StageSource& vertex, const StageSource& fragment, const char* name);
@@ -57,6 +61,10 @@ class Program {
   void set(const char* name, const std::vector<int>& v) const;
 
   GLuint id = 0;
+
+ private:
+  static GLuint link(const StageSource& vertex, const StageSource& fragment, const char* name);
+  bool owned_ = false;  // deleted with this Program (no GlContext to keep it)
 };
 
 // A 2D texture of one level, clamped at its edges.

@@ -8,6 +8,7 @@
 #include "glsl/embedded_glsl.h"
 #include "libcore/render/light_maps.h"
 #include "libcore/render/line_decimation.h"
+#include "libcore/render/readback.h"
 #include "libcore/render/shader_interface.h"
 
 namespace hairgen {
@@ -69,21 +70,6 @@ void useForHairStrips(const Program& p, const Scene& scene, const RenderSettings
   p.set("uMinWidth", float(scene.block));
   p.set("uBlock", scene.block);
   p.set("uOrder", ditherOrder(scene.block));
-}
-
-// Reads the first planes.size() float channels of a single-sample RGBA texture into planes (a null
-// plane is skipped), rows top to bottom.
-void readPlanes(const Texture& texture, std::vector<std::vector<float>*> planes) {
-  const int w = texture.width, h = texture.height;
-  std::vector<float> rgba(size_t(w) * h * 4);
-  glGetTextureImage(texture.id, 0, GL_RGBA, GL_FLOAT, static_cast<GLsizei>(rgba.size() * sizeof(float)),
-                    rgba.data());
-  for (size_t c = 0; c < planes.size(); ++c) {
-    if (!planes[c]) continue;
-    planes[c]->resize(size_t(w) * h);
-    for (int y = 0; y < h; ++y)
-      for (int x = 0; x < w; ++x) (*planes[c])[size_t(h - 1 - y) * w + x] = rgba[(size_t(y) * w + x) * 4 + c];
-  }
 }
 
 // A program's stage: `custom` in place of hairgen's `own` when the Setup names one, with the same
@@ -444,18 +430,21 @@ void readBack(const ShadedImage& image, const Texture* motion, const LightDepth*
   b.channels = {"R", "G", "B", "A", "Z", kChannelOpacity, kChannelShadow};
   if (motion) b.channels.insert(b.channels.end(), {kChannelMotionU, kChannelMotionV});
   b.planes.resize(b.channels.size());
-  readPlanes(image.color, {&b.planes[0], &b.planes[1], &b.planes[2], &b.planes[3]});
-  readPlanes(image.data, {&b.planes[4], &b.planes[5], &b.planes[6]});
-  if (motion) readPlanes(*motion, {&b.planes[7], &b.planes[8]});
+  std::vector<PlaneRead> reads;
+  for (int c = 0; c < 4; ++c) reads.push_back({&image.color, c, &b.planes[size_t(c)]});
+  for (int c = 0; c < 3; ++c) reads.push_back({&image.data, c, &b.planes[size_t(4 + c)]});
+  if (motion)
+    for (int c = 0; c < 2; ++c) reads.push_back({motion, c, &b.planes[size_t(7 + c)]});
   if (depth && opacity) {
     Image& d = out.dom;
     d.width = d.height = depth->hairStart.width;
     d.channels = {"Z", kChannelDomLayers[0], kChannelDomLayers[1], kChannelDomLayers[2],
                   kChannelDomLayers[3]};
     d.planes.resize(5);
-    readPlanes(depth->hairStart, {&d.planes[0]});
-    readPlanes(*opacity, {&d.planes[1], &d.planes[2], &d.planes[3], &d.planes[4]});
+    reads.push_back({&depth->hairStart, 0, &d.planes[0]});
+    for (int c = 0; c < 4; ++c) reads.push_back({opacity, c, &d.planes[size_t(1 + c)]});
   }
+  readPlanes(reads);
   checkGl("reading the images back");
   glBindFramebuffer(GL_FRAMEBUFFER, 0);
 }

@@ -21,10 +21,25 @@
 //                       bytes_per_second is the file's size over the time.
 //   SimulateSprings:    Model springs, 10,000 keyhairs of 32 particles through a head turn with
 //                       velocity smoothing (Petrovic et al. 2006 §5).
-//   Render/strands/width/height/samples: the render stage on coupe 3 with the head and shadows,
-//                       through whatever EGL opens (llvmpipe here); counters give each pass's seconds.
-//   RenderCommand:      the whole `hairgen render` of that coupe's cache at 1920×1080, a child process:
-//                       wall time against 4 s, peak memory (peak_MB) against 3× the cache (peak_of_target).
+//   Render/strands/width/height/samples: the render stage on coupe 3 (65 points a strand) with the head
+//                       and shadows, through whatever EGL opens (the label names it: llvmpipe here);
+//                       counters give each pass's seconds. At 150,000 strands, 1920×1080, Samples 1,
+//                       the GPU passes (light depth, deep opacity, shading: passes_s) against 5 ms on a
+//                       GPU (issue 34; no target on a software rasteriser).
+//   RenderCommand:      the whole `hairgen render` of that coupe's cache at 1920×1080, Samples 1, a child
+//                       process: wall time against 0.3 s on a GPU and 2 s on a software rasteriser
+//                       (issue 34), peak memory (peak_MB) against 3× the cache (peak_of_target).
+//   RenderSequence/frames: the render stage frame after frame on one context (as `render --frames`),
+//                       the coupe moved between frames: seconds a frame (frame_s) against 0.1 s on a GPU.
+//   Readback/pbo:       the beauty's seven planes read back at 1920×1080: 0 as readBack did before,
+//                       1 and 2 through the pixel-pack buffer (readback.h), channel by channel and
+//                       whole textures.
+//   DeviceStart:        opening the EGL context and the first render of one strand (the programs
+//                       compiled): what `hairgen render` spends before its first pass. Run it alone
+//                       (--benchmark_filter=DeviceStart): after another benchmark's context the display
+//                       is already initialised, and the label says so.
+// The render benchmarks find hairgen and the sources where they were built; HAIRGEN_BENCH_BINARY and
+// HAIRGEN_BENCH_SOURCE name others (a build carried to another machine: scripts/device-check.sh).
 // Every benchmark with a target gives `of_target` (its figure over the target: 1 or more meets it) and
 // the target; after the runs, a table lists them all (TargetTable, at the end).
 #include <benchmark/benchmark.h>
@@ -35,9 +50,11 @@
 
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <ctime>
 #include <map>
 #include <ostream>
@@ -53,6 +70,8 @@
 #include "libcore/io/obj_io.h"
 #include "libcore/physics/cantilever.h"
 #include "libcore/render/gl_context.h"
+#include "libcore/render/gl_resources.h"
+#include "libcore/render/readback.h"
 #include "libcore/util/stopwatch.h"
 #include "stages/grow.h"
 #include "stages/interpolate.h"
@@ -69,9 +88,13 @@ namespace {
 // or more meets it (issue 20 for the stages and caches, 15 and 16 for the dynamics).
 constexpr double kGrowCoupe3GuidesPerSecond = 5000.0, kGrowDefaultGuidesPerSecond = 2000.0;
 constexpr double kInterpolateSeconds = 0.05, kShadeSeconds = 0.4, kReadCacheSeconds = 0.3;
-constexpr double kRender1080pSeconds = 4.0;   // 150,000 strands at 1920×1080 (the whole command's)
-constexpr double kRenderPeakOverCache = 3.0;  // its peak memory over the cache's size
-constexpr double kConvertGlbSeconds = 3.0;    // a 50,000-strand coupe, .hair to .glb (issue 36)
+constexpr double kConvertGlbSeconds = 3.0;  // a 50,000-strand coupe, .hair to .glb (issue 36)
+// 150,000 strands of 65 points at 1920×1080, Samples 1 with shadows (issue 34): the whole command on a
+// GPU and on a software rasteriser (llvmpipe, 2 cores), the passes on a GPU, a frame of a sequence on
+// a GPU.
+constexpr double kRenderCommandGpuSeconds = 0.3, kRenderCommandSoftwareSeconds = 2.0;
+constexpr double kRenderPassesGpuSeconds = 0.005, kRenderFrameGpuSeconds = 0.1;
+constexpr double kRenderPeakOverCache = 3.0;  // the command's peak memory over the cache's size
 constexpr double kAnjyoFramesPerSecond = 200.0, kSpringsFramesPerSecond = 24.0;
 
 // `done` things in `seconds` against a target of `perSecond` a second, `unit` naming them ("guides/s").
@@ -87,13 +110,23 @@ void timeTarget(benchmark::State& state, double seconds, double target) {
   state.counters["target_s"] = target;
 }
 
+// The sources (configs/) and the hairgen binary the benchmarks use: where they were built, or the
+// environment's HAIRGEN_BENCH_SOURCE and HAIRGEN_BENCH_BINARY.
+std::filesystem::path sourceDir() {
+  const char* dir = std::getenv("HAIRGEN_BENCH_SOURCE");
+  return dir && *dir ? dir : HAIRGEN_SOURCE_DIR;
+}
+std::string hairgenBinary() {
+  const char* file = std::getenv("HAIRGEN_BENCH_BINARY");
+  return file && *file ? file : HAIRGEN_BINARY;
+}
+
 // A bundled coupe's config and wick.
 struct Bundled {
   Config config;
   Mesh wick;
   explicit Bundled(const char* setup)
-      : config(
-            loadConfig(std::filesystem::path(HAIRGEN_SOURCE_DIR) / "configs" / setup, {}, SetupUse::kGrow)),
+      : config(loadConfig(sourceDir() / "configs" / setup, {}, SetupUse::kGrow)),
         wick(readObj(config.setup.wickModel.path)) {}
 };
 using Coupe3 = Bundled;
@@ -367,28 +400,31 @@ void SimulateSprings(benchmark::State& state) {
 }
 BENCHMARK(SimulateSprings)->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(3.0);
 
-// Coupe 3 at about `strands` strands (64 vertices each), made once per size.
-const Strands& coupe3Strands(int strands) {
-  static std::map<int, Strands> made;
-  auto it = made.find(strands);
+// Coupe 3 at about `strands` strands of `points` points each (64 for the caches', 65 for the render's,
+// issue 34's figure), made once per size.
+const Strands& coupe3Strands(int strands, int points = 64) {
+  static std::map<std::pair<int, int>, Strands> made;
+  auto it = made.find({strands, points});
   if (it != made.end()) return it->second;
   const Coupe3& c = coupe3();
   Hairstyle style = c.config.hairstyle;
-  style.visualityStep = style.totalLength() / 63.0;
+  style.visualityStep = style.totalLength() / double(points - 1);
   const Strands guides = grow(c.wick, style, c.config.collision, {}).guides;
   const double area = surfaceArea(c.wick) * 1e4;
   style.hairDensity = strands / area;
-  return made[strands] = interpolate(c.wick, guides, style, c.config.collision, {});
+  return made[{strands, points}] = interpolate(c.wick, guides, style, c.config.collision, {});
 }
 
-// The .hair cache of the 150,000-strand coupe, written once, then read whole (checked: CRCs, finiteness).
-std::filesystem::path coupeCache() {
-  static const std::filesystem::path file = [] {
-    const std::filesystem::path f = std::filesystem::temp_directory_path() / "hairgen_bench_coupe.hair";
-    writeHair(f, coupe3Strands(150000));
-    return f;
-  }();
-  return file;
+// The .hair cache of the 150,000-strand coupe (`points` a strand), written once, then read whole
+// (checked: CRCs, finiteness).
+std::filesystem::path coupeCache(int points = 64) {
+  static std::map<int, std::filesystem::path> written;
+  auto it = written.find(points);
+  if (it != written.end()) return it->second;
+  const std::filesystem::path f =
+      std::filesystem::temp_directory_path() / ("hairgen_bench_coupe" + std::to_string(points) + ".hair");
+  writeHair(f, coupe3Strands(150000, points));
+  return written[points] = f;
 }
 
 void ReadCache(benchmark::State& state) {
@@ -426,17 +462,44 @@ void ConvertToGlb(benchmark::State& state) {
 }
 BENCHMARK(ConvertToGlb)->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(3.0);
 
-void Render(benchmark::State& state) {
+// The render benchmarks' context, opened once (a sequence's, reused by every iteration), and whether it
+// rasterises on the CPU (the targets differ).
+bool benchContextOpened = false;
+GlContext& benchContext() {
   static GlContext gl;
-  static const Mesh head = readObj(std::filesystem::path(HAIRGEN_SOURCE_DIR) / "configs/assets/head.obj");
-  const Strands& hair = coupe3Strands(int(state.range(0)));
+  benchContextOpened = true;
+  return gl;
+}
+bool onGpu() {
+  benchContext().makeCurrent();
+  return !softwareRasteriser();
+}
+std::string deviceLabel() {
+  GlContext& gl = benchContext();
+  return gl.renderer() + " (" + gl.platform() + ")";
+}
+const Mesh& benchHead() {
+  static const Mesh head = readObj(sourceDir() / "configs/assets/head.obj");
+  return head;
+}
+constexpr int kRenderPoints = 65;  // a strand's points in the render benchmarks (issue 34)
+
+// Coupe 3's Render Info at `width`×`height` and `samples` (shadows, the head, its camera and light).
+RenderSettings benchSettings(int width, int height, int samples) {
   RenderSettings settings = coupe3().config.render;
-  settings.resolution = {int(state.range(1)), int(state.range(2))};
-  settings.samples = int(state.range(3));
+  settings.resolution = {width, height};
+  settings.samples = samples;
+  return settings;
+}
+
+void Render(benchmark::State& state) {
+  GlContext& gl = benchContext();
+  const Strands& hair = coupe3Strands(int(state.range(0)), kRenderPoints);
+  const RenderSettings settings =
+      benchSettings(int(state.range(1)), int(state.range(2)), int(state.range(3)));
   RenderTimings sum;
-  Stopwatch clock;
   for (auto _ : state) {
-    RenderOutput out = render(gl, hair, &head, coupe3().config.visuality, settings, {}, {});
+    RenderOutput out = render(gl, hair, &benchHead(), coupe3().config.visuality, settings, {}, {});
     sum.upload += out.timings.upload;
     sum.lightDepth += out.timings.lightDepth;
     sum.opacity += out.timings.opacity;
@@ -444,24 +507,40 @@ void Render(benchmark::State& state) {
     sum.readback += out.timings.readback;
   }
   const double n = double(state.iterations());
+  const double passes = (sum.lightDepth + sum.opacity + sum.shading) / n;
   state.counters["strands"] = double(hair.strandCount());
   state.counters["upload_s"] = sum.upload / n;
   state.counters["lightDepth_s"] = sum.lightDepth / n;
   state.counters["opacity_s"] = sum.opacity / n;
   state.counters["shading_s"] = sum.shading / n;
+  state.counters["passes_s"] = passes;
   state.counters["readback_s"] = sum.readback / n;
-  state.SetLabel(gl.renderer() + " (" + gl.platform() + ")");
-  if (state.range(0) == 150000 && state.range(1) == 1920 && state.range(2) == 1080)
-    timeTarget(state, clock.lap(), kRender1080pSeconds);
+  state.SetLabel(deviceLabel());
+  if (onGpu() && state.range(0) == 150000 && state.range(1) == 1920 && state.range(2) == 1080 &&
+      state.range(3) == 1) {
+    state.counters["of_target"] = kRenderPassesGpuSeconds / passes;
+    state.counters["target_s"] = kRenderPassesGpuSeconds;
+  }
 }
-// The whole `hairgen render` command on the 150,000-strand coupe's cache at 1920×1080 (reading the
-// cache, the passes, writing the EXR), run as a child process: its wall time against 4 s, and its peak
-// memory (the child's maximum resident set) against 3× the cache's size (issue 20).
+BENCHMARK(Render)
+    ->ArgNames({"strands", "width", "height", "samples"})
+    ->Args({10000, 512, 512, 1})
+    ->Args({10000, 512, 512, 4})
+    ->Args({150000, 1920, 1080, 1})
+    ->Args({150000, 1920, 1080, 4})
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime()
+    ->Iterations(3);
+
+// The whole `hairgen render` command on the 150,000-strand coupe's cache at 1920×1080, Samples 1
+// (reading the cache, the device's start, the passes, writing the EXR), run as a child process: its
+// wall time against the target of the device this process opens (a GPU's or a software rasteriser's),
+// and its peak memory (the child's maximum resident set) against 3× the cache's size (issues 20, 34).
 void RenderCommand(benchmark::State& state) {
-  const std::filesystem::path cache = coupeCache();
+  const std::filesystem::path cache = coupeCache(kRenderPoints);
   const std::filesystem::path image = std::filesystem::temp_directory_path() / "hairgen_bench_render.exr";
-  const std::string setup = std::string(HAIRGEN_SOURCE_DIR) + "/configs/thesis/coupe3/setup.txt";
-  std::vector<std::string> args = {HAIRGEN_BINARY,
+  const std::string setup = (sourceDir() / "configs/thesis/coupe3/setup.txt").string();
+  std::vector<std::string> args = {hairgenBinary(),
                                    "render",
                                    setup,
                                    "--hair",
@@ -477,6 +556,8 @@ void RenderCommand(benchmark::State& state) {
   for (std::string& a : args) argv.push_back(a.data());
   argv.push_back(nullptr);
   long peakKiB = 0;
+  const std::string label = deviceLabel();
+  const double target = onGpu() ? kRenderCommandGpuSeconds : kRenderCommandSoftwareSeconds;
   Stopwatch clock;
   for (auto _ : state) {
     pid_t child = 0;
@@ -495,7 +576,8 @@ void RenderCommand(benchmark::State& state) {
     }
     peakKiB = std::max(peakKiB, usage.ru_maxrss);
   }
-  timeTarget(state, clock.lap(), kRender1080pSeconds);
+  timeTarget(state, clock.lap(), target);
+  state.SetLabel(label);
   std::filesystem::remove(image);
   const double peak = double(peakKiB) * 1024.0, cacheBytes = double(std::filesystem::file_size(cache));
   state.counters["peak_MB"] = peak / 1e6;
@@ -506,15 +588,119 @@ void RenderCommand(benchmark::State& state) {
 // One command an iteration; --benchmark_repetitions=5 gives the medians of five.
 BENCHMARK(RenderCommand)->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(1);
 
-BENCHMARK(Render)
-    ->ArgNames({"strands", "width", "height", "samples"})
-    ->Args({10000, 512, 512, 1})
-    ->Args({10000, 512, 512, 4})
-    ->Args({150000, 1920, 1080, 1})
-    ->Args({150000, 1920, 1080, 4})
+// A sequence of range(0) frames of the 150,000-strand coupe at 1920×1080, Samples 1, on one context as
+// `render --frames` renders them: each frame's coupe is the last one moved by a tenth of a millimetre
+// (done outside the timing), so nothing but the programs and buffers a context keeps carries over.
+// frame_s is the median frame's seconds (the first frame, which compiles the programs, among them),
+// frame_mean_s the mean.
+void RenderSequence(benchmark::State& state) {
+  GlContext& gl = benchContext();
+  Strands hair = coupe3Strands(150000, kRenderPoints);
+  const RenderSettings settings = benchSettings(1920, 1080, 1);
+  const int frames = int(state.range(0));
+  std::vector<double> seconds;
+  for (auto _ : state) {
+    for (int f = 0; f < frames; ++f) {
+      state.PauseTiming();
+      for (glm::vec3& p : hair.points) p.x += 1e-4f;
+      state.ResumeTiming();
+      Stopwatch clock;
+      RenderOutput out = render(gl, hair, &benchHead(), coupe3().config.visuality, settings, {}, {});
+      benchmark::DoNotOptimize(out.beauty.planes.data());
+      seconds.push_back(clock.lap());
+    }
+  }
+  double total = 0.0;
+  for (double t : seconds) total += t;
+  std::nth_element(seconds.begin(), seconds.begin() + std::ptrdiff_t(seconds.size() / 2), seconds.end());
+  const double median = seconds[seconds.size() / 2];
+  state.counters["frame_s"] = median;
+  state.counters["frame_mean_s"] = total / double(seconds.size());
+  state.SetLabel(deviceLabel());
+  if (onGpu()) {
+    state.counters["of_target"] = kRenderFrameGpuSeconds / median;
+    state.counters["target_s"] = kRenderFrameGpuSeconds;
+  }
+}
+BENCHMARK(RenderSequence)
+    ->ArgName("frames")
+    ->Arg(48)
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime()
-    ->Iterations(3);
+    ->Iterations(1);
+
+// What `hairgen render` spends before its first pass: the EGL context opened (devices found, the
+// display initialised, the context made) and a first render of one short strand at 8×8, which
+// compiles and links every program it draws with (the head's too). A fresh context an iteration.
+void DeviceStart(benchmark::State& state) {
+  Strands strand;
+  strand.addStrand({glm::vec3(0.0f, 0.0f, 0.0f), glm::vec3(0.01f, 0.0f, 0.0f)});
+  const RenderSettings settings = benchSettings(8, 8, 1);
+  GlStartTimes start;
+  double opening = 0.0, first = 0.0;
+  std::string label;
+  for (auto _ : state) {
+    Stopwatch clock;
+    GlContext gl;
+    opening += clock.lap();
+    render(gl, strand, &benchHead(), coupe3().config.visuality, settings, {}, {});
+    first += clock.lap();
+    start.devices += gl.startTimes().devices;
+    start.display += gl.startTimes().display;
+    start.context += gl.startTimes().context;
+    label = gl.renderer() + " (" + gl.platform() + ")" +
+            (benchContextOpened ? ", the display already initialised by another benchmark's context" : "");
+  }
+  const double n = double(state.iterations());
+  state.counters["open_s"] = opening / n;
+  state.counters["devices_s"] = start.devices / n;
+  state.counters["display_s"] = start.display / n;
+  state.counters["context_s"] = start.context / n;
+  state.counters["first_render_s"] = first / n;
+  state.SetLabel(label);
+  if (benchContextOpened) benchContext().makeCurrent();  // the other benchmarks' context, current again
+}
+BENCHMARK(DeviceStart)->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(3);
+
+// The beauty image's readback at 1920×1080 (issue 34): R G B A, Z, opacity and shadow from two
+// RGBA32F textures as the resolve leaves them. pbo 0: what readBack did before (each texture whole
+// through a pageable glGetTextureImage, then split into planes on one thread); readPlanes through a
+// pixel-pack buffer, pbo 1 channel by channel (a GPU's layout), 2 whole textures (llvmpipe's).
+void Readback(benchmark::State& state) {
+  benchContext().makeCurrent();
+  const int w = 1920, h = 1080;
+  std::vector<float> texels(size_t(w) * h * 4);
+  for (size_t i = 0; i < texels.size(); ++i) texels[i] = float(i % 1021) * 0.25f;
+  const Texture color(GL_RGBA32F, w, h), data(GL_RGBA32F, w, h);
+  for (const Texture* t : {&color, &data})
+    glTextureSubImage2D(t->id, 0, 0, 0, w, h, GL_RGBA, GL_FLOAT, texels.data());
+  glFinish();
+  std::vector<std::vector<float>> planes(7);
+  for (auto _ : state) {
+    if (state.range(0) > 0) {
+      std::vector<PlaneRead> reads;
+      for (int c = 0; c < 4; ++c) reads.push_back({&color, c, &planes[size_t(c)]});
+      for (int c = 0; c < 3; ++c) reads.push_back({&data, c, &planes[size_t(4 + c)]});
+      readPlanes(reads, state.range(0) == 1 ? ReadbackLayout::kChannels : ReadbackLayout::kWholeTextures);
+    } else {
+      for (const Texture* t : {&color, &data}) {
+        std::vector<float> rgba(size_t(w) * h * 4);
+        glGetTextureImage(t->id, 0, GL_RGBA, GL_FLOAT, GLsizei(rgba.size() * sizeof(float)), rgba.data());
+        const int first = t == &color ? 0 : 4, count = t == &color ? 4 : 3;
+        for (int c = 0; c < count; ++c) {
+          std::vector<float>& plane = planes[size_t(first + c)];
+          plane.resize(size_t(w) * h);
+          for (int y = 0; y < h; ++y)
+            for (int x = 0; x < w; ++x) plane[size_t(h - 1 - y) * w + x] = rgba[(size_t(y) * w + x) * 4 + c];
+        }
+      }
+    }
+    benchmark::DoNotOptimize(planes[6].data());
+  }
+  state.SetBytesProcessed(int64_t(state.iterations()) * 7 * w * h * int64_t(sizeof(float)));
+  state.SetLabel(deviceLabel());
+}
+BENCHMARK(Readback)->ArgName("pbo")->DenseRange(0, 2)->Unit(benchmark::kMillisecond)->UseRealTime();
 
 // After the benchmarks' own lines, every figure that has a target in one table: the figure, the target,
 // the figure over the target and whether it is met (the README's Performance table gives the same
