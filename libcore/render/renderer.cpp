@@ -42,7 +42,7 @@ RenderOutput renderHair(GlContext&, const RenderInput& in) {
   out.worldToLight = scene.light.proj * scene.light.view;
   out.timings.upload = seconds(clock);
   out.hairReadInPlace = scene.hair.readsStrandsInPlace();
-  out.lightMapsOnCpu = scene.lightRaster != nullptr;
+  out.lightMapsOnCpu = scene.lightMaps != nullptr;
   if (in.uploaded && !out.hairReadInPlace) in.uploaded();
   auto passDone = [&] {
     if (in.progress) in.progress->advance();
@@ -53,7 +53,7 @@ RenderOutput renderHair(GlContext&, const RenderInput& in) {
   out.timings.lightDepth = seconds(clock);
   passDone();
   const Texture opacity = deepOpacityPass(scene, depth);
-  scene.releaseLightLines();
+  scene.releaseLightMaps();
   out.timings.opacity = seconds(clock);
   passDone();
   const ShadedImage image = resolvePass(scene, shadingPass(scene, depth, opacity));
