@@ -149,12 +149,10 @@ TEST(HairLightMaps, ASegmentCoversItsWidthTimesItsLength) {
       const glm::dvec2 a = glm::dvec2(64.3, 61.7) - 20.0 * d, m = a + 17.0 * d, b = a + 40.0 * d;
       const Strands one = strip({{a.x, a.y, -1.0f}, {b.x, b.y, -1.0f}});
       const Strands two = strip({{a.x, a.y, -1.0f}, {m.x, m.y, -1.0f}, {b.x, b.y, -1.0f}});
-      for (int samples : {1, 4}) {
-        const double got = totalCoverage(rasteriseLightMaps(one, texelView(128), width, samples, kLayers));
-        EXPECT_NEAR(got, width * 40.0, 0.01 * width * 40.0) << width << " texels at " << angle;
-        const double split = totalCoverage(rasteriseLightMaps(two, texelView(128), width, samples, kLayers));
-        EXPECT_NEAR(split, got, 0.01 * got) << width << " texels at " << angle;
-      }
+      const double got = totalCoverage(rasteriseLightMaps(one, texelView(128), width, kLayers));
+      EXPECT_NEAR(got, width * 40.0, 0.01 * width * 40.0) << width << " texels at " << angle;
+      const double split = totalCoverage(rasteriseLightMaps(two, texelView(128), width, kLayers));
+      EXPECT_NEAR(split, got, 0.01 * got) << width << " texels at " << angle;
     }
 }
 
@@ -164,7 +162,7 @@ TEST(HairLightMaps, ASegmentCoversItsWidthTimesItsLength) {
 TEST(HairLightMaps, OpacityFallsInTheLayersBehindWhereTheHairBegins) {
   Strands s = strip({{2.0f, 4.5f, -1.0f}, {13.0f, 4.5f, -1.0f}});
   s.addStrand({{2.0f, 4.5f, -1.004f}, {13.0f, 4.5f, -1.004f}});
-  const HairLightMaps maps = rasteriseLightMaps(s, texelView(16), 0.5, 1, kLayers);
+  const HairLightMaps maps = rasteriseLightMaps(s, texelView(16), 0.5, kLayers);
   const std::vector<float> start = maps.startMetres(1e10f);
   const std::vector<glm::vec4> opacity = maps.opacity(0.8);
   for (int x = 4; x <= 10; ++x) {
@@ -192,7 +190,7 @@ TEST(HairLightMaps, TheMapsAreTheSameBitsOnOneThreadAsOnAll) {
     }
     s.addStrand(points);
   }
-  auto maps = [&] { return rasteriseLightMaps(s, texelView(256), 0.7, 2, kLayers); };
+  auto maps = [&] { return rasteriseLightMaps(s, texelView(256), 0.7, kLayers); };
   const HairLightMaps all = maps(), again = maps();
   tbb::global_control one(tbb::global_control::max_allowed_parallelism, 1);
   const HairLightMaps single = maps();
@@ -207,8 +205,7 @@ TEST(HairLightMaps, AStrandMovedAHundredthOfATexelChangesTheMapsByAboutAHundredt
     const glm::dvec2 d(std::cos(angle), std::sin(angle)), n(-d.y, d.x);
     auto mapsAt = [&](double shift) {
       const glm::dvec2 a = glm::dvec2(32.0, 32.0) - 15.0 * d + shift * n, b = a + 30.0 * d;
-      return rasteriseLightMaps(strip({{a.x, a.y, -1.0f}, {b.x, b.y, -1.0f}}), texelView(64), 0.3, 1,
-                                kLayers);
+      return rasteriseLightMaps(strip({{a.x, a.y, -1.0f}, {b.x, b.y, -1.0f}}), texelView(64), 0.3, kLayers);
     };
     const HairLightMaps before = mapsAt(0.0), after = mapsAt(0.01);
     double moved = 0.0, largest = 0.0;

@@ -24,64 +24,124 @@ int64_t floorDiv(int64_t a, int64_t b) {
   return (a % b != 0 && ((a < 0) != (b < 0))) ? q - 1 : q;
 }
 
-int64_t ceilDiv(int64_t a, int64_t b) {
-  return -floorDiv(-a, b);
-}
-
 // A point as the rasteriser reads it: x, y in 1/kSubTexel texel (window, y up), depth in kDepthUnit,
 // the strand's projected width in 1/kWidthUnit texel; depth −1 when the point is not drawn.
 struct Vertex {
   int32_t x, y, depth, width;
 };
 
-struct Sample {
-  int64_t x, y;   // 1/kSubTexel texel
-  int64_t depth;  // kDepthUnit
-  uint64_t area;  // coverage units
-};
-
-// Calls `sample` for each midpoint of the segment a → b: `perTexel` positions per texel along it and
-// across its width, each carrying the ribbon's area divided among them (rounded down).
-template <class F>
-void sampleSegment(const Vertex& a, const Vertex& b, int perTexel, F&& sample) {
-  const int64_t dx = int64_t(b.x) - a.x, dy = int64_t(b.y) - a.y;
-  const int64_t lengthSquared = dx * dx + dy * dy;
-  if (lengthSquared == 0) return;  // seen end on: no length, no area
-  // The square root of an integer below 2^53 is correctly rounded in double: the same on every machine.
-  const int64_t length = int64_t(std::sqrt(double(lengthSquared)));
-  if (length == 0) return;
-  const int64_t along = std::max<int64_t>(1, ceilDiv(length * perTexel, kSubTexel));
-  const int64_t across =
-      std::max<int64_t>(1, ceilDiv(int64_t(std::max(a.width, b.width)) * perTexel, kWidthUnit));
-  // The unit normal on the image, in 1/kSubTexel.
-  const int64_t nx = -dy * kSubTexel / length, ny = dx * kSubTexel / length;
-  for (int64_t i = 0; i < along; ++i) {
-    const int64_t num = 2 * i + 1, den = 2 * along;
-    const int64_t cx = a.x + floorDiv(dx * num, den), cy = a.y + floorDiv(dy * num, den);
-    const int64_t depth = a.depth + floorDiv((int64_t(b.depth) - a.depth) * num, den);
-    const int64_t width = a.width + floorDiv((int64_t(b.width) - a.width) * num, den);
-    // width × length / samples, in 1/(kWidthUnit·kSubTexel) texel², to kCoverageOne per texel².
-    const uint64_t area = uint64_t(width * length) /
-                          uint64_t(along * across * (int64_t(kWidthUnit) * kSubTexel / kCoverageOne));
-    for (int64_t j = 0; j < across; ++j) {
-      const int64_t offset = floorDiv(width * (2 * j + 1 - across), 2 * across * (kWidthUnit / kSubTexel));
-      sample(
-          Sample{cx + floorDiv(offset * nx, kSubTexel), cy + floorDiv(offset * ny, kSubTexel), depth, area});
+// The 128-bit product a·b/c, rounded down: a wide strand's width × its length may pass 64 bits before
+// the division brings it back.
+// base + ⌊d·t / (2n)⌋ for t = t0, t0 + 2·kSubTexel, t0 + 4·kSubTexel, …: exact, with one division to
+// start and none after.
+class MidpointStep {
+ public:
+  MidpointStep(int64_t base, int64_t d, int64_t n, int64_t t0) : den_(2 * n) {
+    q_ = floorDiv(d * t0, den_);
+    r_ = d * t0 - q_ * den_;
+    q_ += base;
+    stepQ_ = floorDiv(2 * kSubTexel * d, den_);
+    stepR_ = 2 * kSubTexel * d - stepQ_ * den_;
+  }
+  int64_t value() const { return q_; }
+  void next() {
+    q_ += stepQ_;
+    r_ += stepR_;
+    if (r_ >= den_) {
+      r_ -= den_;
+      ++q_;
     }
   }
+
+ private:
+  int64_t den_, q_, r_, stepQ_, stepR_;
+};
+
+__extension__ typedef unsigned __int128 Wide;  // GCC's and Clang's; __extension__ keeps -Wpedantic quiet
+uint64_t mulDiv(uint64_t a, uint64_t b, uint64_t c) {
+  return uint64_t(Wide(a) * b / c);
 }
 
-// The four texels around a sample (centres at whole + ½) and their bilinear weights, in
-// 1/kSubTexel², summing to kSubTexel².
+// Calls fragment(column, row, depth, coverage) for each texel the segment a → b covers, coverage in
+// kCoverageOne per texel; `rowLo`, `rowHi`: the rows wanted (others may come too). Along the segment's
+// major axis (x or y, whichever it moves more along) it is cut at the texel boundaries: a piece of
+// length o along that axis covers the strand's width × its true length, w·o·L/|du|, exactly, so a
+// strip's shared point counts once and a strand moving along itself moves its coverage continuously.
+// Across, each piece is cut into ⌈extent⌉ strips of the ribbon (its extent across the major axis,
+// w·L/|du| texels) and each strip is shared linearly between the two texels whose centres it lies
+// between, so the maps move continuously as the strand moves across them too. Which fragments a
+// segment has does not depend on the rows asked for.
 template <class F>
-void splat(const Sample& s, F&& texel) {
-  const int64_t u = s.x - kSubTexel / 2, v = s.y - kSubTexel / 2;
-  const int64_t i = floorDiv(u, kSubTexel), j = floorDiv(v, kSubTexel);
-  const int64_t fx = u - i * kSubTexel, fy = v - j * kSubTexel;
-  texel(i, j, uint64_t((kSubTexel - fx) * (kSubTexel - fy)));
-  texel(i + 1, j, uint64_t(fx * (kSubTexel - fy)));
-  texel(i, j + 1, uint64_t((kSubTexel - fx) * fy));
-  texel(i + 1, j + 1, uint64_t(fx * fy));
+void rasteriseSegment(Vertex a, Vertex b, int64_t rowLo, int64_t rowHi, F&& fragment) {
+  const bool alongX = std::abs(int64_t(b.x) - a.x) >= std::abs(int64_t(b.y) - a.y);
+  auto major = [&](const Vertex& v) { return int64_t(alongX ? v.x : v.y); };
+  auto minor = [&](const Vertex& v) { return int64_t(alongX ? v.y : v.x); };
+  if (major(a) > major(b)) std::swap(a, b);
+  const int64_t u0 = major(a), u1 = major(b), v0 = minor(a);
+  const int64_t du = u1 - u0, dv = minor(b) - v0, dz = int64_t(b.depth) - a.depth;
+  if (du == 0) return;  // seen end on: no length, no area
+  // The square root of an integer below 2^53 is correctly rounded in double: the same on every machine.
+  const uint64_t length = uint64_t(std::sqrt(double(du * du + dv * dv)));
+  const uint64_t width = (uint64_t(a.width) + uint64_t(b.width)) / 2;  // 1/kWidthUnit texel
+  // The ribbon's extent across the major axis, 1/kWidthUnit texel, and the strips it is cut into.
+  const uint64_t extent = mulDiv(width, length, uint64_t(du));
+  const int64_t strips = std::max<int64_t>(1, int64_t((extent + kWidthUnit - 1) / kWidthUnit));
+  // The texels along the major axis, [first, last], narrowed to those that can reach the rows.
+  int64_t first = u0 >> 8, last = (u1 - 1) >> 8;
+  const int64_t reach = int64_t(extent / (2 * (kWidthUnit / kSubTexel))) + 2 * kSubTexel;
+  if (!alongX) {
+    first = std::max(first, rowLo);
+    last = std::min(last, rowHi - 1);
+  } else if (dv != 0) {
+    // v at a piece's middle is v0 + dv·(u − u0)/du; found in double with two texels to spare either
+    // side (a texel whose fragments fall outside the rows is dropped by the caller).
+    double c0 =
+        (double(u0) + (double(rowLo * kSubTexel - reach) - double(v0)) * double(du) / double(dv)) / kSubTexel;
+    double c1 =
+        (double(u0) + (double(rowHi * kSubTexel + reach) - double(v0)) * double(du) / double(dv)) / kSubTexel;
+    if (c0 > c1) std::swap(c0, c1);
+    if (c0 > double(last) + 2.0 || c1 < double(first) - 2.0) return;
+    first = std::max(first, int64_t(std::floor(c0)) - 2);
+    last = std::min(last, int64_t(std::ceil(c1)) + 2);
+  } else if (v0 + reach < rowLo * kSubTexel || v0 - reach >= rowHi * kSubTexel) {
+    return;
+  }
+  const uint64_t perStrip =
+      uint64_t(du) * (uint64_t(kWidthUnit) * kSubTexel / kCoverageOne) * uint64_t(strips);
+  static_assert(kSubTexel == 256);
+  // A whole texel's piece: its area, and its middle's v and depth stepped from texel to texel (the
+  // middle moves 2·kSubTexel in `twice` a texel); a piece cut by the segment's end is computed on its own.
+  const uint64_t wholeArea = mulDiv(width * kSubTexel, length, perStrip);
+  const int64_t twiceFirst = 2 * first * kSubTexel + kSubTexel - 2 * u0;
+  MidpointStep vStep(v0, dv, du, twiceFirst), depthStep(a.depth, dz, du, twiceFirst);
+  for (int64_t c = first; c <= last; ++c, vStep.next(), depthStep.next()) {
+    const int64_t lo = std::max(u0, c * kSubTexel), hi = std::min(u1, (c + 1) * kSubTexel);
+    if (hi <= lo) continue;
+    const bool whole = hi - lo == kSubTexel;
+    // The piece's middle, as a fraction of the segment: (lo + hi − 2·u0) / (2·du).
+    const int64_t twice = lo + hi - 2 * u0;
+    const int64_t v = whole ? vStep.value() : v0 + floorDiv(dv * twice, 2 * du);
+    const int32_t depth = int32_t(whole ? depthStep.value() : a.depth + floorDiv(dz * twice, 2 * du));
+    // w·o·L/|du| per strip: 1/(kWidthUnit·kSubTexel) texel², to kCoverageOne per texel².
+    const uint64_t area = whole ? wholeArea : mulDiv(width * uint64_t(hi - lo), length, perStrip);
+    for (int64_t k = 0; k < strips; ++k) {
+      const int64_t at = strips == 1 ? v
+                                     : v + floorDiv(int64_t(extent) * (2 * k + 1 - strips),
+                                                    2 * strips * (kWidthUnit / kSubTexel));
+      // Between the texel centres (whole + ½) either side: weights in 1/kSubTexel that sum to one.
+      // (>> of a negative number rounds toward −∞ in C++20.)
+      const int64_t t = at - kSubTexel / 2, m = t >> 8, f = t & 255;
+      const uint32_t before = uint32_t((area * uint64_t(kSubTexel - f)) >> 8);
+      const uint32_t after = uint32_t((area * uint64_t(f)) >> 8);
+      if (alongX) {
+        fragment(c, m, depth, before);
+        fragment(c, m + 1, depth, after);
+      } else {
+        fragment(m, c, depth, before);
+        fragment(m + 1, c, depth, after);
+      }
+    }
+  }
 }
 
 }  // namespace
@@ -100,10 +160,9 @@ std::vector<glm::vec4> HairLightMaps::opacity(double strandOpacity) const {
   return out;
 }
 
-HairLightMaps rasteriseLightMaps(const Strands& hair, const View& light, double strandWidth, int samples,
+HairLightMaps rasteriseLightMaps(const Strands& hair, const View& light, double strandWidth,
                                  const glm::dvec4& layerSizes) {
   const int size = light.width;
-  const int perTexel = std::max(samples, 1);
   // Every point projected as the light's view places it, then quantised: from here on, integers.
   const glm::dmat4 toClip = light.proj * light.view;
   const glm::dvec4 depthRow(-light.view[0][2], -light.view[1][2], -light.view[2][2], -light.view[3][2]);
@@ -190,27 +249,23 @@ HairLightMaps rasteriseLightMaps(const Strands& hair, const View& light, double 
   // Each band by one thread: first where the hair begins in its rows, then the layers' sums.
   tbb::parallel_for(0, bands, [&](int band) {
     const int64_t rowLo = int64_t(band) * kBandRows, rowHi = std::min<int64_t>(size, rowLo + kBandRows);
-    auto eachTexel = [&](auto&& texel) {
+    auto eachFragment = [&](auto&& texel) {
       for (size_t k = bandFirst[band]; k < bandFirst[band + 1]; ++k) {
         const uint32_t first = segments[bandSegments[k]];
-        sampleSegment(vertices[first], vertices[first + 1], perTexel, [&](const Sample& s) {
-          splat(s, [&](int64_t i, int64_t j, uint64_t weight) {
-            if (weight == 0 || j < rowLo || j >= rowHi || i < 0 || i >= size) return;
-            texel(size_t(j) * size + size_t(i), s, weight);
-          });
-        });
+        rasteriseSegment(vertices[first], vertices[first + 1], rowLo, rowHi,
+                         [&](int64_t i, int64_t j, int32_t depth, uint32_t coverage) {
+                           if (coverage == 0 || j < rowLo || j >= rowHi || i < 0 || i >= size) return;
+                           texel(size_t(j) * size + size_t(i), depth, coverage);
+                         });
       }
     };
-    eachTexel([&](size_t t, const Sample& s, uint64_t) {
-      maps.start[t] = std::min(maps.start[t], int32_t(s.depth));
-    });
-    eachTexel([&](size_t t, const Sample& s, uint64_t weight) {
-      const uint32_t c = uint32_t((s.area * weight) / uint64_t(kSubTexel * kSubTexel));
-      const int64_t behind = s.depth - maps.start[t];
+    eachFragment([&](size_t t, int32_t depth, uint32_t) { maps.start[t] = std::min(maps.start[t], depth); });
+    eachFragment([&](size_t t, int32_t depth, uint32_t coverage) {
+      const int64_t behind = int64_t(depth) - maps.start[t];
       glm::uvec4& sum = maps.layers[t];
       for (int k = 0; k < 3; ++k)
-        if (behind < ends[k]) sum[k] += c;
-      sum[3] += c;
+        if (behind < ends[k]) sum[k] += coverage;
+      sum[3] += coverage;
     });
   });
   return maps;

@@ -5,11 +5,11 @@
 // Every point is projected once in double precision and quantised: window x and y to 1/kSubTexel of a
 // texel, depth along the light's axis to kDepthUnit, the strand's projected width to 1/kWidthUnit of a
 // texel. From there on everything is integer arithmetic. Each segment is a thin ribbon of the strand's
-// width (Kajiya & Kay's cylinder seen from the light) integrated by the midpoint rule on a grid of
-// `samples` positions per texel along it and across it; each sample carries its share of the
-// ribbon's area and is splatted bilinearly into the four texels around it (integer weights in
-// 1/kSubTexel² that sum to one), so the maps change continuously as a strand moves. A segment is
-// half-open: it owns [start, end), so a strip's shared point is counted once.
+// width (Kajiya & Kay's cylinder seen from the light), cut at the texel boundaries along its major axis
+// (x or y, whichever it moves more along): each piece covers the strand's width × its true length
+// within that texel column (or row), exactly, and is shared linearly between the two texels across it
+// whose centres it lies between (a ribbon wider than a texel is first cut into strips a texel wide),
+// so the maps change continuously as a strand moves, and a strip's shared point counts once.
 //
 // The depth map keeps, per texel, the nearest sample that reaches it; the opacity map adds each
 // sample's coverage (texel² in 1/kCoverageOne) to its layer and every layer behind it, measured from
@@ -49,10 +49,10 @@ struct HairLightMaps {
   std::vector<glm::vec4> opacity(double strandOpacity) const;
 };
 
-// `light`: a square view (its width texels per side). `strandWidth`: the strands' diameter, metres.
-// `samples`: midpoint positions per texel along and across a segment (at least 1). `layerSizes`:
-// the four layers' depths, metres. A segment with a point nearer than the near plane is dropped.
-HairLightMaps rasteriseLightMaps(const Strands& hair, const View& light, double strandWidth, int samples,
+// `light`: a square perspective view (its width texels per side). `strandWidth`: the strands' diameter,
+// metres. `layerSizes`: the four layers' depths, metres. A segment with a point nearer than the near
+// plane is dropped.
+HairLightMaps rasteriseLightMaps(const Strands& hair, const View& light, double strandWidth,
                                  const glm::dvec4& layerSizes);
 
 }  // namespace hairgen

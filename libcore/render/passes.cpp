@@ -19,11 +19,6 @@ namespace {
 // line still overlaps the curve's).
 constexpr double kChordPixels = 0.375;
 
-// Midpoint positions per texel along and across a strand in the light's maps (light_maps.h): each is
-// splatted bilinearly over 2×2 texels, so one per texel already gives maps that move continuously
-// with the hair; more only smooths what the bilinear lookup smooths anyway.
-constexpr int kLightSamplesPerTexel = 1;
-
 // k for Samples = k² (k ≤ 8), lowered until the sub-pixel image fits the device's largest texture.
 int subpixelBlock(const RenderSettings& r) {
   GLint maxSize = 4096;
@@ -206,7 +201,7 @@ struct Scene::Preparation {
     work.run([=, this, &hair, &lightView, &r] {
       if (!lightByRasteriser) return;
       lightMaps = std::make_unique<HairLightMaps>(
-          rasteriseLightMaps(hair, lightView, r.strandWidth, kLightSamplesPerTexel, r.layerSizes));
+          rasteriseLightMaps(hair, lightView, r.strandWidth, r.layerSizes));
     });
     work.run([=, this, &hair] {
       if (ordered) order = frontToBack(hair, view);
