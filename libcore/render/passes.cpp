@@ -200,8 +200,8 @@ struct Scene::Preparation {
     const RenderSettings& r = in.settings;
     work.run([=, this, &hair, &lightView, &r] {
       if (!lightByRasteriser) return;
-      lightMaps = std::make_unique<HairLightMaps>(
-          rasteriseLightMaps(hair, lightView, r.strandWidth, r.layerSizes));
+      lightMaps =
+          std::make_unique<HairLightMaps>(rasteriseLightMaps(hair, lightView, r.strandWidth, r.layerSizes));
     });
     work.run([=, this, &hair] {
       if (ordered) order = frontToBack(hair, view);
