@@ -825,6 +825,36 @@ TEST(Render, TheRasterisersLightMapsAreOpenGlsLines) {
   EXPECT_LT(double(shadowed), 0.05 * double(pixels)) << shadowed << " of " << pixels << " pixels";
 }
 
+// Left to the renderer, the light's maps follow the image: at the scene's centre a texel is no larger
+// than a pixel (between kMinDomResolution and kMaxDomResolution texels a side), so a larger image gets
+// larger maps.
+TEST(Render, TheLightsMapsFollowTheImage) {
+  Strands s;
+  addStraight(s, {-0.04f, 0.02f, 0}, {0.04f, 0.02f, 0});
+  addStraight(s, {-0.04f, 0.0f, 0}, {0.04f, 0.0f, 0});
+  RenderOptions options;
+  options.keepDom = true;
+  int previous = 0;
+  for (int size : {64, 1200, 3000}) {
+    RenderSettings r = frontCamera(size, 1);
+    r.lightPosition = {0.0, 1.0, 0.0};
+    const RenderOutput out = render(gl(), s, nullptr, Visuality{}, r, {}, options);
+    const BoundingSphere sphere = boundingSphere(s, nullptr);
+    const View light = lightView(r, sphere, out.dom.width), camera = cameraView(r, sphere);
+    const double texel = glm::length(sphere.centre - r.lightPosition) / light.focalPx;
+    const double pixel = glm::length(sphere.centre - r.cameraPosition) / camera.focalPx;
+    EXPECT_GE(out.dom.width, kMinDomResolution) << size;
+    EXPECT_LE(out.dom.width, kMaxDomResolution) << size;
+    if (out.dom.width > kMinDomResolution && out.dom.width < kMaxDomResolution) {
+      EXPECT_LE(texel, pixel) << size;
+      EXPECT_GT(texel, 0.99 * pixel * (out.dom.width - 1) / out.dom.width)
+          << size << ": no larger than it needs";
+    }
+    EXPECT_GT(out.dom.width, previous) << size;
+    previous = out.dom.width;
+  }
+}
+
 // After framing, the camera looks at the hair's centre from the same direction, and the hair's
 // bounding sphere lies inside the narrower field of view.
 TEST(Render, FrameHairAimsAtTheHairAndFitsItInTheView) {
