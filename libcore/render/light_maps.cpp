@@ -17,6 +17,10 @@ constexpr int32_t kNoHair = std::numeric_limits<int32_t>::max();
 // A point this many map widths off the map is dropped with its segments: what it could reach of the
 // map is a ribbon the view's field already holds whole (it is made to hold the scene's sphere).
 constexpr int64_t kFarOff = 4;
+// The widest strand drawn, texels: wider is drawn this wide. With points within kFarOff map widths of a
+// map of at most 2^15 texels (OpenGL's largest), a segment is shorter than 2^27 in 1/kSubTexel, so
+// width × length × a piece's length stays below 2^28 · 2^27 · 2^8 = 2^63: every product fits 64 bits.
+constexpr double kWidest = 4096.0;
 
 // Rounds toward −∞, so positions left of and right of 0 are split into texels alike.
 int64_t floorDiv(int64_t a, int64_t b) {
@@ -30,8 +34,6 @@ struct Vertex {
   int32_t x, y, depth, width;
 };
 
-// The 128-bit product a·b/c, rounded down: a wide strand's width × its length may pass 64 bits before
-// the division brings it back.
 // base + ⌊d·t / (2n)⌋ for t = t0, t0 + 2·kSubTexel, t0 + 4·kSubTexel, …: exact, with one division to
 // start and none after.
 class MidpointStep {
@@ -57,11 +59,6 @@ class MidpointStep {
   int64_t den_, q_, r_, stepQ_, stepR_;
 };
 
-__extension__ typedef unsigned __int128 Wide;  // GCC's and Clang's; __extension__ keeps -Wpedantic quiet
-uint64_t mulDiv(uint64_t a, uint64_t b, uint64_t c) {
-  return uint64_t(Wide(a) * b / c);
-}
-
 // Calls fragment(column, row, depth, coverage) for each texel the segment a → b covers, coverage in
 // kCoverageOne per texel; `rowLo`, `rowHi`: the rows wanted (others may come too). Along the segment's
 // major axis (x or y, whichever it moves more along) it is cut at the texel boundaries: a piece of
@@ -84,7 +81,7 @@ void rasteriseSegment(Vertex a, Vertex b, int64_t rowLo, int64_t rowHi, F&& frag
   const uint64_t length = uint64_t(std::sqrt(double(du * du + dv * dv)));
   const uint64_t width = (uint64_t(a.width) + uint64_t(b.width)) / 2;  // 1/kWidthUnit texel
   // The ribbon's extent across the major axis, 1/kWidthUnit texel, and the strips it is cut into.
-  const uint64_t extent = mulDiv(width, length, uint64_t(du));
+  const uint64_t extent = width * length / uint64_t(du);
   const int64_t strips = std::max<int64_t>(1, int64_t((extent + kWidthUnit - 1) / kWidthUnit));
   // The texels along the major axis, [first, last], narrowed to those that can reach the rows.
   int64_t first = u0 >> 8, last = (u1 - 1) >> 8;
@@ -111,7 +108,7 @@ void rasteriseSegment(Vertex a, Vertex b, int64_t rowLo, int64_t rowHi, F&& frag
   static_assert(kSubTexel == 256);
   // A whole texel's piece: its area, and its middle's v and depth stepped from texel to texel (the
   // middle moves 2·kSubTexel in `twice` a texel); a piece cut by the segment's end is computed on its own.
-  const uint64_t wholeArea = mulDiv(width * kSubTexel, length, perStrip);
+  const uint64_t wholeArea = width * kSubTexel * length / perStrip;
   const int64_t twiceFirst = 2 * first * kSubTexel + kSubTexel - 2 * u0;
   MidpointStep vStep(v0, dv, du, twiceFirst), depthStep(a.depth, dz, du, twiceFirst);
   for (int64_t c = first; c <= last; ++c, vStep.next(), depthStep.next()) {
@@ -123,7 +120,7 @@ void rasteriseSegment(Vertex a, Vertex b, int64_t rowLo, int64_t rowHi, F&& frag
     const int64_t v = whole ? vStep.value() : v0 + floorDiv(dv * twice, 2 * du);
     const int32_t depth = int32_t(whole ? depthStep.value() : a.depth + floorDiv(dz * twice, 2 * du));
     // w·o·L/|du| per strip: 1/(kWidthUnit·kSubTexel) texel², to kCoverageOne per texel².
-    const uint64_t area = whole ? wholeArea : mulDiv(width * uint64_t(hi - lo), length, perStrip);
+    const uint64_t area = whole ? wholeArea : width * uint64_t(hi - lo) * length / perStrip;
     for (int64_t k = 0; k < strips; ++k) {
       const int64_t at = strips == 1 ? v
                                      : v + floorDiv(int64_t(extent) * (2 * k + 1 - strips),
@@ -184,7 +181,7 @@ HairLightMaps rasteriseLightMaps(const Strands& hair, const View& light, double 
                         const double width = strandWidth * light.focalPx / depth;
                         v = {int32_t(std::lround(x * kSubTexel)), int32_t(std::lround(y * kSubTexel)),
                              int32_t(std::lround(depth / kDepthUnit)),
-                             int32_t(std::lround(std::min(width, farOff) * kWidthUnit))};
+                             int32_t(std::lround(std::min(width, kWidest) * kWidthUnit))};
                       }
                     });
   // The segments: each pair of consecutive points of a strand, both drawn; by their first point.
