@@ -118,8 +118,7 @@ RenderOutput render(GlContext& gl, const Strands& hair, const Mesh* head, const 
   }
   input.shaders = shaders;
   input.progress = options.progress;
-  input.domResolution =
-      options.domResolution > 0 ? options.domResolution : domResolutionFor(settings.resolution);
+  input.domResolution = options.domResolution;
   input.keepDom = options.keepDom;
   input.lightMaps = options.lightMaps;
   input.uploaded = [&] {  // render's own copies (conformed, framing) go with the caller's hair

@@ -59,7 +59,7 @@ struct RenderOptions {
   bool zUp = false;       // the hair is z-up (made elsewhere): turned to hairgen's y-up
   double scale = 1.0;     // multiplies the hair's positions and widths, to metres (0.01 for centimetres)
   bool keepDom = false;   // return the light's maps in RenderOutput::dom
-  int domResolution = 0;  // texels per side of the light's maps; 0: domResolutionFor(Resolution)
+  int domResolution = 0;  // texels per side of the light's maps; 0: as the image needs (RenderInput)
   RenderInput::LightMaps lightMaps = RenderInput::LightMaps::kAuto;  // who draws them (RenderInput)
   bool force = false;  // render work estimated to take absurdly long (never work that cannot fit)
   // The hair the camera is aimed at (--frame, CameraPosition auto), as read; null: the hair rendered.

@@ -29,7 +29,7 @@
 namespace hairgen {
 namespace {
 
-// The light's passes draw chords: every point dropped lies within the tolerance of the chord that
+// The shading pass draws chords: every point dropped lies within the tolerance of the chord that
 // replaces it, ends are kept, a chord spans at most kMostSegmentsPerChord segments, and what bends more
 // than the tolerance keeps its points.
 TEST(LineDecimation, ChordsStayWithinToleranceOfEveryPointTheyDrop) {
@@ -118,8 +118,8 @@ TEST(LineDecimation, StripsFollowTheDrawingOrderFrontToBack) {
   EXPECT_EQ(ordered, expected);
 }
 
-// LightRaster on an orthographic view whose window coordinates are the world's x and y (texels) and
-// whose depth is −z: the texels a line covers, once per strip, at the depths along it.
+// The light's maps (light_maps.h) on an orthographic view whose window coordinates are the world's x
+// and y (texels) and whose depth is −z; focalPx 1, so a strand at depth 1 m is its width in texels.
 View texelView(int size) {
   View v;
   v.width = v.height = size;
@@ -133,112 +133,56 @@ Strands strip(std::initializer_list<glm::vec3> points) {
   return s;
 }
 
-std::vector<uint32_t> wholeStrip(size_t points) {
-  std::vector<uint32_t> indices(points);
-  for (size_t i = 0; i < points; ++i) indices[i] = uint32_t(i);
-  indices.push_back(kRestartIndex);
-  return indices;
+constexpr glm::dvec4 kLayers{0.002, 0.006, 0.015, 0.04};
+
+// All the coverage the maps hold, in texels (the last layer has every sample's).
+double totalCoverage(const HairLightMaps& maps) {
+  double sum = 0.0;
+  for (const glm::uvec4& l : maps.layers) sum += double(l.w);
+  return sum / double(kCoverageOne);
 }
 
-TEST(LightRaster, ALineCoversOneTexelPerColumnWhoseCentreItPassesOnceAlongAStrip) {
-  // Two segments along row 5 sharing the point at x = 15.5, a texel's centre: columns 10-14 from the
-  // first, 15-20 from the second (centres in [10.2, 15.5) and [15.5, 20.7)); the shared column is
-  // drawn once.
-  const Strands s = strip({{10.2f, 5.5f, -2.0f}, {15.5f, 5.5f, -2.0f}, {20.7f, 5.5f, -2.0f}});
-  const LightRaster raster(s, wholeStrip(3), texelView(32));
-  const std::vector<float> depth = raster.depth(1e10f);
-  const std::vector<glm::vec4> opacity = raster.opacity(depth, glm::vec4(0.5f, 1, 1, 1), 0.25f);
-  for (int y = 0; y < 32; ++y)
-    for (int x = 0; x < 32; ++x) {
-      const size_t t = size_t(y) * 32 + x;
-      const bool covered = y == 5 && x >= 10 && x <= 20;
-      EXPECT_EQ(depth[t], covered ? 2.0f : 1e10f) << x << "," << y;
-      EXPECT_EQ(opacity[t], covered ? glm::vec4(0.25f) : glm::vec4(0.0f)) << x << "," << y;
+// A strand's coverage is its ribbon's area, width × length in texels, at any angle and width, whether
+// thinner or wider than a texel; a strip's shared point is counted once (two segments cover what one
+// straight segment does).
+TEST(HairLightMaps, ASegmentCoversItsWidthTimesItsLength) {
+  for (const double width : {0.1, 0.3, 1.0, 3.0})
+    for (const double angle : {0.0, 0.3, 0.785, 1.2, 1.5708}) {
+      const glm::dvec2 d(std::cos(angle), std::sin(angle));
+      const glm::dvec2 a = glm::dvec2(64.3, 61.7) - 20.0 * d, m = a + 17.0 * d, b = a + 40.0 * d;
+      const Strands one = strip({{a.x, a.y, -1.0f}, {b.x, b.y, -1.0f}});
+      const Strands two = strip({{a.x, a.y, -1.0f}, {m.x, m.y, -1.0f}, {b.x, b.y, -1.0f}});
+      const double got = totalCoverage(rasteriseLightMaps(one, texelView(128), width, kLayers));
+      EXPECT_NEAR(got, width * 40.0, 0.01 * width * 40.0) << width << " texels at " << angle;
+      const double split = totalCoverage(rasteriseLightMaps(two, texelView(128), width, kLayers));
+      EXPECT_NEAR(split, got, 0.01 * got) << width << " texels at " << angle;
     }
 }
 
-// A nearly flat line crossing a band's edge far from the origin, where a row's rounding divided by the
-// slope is many columns: each column is still drawn once, by whichever band its row falls in.
-TEST(LightRaster, ANearlyFlatLineAcrossABandEdgeCoversEveryColumnOnce) {
-  // Rising and falling, drawn left to right and right to left.
-  for (const float rise : {3e-4f, 2.5e-4f, 1.0f / 4096.0f, -3e-4f}) {
-    for (const bool reversed : {false, true}) {
-      const glm::vec3 a{0.25f, 3008.0f - rise / 2, -1.0f}, b{1000.25f, 3008.0f + rise / 2, -1.0f};
-      const Strands s = reversed ? strip({b, a}) : strip({a, b});
-      // A texel is drawn by the one band holding its row, so a column can be missed but not drawn twice.
-      const std::vector<float> depth = LightRaster(s, wholeStrip(2), texelView(4096)).depth(1e10f);
-      for (int x = 0; x < 1000; ++x) {
-        const int covered =
-            (depth[size_t(3007) * 4096 + x] == 1.0f) + (depth[size_t(3008) * 4096 + x] == 1.0f);
-        ASSERT_EQ(covered, 1) << "column " << x << " rise " << rise << (reversed ? " reversed" : "");
-      }
-    }
+// Two strands over the same texels, the second 4 mm behind the first: with layers of 2, 6, 15 and 40 mm
+// it adds to the second layer and those behind, not the first; where the hair begins is the first's
+// depth. (A strand's width in texels is its width over its depth: 0.5 texel at 1 m, 0.498 at 1.004 m.)
+TEST(HairLightMaps, OpacityFallsInTheLayersBehindWhereTheHairBegins) {
+  Strands s = strip({{2.0f, 4.5f, -1.0f}, {13.0f, 4.5f, -1.0f}});
+  s.addStrand({{2.0f, 4.5f, -1.004f}, {13.0f, 4.5f, -1.004f}});
+  const HairLightMaps maps = rasteriseLightMaps(s, texelView(16), 0.5, kLayers);
+  const std::vector<float> start = maps.startMetres(1e10f);
+  const std::vector<glm::vec4> opacity = maps.opacity(0.8);
+  for (int x = 4; x <= 10; ++x) {
+    const size_t t = 4 * 16 + x;
+    EXPECT_EQ(start[t], 1.0f) << x;
+    // Each strand covers half of each texel it crosses, opacity 0.8: 0.4 each.
+    EXPECT_NEAR(opacity[t].x, 0.4f, 1e-4f) << x;
+    EXPECT_NEAR(opacity[t].y, 0.4f + 0.4f / 1.004f, 1e-4f) << x;
+    EXPECT_EQ(opacity[t].y, opacity[t].z);
+    EXPECT_EQ(opacity[t].z, opacity[t].w);
   }
 }
 
-TEST(LightRaster, ASteepLineCoversOneTexelPerRow) {
-  // From (3.9, 2.2) to (6.1, 9.8): rows 2-9, each at the column the line crosses at the row's centre.
-  const Strands s = strip({{3.9f, 2.2f, -1.0f}, {6.1f, 9.8f, -1.0f}});
-  const LightRaster raster(s, wholeStrip(2), texelView(16));
-  const std::vector<float> depth = raster.depth(1e10f);
-  int covered = 0;
-  for (int y = 0; y < 16; ++y)
-    for (int x = 0; x < 16; ++x) {
-      if (depth[size_t(y) * 16 + x] == 1e10f) continue;
-      ++covered;
-      const double along = 3.9 + (y + 0.5 - 2.2) / 7.6 * 2.2;
-      EXPECT_EQ(x, int(std::floor(along))) << "row " << y;
-      EXPECT_TRUE(y >= 2 && y <= 9) << "row " << y;
-    }
-  EXPECT_EQ(covered, 8);
-}
-
-TEST(LightRaster, DepthIsThePointOnTheSegmentSeenThroughTheTexel) {
-  // A perspective light looking down −z; a segment receding from 1 m to 3 m: each fragment's depth
-  // is that of the segment's point on the ray through its texel's centre, not the image's midpoint.
-  View v;
-  v.width = v.height = 256;
-  v.proj = glm::perspective(glm::radians(60.0), 1.0, 0.1, 10.0);
-  v.focalPx = 128.0 / std::tan(glm::radians(30.0));
-  const glm::dvec3 a(-0.3, 0.01, -1.0), b(0.9, 0.01, -3.0);
-  const Strands s = strip({glm::vec3(a), glm::vec3(b)});
-  const std::vector<float> depth = LightRaster(s, wholeStrip(2), v).depth(1e10f);
-  int checked = 0;
-  for (int x = 0; x < 256; ++x)
-    for (int y = 0; y < 256; ++y) {
-      const float d = depth[size_t(y) * 256 + x];
-      if (d == 1e10f) continue;
-      // The point of the segment whose image x is the column's centre: x/−z = u, linear in the segment.
-      const double u = (x + 0.5 - 128.0) / v.focalPx;
-      const double t = (-u * a.z - a.x) / ((b.x - a.x) + u * (b.z - a.z));
-      const glm::dvec3 p = a + t * (b - a);
-      EXPECT_NEAR(d, -p.z, 2e-5 * -p.z) << "column " << x;
-      ++checked;
-    }
-  EXPECT_GT(checked, 50);
-}
-
-TEST(LightRaster, OpacityFallsInTheLayersBehindWhereTheHairBegins) {
-  // Two strands over the same texels, the second 4 mm behind the first: with layers of 2, 6, 15 and
-  // 40 mm it adds to the second layer and those behind, not the first.
-  Strands s = strip({{2.2f, 4.5f, -1.0f}, {12.8f, 4.5f, -1.0f}});
-  s.addStrand({{2.2f, 4.5f, -1.004f}, {12.8f, 4.5f, -1.004f}});
-  std::vector<uint32_t> indices = {0, 1, kRestartIndex, 2, 3, kRestartIndex};
-  const LightRaster raster(s, indices, texelView(16));
-  const std::vector<float> depth = raster.depth(1e10f);
-  const std::vector<glm::vec4> opacity =
-      raster.opacity(depth, glm::vec4(0.002f, 0.006f, 0.015f, 0.04f), 0.5f);
-  for (int x = 2; x <= 12; ++x) {
-    EXPECT_EQ(depth[4 * 16 + x], 1.0f);
-    EXPECT_EQ(opacity[4 * 16 + x], glm::vec4(0.5f, 1.0f, 1.0f, 1.0f)) << x;
-  }
-}
-
-TEST(LightRaster, TheMapsAreTheSameBitsOnOneThreadAsOnAll) {
-  // Many strands crossing in every direction, with equal depths where they cross: the opacity sums
-  // are made in the strips' order in every band whatever thread draws it.
+// Many strands crossing in every direction at equal depths: integer minima and sums, the same bits
+// on one thread as on all, and on a second run.
+TEST(HairLightMaps, TheMapsAreTheSameBitsOnOneThreadAsOnAll) {
   Strands s;
-  std::vector<uint32_t> indices;
   for (int i = 0; i < 3000; ++i) {
     const float a = 0.37f * float(i), r = 40.0f + 30.0f * std::sin(0.11f * float(i));
     std::vector<glm::vec3> points;
@@ -246,21 +190,38 @@ TEST(LightRaster, TheMapsAreTheSameBitsOnOneThreadAsOnAll) {
       const float t = float(k) / 11.0f;
       points.push_back({128.0f + r * std::cos(a + 2.0f * t), 128.0f + r * std::sin(a * 1.3f + 3.0f * t),
                         -1.0f - 0.01f * float(i % 7)});
-      indices.push_back(uint32_t(s.pointCount() + points.size() - 1));
     }
     s.addStrand(points);
-    indices.push_back(kRestartIndex);
   }
-  auto maps = [&] {
-    const LightRaster raster(s, indices, texelView(256));
-    const std::vector<float> depth = raster.depth(1e10f);
-    return std::make_pair(depth, raster.opacity(depth, glm::vec4(0.002f, 0.006f, 0.015f, 0.04f), 0.3f));
-  };
-  const auto all = maps();
+  auto maps = [&] { return rasteriseLightMaps(s, texelView(256), 0.7, kLayers); };
+  const HairLightMaps all = maps(), again = maps();
   tbb::global_control one(tbb::global_control::max_allowed_parallelism, 1);
-  const auto single = maps();
-  EXPECT_TRUE(all.first == single.first);
-  EXPECT_TRUE(all.second == single.second);
+  const HairLightMaps single = maps();
+  EXPECT_TRUE(all.start == single.start && all.start == again.start);
+  EXPECT_TRUE(all.layers == single.layers && all.layers == again.layers);
+}
+
+// A strand moved by a hundredth of a texel moves a hundredth of its coverage: the maps are continuous
+// in the hair's position (each sample is splatted bilinearly), so shadows do not jump.
+TEST(HairLightMaps, AStrandMovedAHundredthOfATexelChangesTheMapsByAboutAHundredth) {
+  for (const double angle : {0.0, 0.4, 1.5708}) {
+    const glm::dvec2 d(std::cos(angle), std::sin(angle)), n(-d.y, d.x);
+    auto mapsAt = [&](double shift) {
+      const glm::dvec2 a = glm::dvec2(32.0, 32.0) - 15.0 * d + shift * n, b = a + 30.0 * d;
+      return rasteriseLightMaps(strip({{a.x, a.y, -1.0f}, {b.x, b.y, -1.0f}}), texelView(64), 0.3, kLayers);
+    };
+    const HairLightMaps before = mapsAt(0.0), after = mapsAt(0.01);
+    double moved = 0.0, largest = 0.0;
+    for (size_t t = 0; t < before.layers.size(); ++t) {
+      const double change = std::abs(double(after.layers[t].w) - double(before.layers[t].w)) / kCoverageOne;
+      moved += change;
+      largest = std::max(largest, change);
+    }
+    const double total = totalCoverage(before);
+    // Moving across by δ moves about 2δ of the coverage (out of one texel row, into the next).
+    EXPECT_LT(moved, 0.03 * total) << angle;
+    EXPECT_LT(largest, 0.03 * 0.3) << angle;
+  }
 }
 
 GlContext& gl() {
@@ -299,7 +260,8 @@ RenderOutput renderStrands(const Strands& hair, const RenderSettings& r, const M
   return render(gl(), hair, head, v, r, shaders, options);
 }
 
-// The light's maps drawn by the CPU (what llvmpipe gets) and by OpenGL (what a GPU gets).
+// The light's maps drawn by hairgen's rasteriser (what every machine gets) and by OpenGL (what a custom
+// HairVert gets).
 constexpr RenderInput::LightMaps kBothLightMaps[] = {RenderInput::LightMaps::kCpu,
                                                      RenderInput::LightMaps::kGl};
 
@@ -442,7 +404,7 @@ TEST(Render, BackgroundPixelsHaveNoOpacityAndTheBackgroundZ) {
 
 TEST(Render, AStrandBetweenTheLightAndAnotherDarkensOnlyThatOne) {
   for (RenderInput::LightMaps maps : kBothLightMaps) {
-    SCOPED_TRACE(maps == RenderInput::LightMaps::kCpu ? "light maps on the CPU" : "light maps by OpenGL");
+    SCOPED_TRACE(maps == RenderInput::LightMaps::kCpu ? "hairgen's light maps" : "light maps by OpenGL");
     // Light straight above; strand A 2 cm above strand B; the camera sees both from the front.
     RenderSettings r = frontCamera(96, 1);
     r.strandWidth = 0.004;
@@ -471,6 +433,44 @@ TEST(Render, AStrandBetweenTheLightAndAnotherDarkensOnlyThatOne) {
     EXPECT_GT(aPixels, 50);
     EXPECT_GT(bPixels, 50);
   }
+}
+
+// Strand A, a little thinner than a texel of the light's map, 2 cm above strand B, the light straight
+// above: moving A across the light's view a hundredth of a texel at a time (over a fifth of a texel,
+// wherever it falls on the texel grid) changes the shadow on B by about a hundredth of the shadow's
+// range each step, never by the jump of a texel (0.5 and more with a nearest-texel lookup).
+TEST(Render, AStrandMovedAHundredthOfATexelChangesTheShadowByAboutAHundredth) {
+  RenderSettings r = frontCamera(96, 1);
+  r.strandWidth = 1.2e-4;
+  r.lightPosition = {0.0, 1.0, 0.0};
+  // The light's map holds the scene's sphere at 512 texels: a texel at A's depth, in metres.
+  Strands probe;
+  addStraight(probe, {-0.04f, 0.02f, 0}, {0.04f, 0.02f, 0});
+  addStraight(probe, {-0.04f, 0.0f, 0}, {0.04f, 0.0f, 0});
+  const View light = lightView(r, boundingSphere(probe, nullptr), 512);
+  const double texel = glm::length(glm::dvec3(0.0, 0.02, 0.0) - r.lightPosition) / light.focalPx;
+  std::vector<float> before;
+  double largest = 0.0, range = 0.0;
+  for (int step = 0; step <= 20; ++step) {
+    const float dz = float(0.01 * step * texel);
+    Strands both;
+    addStraight(both, {-0.04f, 0.02f, dz}, {0.04f, 0.02f, dz});
+    addStraight(both, {-0.04f, 0.0f, 0}, {0.04f, 0.0f, 0});
+    const RenderOutput out = renderStrands(both, r);
+    std::vector<float> shadow;
+    for (int y = 48; y < 96; ++y)  // B's half of the image: y down, B below A
+      for (int x = 20; x < 76; ++x)
+        if (out.beauty.at(kChannelOpacity, x, y) > 0.0f)
+          shadow.push_back(out.beauty.at(kChannelShadow, x, y));
+    ASSERT_GT(shadow.size(), 40u);
+    for (float v : shadow) range = std::max(range, 1.0 - double(v));
+    if (!before.empty() && before.size() == shadow.size())
+      for (size_t i = 0; i < shadow.size(); ++i)
+        largest = std::max(largest, double(std::abs(shadow[i] - before[i])));
+    before = shadow;
+  }
+  EXPECT_GT(range, 0.1) << "A shadows B";
+  EXPECT_LT(largest, 0.03 * 0.75) << "the largest change of B's shadow in one step of 1/100 texel";
 }
 
 // A flat "head" facing up, a patch of hair 5 cm above its middle (x from −2 to 2 cm), the light above
@@ -786,13 +786,13 @@ TEST(Render, HairReadInPlaceGivesTheImageOfACopy) {
   EXPECT_TRUE(outs[0].beauty.planes == outs[1].beauty.planes);
 }
 
-// Coupe 3 at a fifth of its density with its head and Render Info at 320×240: the light's maps the CPU
-// draws (what llvmpipe gets) and those OpenGL draws (what a GPU gets) cover the same texels but for
-// their edges' rounding, hold as much opacity in each layer, and give the same picture but for a few
-// shadow edges (measured: 160 of 164,173 hair texels differ; the opacity in the nearest three layers
-// by 0.16-0.25%, where a fragment's depth is interpolated a little differently, and in all of them by
-// 6e-5; 107 of 17,126 pixels' shadow).
-TEST(Render, TheCpusLightMapsAreOpenGlsToTheirEdges) {
+// Coupe 3 at a fifth of its density with its head and Render Info at 320×240: the light's maps from
+// hairgen's rasteriser (every machine's) and from OpenGL's lines (a custom HairVert's) hold about as much
+// opacity in all: OpenGL's lines cover a texel per step along the major axis, so a segment at angle θ to
+// it counts cos θ of its length (0.71-1). (The nearer layers differ more: the rasteriser's start is the
+// nearest strand that reaches a texel through its bilinear footprint, a line's the nearest through its
+// one texel.) The two give the same picture but for the shadows' edges.
+TEST(Render, TheRasterisersLightMapsAreOpenGlsLines) {
   test::Job job = test::loadJob("thesis/coupe3/setup.txt", SetupUse::kRender);
   Hairstyle h = job.config.hairstyle;
   h.hairDensity = 20;
@@ -804,37 +804,58 @@ TEST(Render, TheCpusLightMapsAreOpenGlsToTheirEdges) {
   r.samples = 1;
   RenderOptions options;
   options.keepDom = true;
+  options.domResolution = 1024;
   options.lightMaps = RenderInput::LightMaps::kCpu;
-  const RenderOutput cpu = render(gl(), coupe, &head, job.config.visuality, r, {}, options);
+  const RenderOutput own = render(gl(), coupe, &head, job.config.visuality, r, {}, options);
   options.lightMaps = RenderInput::LightMaps::kGl;
   const RenderOutput ogl = render(gl(), coupe, &head, job.config.visuality, r, {}, options);
-  size_t hair = 0, differ = 0;
-  double cpuSum[4] = {}, oglSum[4] = {};
-  for (int y = 0; y < cpu.dom.height; ++y)
-    for (int x = 0; x < cpu.dom.width; ++x) {
-      const bool a = cpu.dom.at("Z", x, y) < 1e9f, b = ogl.dom.at("Z", x, y) < 1e9f;
-      hair += a || b;
-      differ += a != b;
-      for (int layer = 0; layer < 4; ++layer) {
-        const std::string name = kChannelDomLayers[layer];
-        cpuSum[layer] += cpu.dom.at(name, x, y);
-        oglSum[layer] += ogl.dom.at(name, x, y);
-      }
+  double ownSum = 0.0, oglSum = 0.0;
+  for (int y = 0; y < own.dom.height; ++y)
+    for (int x = 0; x < own.dom.width; ++x) {
+      ownSum += own.dom.at(kChannelDomLayers[3], x, y);
+      oglSum += ogl.dom.at(kChannelDomLayers[3], x, y);
     }
-  EXPECT_GT(hair, 10000u);
-  EXPECT_LT(double(differ), 0.005 * double(hair)) << differ << " of " << hair << " texels";
-  for (int layer = 0; layer < 4; ++layer)
-    EXPECT_NEAR(cpuSum[layer], oglSum[layer], (layer == 3 ? 1e-3 : 5e-3) * oglSum[layer])
-        << "layer " << layer + 1;
+  EXPECT_GT(oglSum, 0.7 * ownSum);
+  EXPECT_LT(oglSum, 1.02 * ownSum);
   size_t pixels = 0, shadowed = 0;
   for (int y = 0; y < 240; ++y)
     for (int x = 0; x < 320; ++x) {
-      if (cpu.beauty.at(kChannelOpacity, x, y) == 0.0f) continue;
+      if (own.beauty.at(kChannelOpacity, x, y) == 0.0f) continue;
       ++pixels;
-      shadowed += std::abs(cpu.beauty.at(kChannelShadow, x, y) - ogl.beauty.at(kChannelShadow, x, y)) > 0.05f;
+      shadowed += std::abs(own.beauty.at(kChannelShadow, x, y) - ogl.beauty.at(kChannelShadow, x, y)) > 0.1f;
     }
   EXPECT_GT(pixels, 5000u);
-  EXPECT_LT(double(shadowed), 0.02 * double(pixels)) << shadowed << " of " << pixels << " pixels";
+  EXPECT_LT(double(shadowed), 0.05 * double(pixels)) << shadowed << " of " << pixels << " pixels";
+}
+
+// Left to the renderer, the light's maps follow the image: at the scene's centre a texel is no larger
+// than a pixel (between kMinDomResolution and kMaxDomResolution texels a side), so a larger image gets
+// larger maps.
+TEST(Render, TheLightsMapsFollowTheImage) {
+  Strands s;
+  addStraight(s, {-0.04f, 0.02f, 0}, {0.04f, 0.02f, 0});
+  addStraight(s, {-0.04f, 0.0f, 0}, {0.04f, 0.0f, 0});
+  RenderOptions options;
+  options.keepDom = true;
+  int previous = 0;
+  for (int size : {64, 1200, 3000}) {
+    RenderSettings r = frontCamera(size, 1);
+    r.lightPosition = {0.0, 1.0, 0.0};
+    const RenderOutput out = render(gl(), s, nullptr, Visuality{}, r, {}, options);
+    const BoundingSphere sphere = boundingSphere(s, nullptr);
+    const View light = lightView(r, sphere, out.dom.width), camera = cameraView(r, sphere);
+    const double texel = glm::length(sphere.centre - r.lightPosition) / light.focalPx;
+    const double pixel = glm::length(sphere.centre - r.cameraPosition) / camera.focalPx;
+    EXPECT_GE(out.dom.width, kMinDomResolution) << size;
+    EXPECT_LE(out.dom.width, kMaxDomResolution) << size;
+    if (out.dom.width > kMinDomResolution && out.dom.width < kMaxDomResolution) {
+      EXPECT_LE(texel, pixel) << size;
+      EXPECT_GT(texel, 0.99 * pixel * (out.dom.width - 1) / out.dom.width)
+          << size << ": no larger than it needs";
+    }
+    EXPECT_GT(out.dom.width, previous) << size;
+    previous = out.dom.width;
+  }
 }
 
 // After framing, the camera looks at the hair's centre from the same direction, and the hair's

@@ -15,12 +15,10 @@ namespace hairgen {
 
 namespace {
 
-// How far from the hair the chords drawn for it may stray: 3/8 of a pixel of the image being drawn (a
-// sub-pixel when Samples asks for them; a strand is drawn at least a pixel wide, so its chord's line
-// still overlaps the curve's), and half a texel of the light's maps, whose lookup takes the
-// nearest start and the largest opacity over 2×2 texels (shadow.glsl), so a shadow is two texels wide
-// at its sharpest; a shadow's edge may move by the half texel.
-constexpr double kChordPixels = 0.375, kChordTexels = 0.5;
+// How far from the hair the chords the shading pass draws may stray: 3/8 of a pixel of the image being
+// drawn (a sub-pixel when Samples asks for them; a strand is drawn at least a pixel wide, so its chord's
+// line still overlaps the curve's).
+constexpr double kChordPixels = 0.375;
 
 // k for Samples = k² (k ≤ 8), lowered until the sub-pixel image fits the device's largest texture.
 int subpixelBlock(const RenderSettings& r) {
@@ -29,6 +27,23 @@ int subpixelBlock(const RenderSettings& r) {
   int block = std::min(std::max(1, int(std::lround(std::sqrt(double(r.samples))))), 8);
   while (block > 1 && std::max(r.resolution.x, r.resolution.y) * block > maxSize) --block;
   return block;
+}
+
+// The light's maps' size when the input leaves it to the renderer: a texel no larger than a pixel at the
+// scene's centre (a texel there is its distance from the light over the light's focal length in
+// texels, which grows with the map's size), between kMinDomResolution and the smaller of
+// kMaxDomResolution and the device's largest texture.
+int lightMapSize(const RenderInput& in, const BoundingSphere& sphere, const View& camera) {
+  if (in.domResolution > 0) return in.domResolution;
+  GLint maxSize = 4096;
+  glGetIntegerv(GL_MAX_TEXTURE_SIZE, &maxSize);
+  const int largest = std::min(int(maxSize), kMaxDomResolution);
+  const double lightFocalPerTexel = lightView(in.settings, sphere, 1).focalPx;
+  const double lightDistance = glm::length(sphere.centre - in.settings.lightPosition);
+  const double cameraDistance = glm::length(sphere.centre - in.settings.cameraPosition);
+  const double pixel = std::max(cameraDistance, 1e-6) / camera.focalPx;
+  const double texels = std::ceil(std::max(lightDistance, 1e-6) / (lightFocalPerTexel * pixel));
+  return int(std::clamp(texels, double(kMinDomResolution), double(largest)));
 }
 
 // Lines where every strand is at most a pixel and a half wide (at the scene's nearest point) and
@@ -133,23 +148,21 @@ Programs::Programs(bool ribbons, int block, const CustomShaders& custom, bool mo
                         "motion resolve");
 }
 
-// The strands' drawing order and their chords (line_decimation.h) for the light's passes and the shading
-// pass, computed on TBB's threads while the main thread, which holds the GL context, uploads the hair and
-// compiles the programs.
+// The light's maps (light_maps.h), and the strands' drawing order and chords (line_decimation.h) for the
+// shading pass, computed on TBB's threads while the main thread, which holds the GL context, uploads the
+// hair and compiles the programs.
 //
 // Order: only without sub-pixels, where the shading stage is tested for depth before it runs (the screen
 // door's discard would defer the test); a different order could only change which of two fragments of
-// exactly equal depth is kept. The light's passes are order-free: the nearest depth, and sums of equal
-// opacities.
+// exactly equal depth is kept.
 //
-// Chords: within kChordPixels of a pixel of the image or kChordTexels of a texel of the light's maps,
-// measured where the hair is nearest the eye (where those are smallest); the passes, whose cost is
-// llvmpipe's vertex stage on one thread, draw a fraction of the vertices and the same picture to that.
-// Not for a custom HairVert, which gets every point.
+// Chords: within kChordPixels of a pixel of the image, measured where the hair is nearest the eye (where
+// those are smallest); the pass, whose cost is llvmpipe's vertex stage on one thread, draws a fraction of
+// the vertices and the same picture to that. Not for a custom HairVert, which gets every point.
 struct Scene::Preparation {
-  std::vector<uint32_t> order, light, camera;
-  bool lightChords = false, cameraChords = false;
-  std::unique_ptr<LightRaster> lightRaster;  // the light's chords projected, when the CPU draws its maps
+  std::vector<uint32_t> order, camera;
+  bool cameraChords = false;
+  std::unique_ptr<HairLightMaps> lightMaps;  // when hairgen's rasteriser draws them
   tbb::task_group work;
 
   Preparation(const Scene& scene, const RenderInput& in) {
@@ -162,21 +175,19 @@ struct Scene::Preparation {
       const double tanX = 1.0 / v.proj[0][0], tanY = 1.0 / v.proj[1][1];  // the half-angles' tangents
       return depth / v.focalPx / (1.0 + tanX * tanX + tanY * tanY);
     };
-    const double lightPixel = nearestPixel(scene.light), cameraPixel = nearestPixel(scene.subpixel);
-    lightChords = !in.shaders.hairVert && lightPixel > 0.0;
+    const double cameraPixel = nearestPixel(scene.subpixel);
     cameraChords = !in.shaders.hairVert && !scene.ribbons && cameraPixel > 0.0;
     const Strands& hair = *in.hair;
-    const double lightTolerance = kChordTexels * lightPixel, cameraTolerance = kChordPixels * cameraPixel;
+    const double cameraTolerance = kChordPixels * cameraPixel;
     const bool ordered = scene.block == 1;
     const glm::dmat4 view = scene.camera.view;
-    const bool lightOnCpu = lightChords && in.lightMaps != RenderInput::LightMaps::kGl &&
-                            (in.lightMaps == RenderInput::LightMaps::kCpu || softwareRasteriser());
+    const bool lightByRasteriser = !in.shaders.hairVert && in.lightMaps != RenderInput::LightMaps::kGl;
     const View& lightView = scene.light;
-    work.run([=, this, &hair, &lightView] {
-      if (lightChords) light = decimatedLineStrips(hair, lightTolerance);
-      if (!lightOnCpu) return;
-      lightRaster = std::make_unique<LightRaster>(hair, light, lightView);
-      std::vector<uint32_t>().swap(light);  // projected into the raster: no chords to upload
+    const RenderSettings& r = in.settings;
+    work.run([=, this, &hair, &lightView, &r] {
+      if (!lightByRasteriser) return;
+      lightMaps =
+          std::make_unique<HairLightMaps>(rasteriseLightMaps(hair, lightView, r.strandWidth, r.layerSizes));
     });
     work.run([=, this, &hair] {
       if (ordered) order = frontToBack(hair, view);
@@ -200,7 +211,7 @@ Scene::Scene(const RenderInput& in)
       block(subpixelBlock(in.settings)),
       camera(cameraView(in.settings, sphere)),
       subpixel(subpixelView(camera, block)),
-      light(lightView(in.settings, sphere, in.domResolution)),
+      light(lightView(in.settings, sphere, lightMapSize(in, sphere, camera))),
       ribbons(drawsRibbons(in.settings, sphere, camera, block)),
       motion(in.previous.has_value()),
       preparing(std::make_unique<Preparation>(*this, in)),
@@ -218,8 +229,7 @@ Scene::Scene(const RenderInput& in)
   }
   preparing->work.wait();
   if (!preparing->order.empty()) hair.drawInOrder(*in.hair, preparing->order);
-  lightRaster = std::move(preparing->lightRaster);
-  if (preparing->lightChords && !lightRaster) lightLines = std::make_unique<LineStrips>(preparing->light);
+  lightMaps = std::move(preparing->lightMaps);
   if (preparing->cameraChords)
     cameraLines = std::make_unique<LineStrips>(preparing->camera, kCameraChunkVertices);
   preparing.reset();
@@ -228,15 +238,14 @@ Scene::Scene(const RenderInput& in)
 
 Scene::~Scene() = default;
 
-void Scene::releaseLightLines() {
-  lightLines.reset();
-  lightRaster.reset();
+void Scene::releaseLightMaps() {
+  lightMaps.reset();
 }
 
 void Scene::releaseGeometry() {
   glBindVertexArray(0);
   hair.release();
-  lightLines.reset();
+  lightMaps.reset();
   cameraLines.reset();
   head.reset();
 }
@@ -245,7 +254,7 @@ LightDepth lightDepthPass(const Scene& scene) {
   const int n = scene.light.width;
   const float far[4] = {kBackgroundZ, kBackgroundZ, kBackgroundZ, kBackgroundZ};
   const float one = 1.0f;
-  LightDepth depth{Texture(GL_R32F, n, n), Texture(GL_R32F, n, n), {}};
+  LightDepth depth{Texture(GL_R32F, n, n), Texture(GL_R32F, n, n)};
   glEnable(GL_DEPTH_TEST);
   glDepthFunc(GL_LESS);
   glDisable(GL_CULL_FACE);
@@ -260,9 +269,9 @@ LightDepth lightDepthPass(const Scene& scene) {
       scene.head->draw();
     }
   }
-  if (scene.lightRaster) {
-    depth.hairStartTexels = scene.lightRaster->depth(kBackgroundZ);
-    glTextureSubImage2D(depth.hairStart.id, 0, 0, 0, n, n, GL_RED, GL_FLOAT, depth.hairStartTexels.data());
+  if (scene.lightMaps) {
+    const std::vector<float> start = scene.lightMaps->startMetres(kBackgroundZ);
+    glTextureSubImage2D(depth.hairStart.id, 0, 0, 0, n, n, GL_RED, GL_FLOAT, start.data());
   } else {
     Framebuffer fb({&depth.hairStart}, n, n, true);
     fb.bind();
@@ -272,19 +281,17 @@ LightDepth lightDepthPass(const Scene& scene) {
     p.use();
     setView(p, scene.light);
     setHairWidth(p, scene.light, scene.settings);
-    scene.hair.drawLines(scene.lightLines.get());
+    scene.hair.drawLines(nullptr);
   }
   checkGl("the light's depth pass");
   return depth;
 }
 
-Texture deepOpacityPass(const Scene& scene, LightDepth& depth) {
+Texture deepOpacityPass(const Scene& scene, const LightDepth& depth) {
   const int n = scene.light.width;
-  Texture opacity(GL_RGBA32F, n, n, GL_LINEAR);
-  if (scene.lightRaster) {
-    const std::vector<glm::vec4> sums = scene.lightRaster->opacity(
-        depth.hairStartTexels, glm::vec4(scene.settings.layerSizes), float(scene.settings.strandOpacity));
-    std::vector<float>().swap(depth.hairStartTexels);  // up to 64 MB at 4096 texels: the texture has them
+  Texture opacity(GL_RGBA32F, n, n);
+  if (scene.lightMaps) {
+    const std::vector<glm::vec4> sums = scene.lightMaps->opacity(scene.settings.strandOpacity);
     glTextureSubImage2D(opacity.id, 0, 0, 0, n, n, GL_RGBA, GL_FLOAT, sums.data());
     checkGl("the deep opacity map's upload");
     return opacity;
@@ -302,7 +309,7 @@ Texture deepOpacityPass(const Scene& scene, LightDepth& depth) {
   setHairWidth(p, scene.light, scene.settings);
   p.set("uLayers", glm::vec4(scene.settings.layerSizes));
   glBindImageTexture(0, depth.hairStart.id, 0, GL_FALSE, 0, GL_READ_ONLY, GL_R32F);
-  scene.hair.drawLines(scene.lightLines.get());
+  scene.hair.drawLines(nullptr);
   glBindImageTexture(0, 0, 0, GL_FALSE, 0, GL_READ_ONLY, GL_R32F);
   glDisable(GL_BLEND);
   checkGl("the deep opacity pass");

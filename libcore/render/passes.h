@@ -23,7 +23,7 @@
 
 namespace hairgen {
 
-class LightRaster;  // light_maps.h
+struct HairLightMaps;  // light_maps.h
 
 // The programs of one render: hairgen's stages (libcore/render/glsl/), or the Setup's custom ones in
 // their place (HairVert in every program that draws hair, HeadVert in every one that draws the head).
@@ -55,19 +55,19 @@ struct Scene {
   struct Preparation;
   std::unique_ptr<Preparation> preparing;
   HairGeometry hair;
-  // The hair as chords for the light's passes and for the shading pass when it draws lines (null: every
-  // point; a custom HairVert always gets every point, since what it does to them is its own).
-  std::unique_ptr<LineStrips> lightLines, cameraLines;
-  // The light's chords on the CPU, when it draws the light's hair maps (RenderInput::lightMaps); then
-  // there are no lightLines.
-  std::unique_ptr<LightRaster> lightRaster;
+  // The hair as chords for the shading pass when it draws lines (null: every point; a custom HairVert
+  // always gets every point, since what it does to them is its own).
+  std::unique_ptr<LineStrips> cameraLines;
+  // The light's hair maps from hairgen's rasteriser (light_maps.h); null when OpenGL draws them from
+  // every point (a custom HairVert, RenderInput::lightMaps).
+  std::unique_ptr<HairLightMaps> lightMaps;
   std::unique_ptr<HeadGeometry> head;  // null when there is no head to draw
   Programs programs;
 
   // Frees the geometry once the passes that draw it are done, so what follows (the readback, the
-  // images' writing) does not run with the coupe still held: the light's chords after its passes, all
+  // images' writing) does not run with the coupe still held: the light's maps after their upload, all
   // of it after the last pass.
-  void releaseLightLines();
+  void releaseLightMaps();
   void releaseGeometry();
 };
 
@@ -75,8 +75,6 @@ struct Scene {
 struct LightDepth {
   Texture head;       // R32F: to the head
   Texture hairStart;  // R32F: to where the hair begins
-  std::vector<float>
-      hairStartTexels;  // the same, when the CPU drew it (Scene::lightRaster), until the opacity pass
 };
 
 // An image the shading pass draws and the resolve averages.
@@ -87,8 +85,7 @@ struct ShadedImage {
 
 LightDepth lightDepthPass(const Scene& scene);
 // RGBA32F, one layer per channel, the light's map size.
-// Frees depth.hairStartTexels once it has read them.
-Texture deepOpacityPass(const Scene& scene, LightDepth& depth);
+Texture deepOpacityPass(const Scene& scene, const LightDepth& depth);
 // At sub-pixel resolution.
 ShadedImage shadingPass(const Scene& scene, const LightDepth& depth, const Texture& opacity);
 // At the image's resolution.

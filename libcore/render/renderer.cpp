@@ -44,7 +44,7 @@ RenderOutput renderHair(GlContext&, const RenderInput& in) {
   out.lightWorldToNdc = openExrWorldToNdc(scene.light);
   out.timings.upload = seconds(clock);
   out.hairReadInPlace = scene.hair.readsStrandsInPlace();
-  out.lightMapsOnCpu = scene.lightRaster != nullptr;
+  out.lightMapsOnCpu = scene.lightMaps != nullptr;
   if (in.uploaded && !out.hairReadInPlace) in.uploaded();
   auto passDone = [&] {
     if (in.progress) in.progress->advance();
@@ -55,7 +55,7 @@ RenderOutput renderHair(GlContext&, const RenderInput& in) {
   out.timings.lightDepth = seconds(clock);
   passDone();
   const Texture opacity = deepOpacityPass(scene, depth);
-  scene.releaseLightLines();
+  scene.releaseLightMaps();
   out.timings.opacity = seconds(clock);
   passDone();
   const ShadedImage image = resolvePass(scene, shadingPass(scene, depth, opacity));

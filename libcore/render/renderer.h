@@ -3,7 +3,6 @@
 // from the camera reading both — into framebuffer objects of a headless EGL context.
 #pragma once
 
-#include <algorithm>
 #include <cstdint>
 #include <functional>
 #include <optional>
@@ -72,13 +71,16 @@ struct RenderInput {
   Visuality visuality;
   RenderSettings settings;
   CustomShaders shaders;
-  int domResolution = 1024;  // texels per side of the light's maps
+  // Texels per side of the light's maps; 0: as the image needs, so that no texel is larger than a pixel
+  // where the camera sees the middle of the scene, from kMinDomResolution up to the device's largest
+  // texture or kMaxDomResolution (passes.cpp).
+  int domResolution = 0;
   bool keepDom = false;
   std::optional<PreviousFrame> previous;  // motion vectors in the beauty image when given
   Progress* progress = nullptr;           // advanced once per pass (renderPassCount of them)
-  // Who draws the hair into the light's maps: the CPU (light_maps.h) or OpenGL. kAuto: the CPU on a
-  // software rasteriser (llvmpipe), OpenGL on a GPU. OpenGL always for a custom HairVert, whose
-  // vertices only it can place, and for a light inside the scene's sphere (no chords: passes.cpp).
+  // Who draws the hair into the light's maps: hairgen's integer rasteriser (light_maps.h), the same
+  // bits on every machine, for kAuto and kCpu; OpenGL's lines for kGl and always for a custom HairVert,
+  // whose vertices only OpenGL can place.
   enum class LightMaps { kAuto, kCpu, kGl };
   LightMaps lightMaps = LightMaps::kAuto;
   // Called once renderHair reads the hair (and the frame before's) no more, so the caller may free
@@ -96,11 +98,10 @@ inline size_t renderPassCount(bool motion) {
   return motion ? 6 : 5;
 }
 
-// The light's maps for an image: half the image's larger side, at least 1024 and at most 4096 texels
-// (the shadow lookup filters 2×2 texels, so this keeps shadows as sharp as the image needs).
-inline int domResolutionFor(const glm::ivec2& resolution) {
-  return std::clamp(std::max(resolution.x, resolution.y) / 2, 1024, 4096);
-}
+// The light's maps' size when RenderInput::domResolution leaves it to the renderer: at least
+// kMinDomResolution texels, and at most kMaxDomResolution (4096² texels hold 44 bytes each between the
+// rasteriser's integers and the textures: 0.7 GB).
+inline constexpr int kMinDomResolution = 512, kMaxDomResolution = 4096;
 
 // Renders with the current context of `gl`; with the previous frame, a motion pass and its resolve
 // after the shading pass (drawing hairgen's own vertex stages, never custom ones). Deterministic for a given
