@@ -268,8 +268,10 @@ void registerRun(CLI::App& app, int& exitCode) {
       "Run the stages in one process: grow and interpolate (or Load a saved coupe), shade when the Setup "
       "asks, then render. A still writes DIR/guides.hair, DIR/coupe.hair, DIR/shaded.hair (only when the "
       "Setup shades), DIR/beauty.exr and DIR/beauty.png; a shot (the Setup names a Dynamics Info) also "
-      "simulates the guides into DIR/sim/guides.####.hair and renders DIR/beauty.####.exr and .png and the "
-      "movie DIR/beauty.mp4 and .gif. Each file equals what the stage run alone writes");
+      "simulates the guides into DIR/sim/guides.####.hair, writes them with the rest coupe as one animated "
+      "USD "
+      "stage DIR/shot.usda, and renders DIR/beauty.####.exr and .png and the movie DIR/beauty.mp4 and .gif. "
+      "Each file equals what the stage run alone writes");
   cmd->add_option("SETUP", options->setup, "The Setup file (default: the bundled configs/default/setup.txt)");
   cmd->add_option("-o,--output", options->outDir,
                   "Output folder (default: out/NAME, NAME the Setup's folder)")
