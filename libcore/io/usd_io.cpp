@@ -370,7 +370,8 @@ class ShotPrim {
                                           "constant)");
         sampled.varies = sampled.varies || v.text != sampled.first.text;
       }
-      if (!v.text.empty()) sampled.spool.append("            " + std::to_string(f) + ": " + v.text + ",\n");
+      if (source_.animated && !v.text.empty())
+        sampled.spool.append("            " + std::to_string(f) + ": " + v.text + ",\n");
       if (f == frames_.first) sampled.first = std::move(v);
     }
     last_ = s.provenance;
