@@ -13,6 +13,7 @@
 #include "libcore/io/hair_cache.h"
 #include "libcore/io/movie.h"
 #include "libcore/io/obj_io.h"
+#include "libcore/io/usd_io.h"
 #include "libcore/physics/head_motion.h"
 #include "libcore/util/error.h"
 #include "libcore/util/file_util.h"
@@ -49,6 +50,20 @@ fs::path defaultSetup() {
   throw InputError(
       "no SETUP given and the default coupe (configs/default/setup.txt) was not found next to the "
       "executable; name a Setup file or set HAIRGEN_DATA to the folder that holds configs/");
+}
+
+// The shot as one USD stage, DIR/shot.usda: the written frames' guides time-sampled (/hair/guides) and
+// the rest coupe (/hair/strands), whose groom_closest_guides name the guides, as Unreal's guide caches
+// have it: a DCC interpolates the strands from the moving guides.
+void writeShotUsd(const fs::path& out, const fs::path& simPattern, const Strands& restCoupe,
+                  FrameRange frames, double frameRate) {
+  UsdShot shot;
+  shot.frames = frames;
+  shot.framesPerSecond = frameRate;
+  shot.guides =
+      UsdShotPrim{[&](int f) { return readStrands(framePath(simPattern, f)); }, simPattern.string()};
+  shot.strands = UsdShotPrim{[&](int) { return restCoupe; }, "the rest coupe", false};
+  writeUsdShot(out / "shot.usda", shot);
 }
 
 // A shot (the Setup names a Dynamics Info): the guides simulated frame by frame into DIR/sim, and each
@@ -120,6 +135,9 @@ void runShot(const CommonOptions& common, const Config& config, const Mesh& wick
   });
   progress.finish();
   stats.counts()["frames"] = wanted.count();
+  writeShotUsd(out, simPattern, restCoupe, wanted, d.frameRate);
+  keepCommittedOutputs();
+  stats.add("write", clock.lap());
   if (!render) return;
   clock.lap();
   MovieOptions movie;
@@ -250,8 +268,10 @@ void registerRun(CLI::App& app, int& exitCode) {
       "Run the stages in one process: grow and interpolate (or Load a saved coupe), shade when the Setup "
       "asks, then render. A still writes DIR/guides.hair, DIR/coupe.hair, DIR/shaded.hair (only when the "
       "Setup shades), DIR/beauty.exr and DIR/beauty.png; a shot (the Setup names a Dynamics Info) also "
-      "simulates the guides into DIR/sim/guides.####.hair and renders DIR/beauty.####.exr and .png and the "
-      "movie DIR/beauty.mp4 and .gif. Each file equals what the stage run alone writes");
+      "simulates the guides into DIR/sim/guides.####.hair, writes them with the rest coupe as one animated "
+      "USD "
+      "stage DIR/shot.usda, and renders DIR/beauty.####.exr and .png and the movie DIR/beauty.mp4 and .gif. "
+      "Each file equals what the stage run alone writes");
   cmd->add_option("SETUP", options->setup, "The Setup file (default: the bundled configs/default/setup.txt)");
   cmd->add_option("-o,--output", options->outDir,
                   "Output folder (default: out/NAME, NAME the Setup's folder)")

@@ -25,8 +25,8 @@ ShadeResult shadeStage(const CommonOptions& common, const Config& config, Strand
             ShadeOptions{config.hairstyle.seed, config.digest(), common.force, volumeWritten});
   const Strands& shaded = result.coupe;
   const Grid& grid = result.volume.density;
-  stats.time("volume", result.timings.volume);
-  stats.time("normals", result.timings.normals);
+  stats.add("volume", result.timings.volume);
+  stats.add("normals", result.timings.normals);
   stats.counts()["strands"] = shaded.strandCount();
   stats.counts()["points"] = shaded.pointCount();
   stats.counts()["grid"] = {grid.size.x, grid.size.y, grid.size.z};
@@ -76,7 +76,7 @@ void registerShade(CLI::App& app, int& exitCode) {
                   "named 'density' and 'sdf'")
       ->type_name("FILE.vdb");
   cmd->add_option("--frames", options->frames,
-                  "With --rest: re-pose every frame of a sequence, the coupe and -o being patterns with ####")
+                  "Every frame of a sequence: the coupe, -o and --vdb being patterns with ####")
       ->type_name("A-B");
   addCommonFlags(*cmd, options->common, true);
   cmd->callback([options, &exitCode] {
@@ -113,7 +113,7 @@ void registerShade(CLI::App& app, int& exitCode) {
           stats.add("repose", clock.lap());
           stats.counts()["strands"] = out.strandCount();
           stats.counts()["points"] = out.pointCount();
-          writeStrands(written, out);
+          warnDropped("shade", written, writeStrands(written, out));
           stats.add("write", clock.lap());
           if (!sequence) continue;
           keepCommittedOutputs();  // a finished frame stays, whatever a later one does
@@ -130,24 +130,50 @@ void registerShade(CLI::App& app, int& exitCode) {
         throw InputError("shade needs a Setup and a coupe: hairgen shade SETUP --hair COUPE -o OUT");
       if (!options->vdb.empty() && !toLower(options->vdb).ends_with(".vdb"))
         throw InputError("--vdb " + options->vdb + ": the volume file must end in .vdb");
-      Config config = loadStageConfig(options->first, options->common, SetupUse::kRender, stats);
-      Strands coupe = readStrandsAs(options->hair, options->units);
-      stats.time("read", clock.lap());
-      ShadeResult shaded;
-      try {
-        shaded = shadeStage(options->common, config, std::move(coupe), stats, !options->vdb.empty());
-      } catch (const InputError& e) {  // what is wrong with the coupe, said of its file
-        if (!e.where().file.empty()) throw;
-        throw InputError({options->hair, 0}, e.message());
+      // One coupe, or every frame of a sequence (--frames), each with its own volume.
+      const bool sequence = !options->frames.empty();
+      const FrameRange frames = sequence ? parseFrameRange(options->frames, "--frames") : FrameRange{0, 0};
+      if (sequence) {
+        for (const std::string* pattern : {&options->hair, &options->output})
+          if (!isFramePattern(*pattern))
+            throw InputError(*pattern + ": with --frames, write #### where the frame number goes");
+        if (!options->vdb.empty() && !isFramePattern(options->vdb))
+          throw InputError(
+              "--vdb " + options->vdb +
+              ": with --frames, each frame has its volume: write #### where the frame number goes");
+        requireWritableOutput(framePath(options->output, frames.first));
       }
-      clock.lap();
-      // The volume first: if the coupe then cannot be written, runCommand removes the volume (no
-      // partial output).
-      if (!options->vdb.empty()) writeVdb(options->vdb, shaded.volume);
-      writeStrands(options->output, shaded.coupe);
-      stats.time("write", clock.lap());
-      note(options->common,
-           "shade: wrote " + options->output + (options->vdb.empty() ? "" : " and " + options->vdb));
+      Config config = loadStageConfig(options->first, options->common, SetupUse::kRender, stats);
+      Progress progress("shade", "frames", size_t(frames.count()), sequence && !options->common.quiet);
+      for (int f = frames.first; f <= frames.last; ++f) {
+        auto frameOf = [&](const std::string& name) {
+          return name.empty() || !sequence ? name : framePath(name, f).string();
+        };
+        const std::string hair = frameOf(options->hair), output = frameOf(options->output),
+                          vdb = frameOf(options->vdb);
+        Strands coupe = readStrandsAs(hair, options->units);
+        stats.add("read", clock.lap());
+        ShadeResult shaded;
+        try {
+          shaded = shadeStage(options->common, config, std::move(coupe), stats, !vdb.empty());
+        } catch (const InputError& e) {  // what is wrong with the coupe, said of its file
+          if (!e.where().file.empty()) throw;
+          throw InputError({hair, 0}, e.message());
+        }
+        clock.lap();
+        // The volume first: if the coupe then cannot be written, runCommand removes the volume (no
+        // partial output).
+        if (!vdb.empty()) writeVdb(vdb, shaded.volume);
+        warnDropped("shade", output, writeStrands(output, shaded.coupe));
+        stats.add("write", clock.lap());
+        if (!sequence) continue;
+        keepCommittedOutputs();  // a finished frame stays, whatever a later one does
+        progress.advance();
+      }
+      progress.finish();
+      note(options->common, "shade: wrote " +
+                                (sequence ? std::to_string(frames.count()) + " frames " : std::string()) +
+                                options->output + (options->vdb.empty() ? "" : " and " + options->vdb));
       stats.write(options->common);
     });
   });

@@ -223,6 +223,12 @@ void note(const CommonOptions& options, const std::string& line) {
   if (!options.quiet) std::cerr << line << "\n";
 }
 
+void warnDropped(const std::string& command, const std::string& file, const WriteReport& report) {
+  if (report.droppedStrands == 0) return;
+  std::cerr << "hairgen " << command << ": warning: " << file << ": " << report.droppedStrands
+            << " strand(s) of fewer than two points (bare follicles) left out: USD linear curves need two\n";
+}
+
 std::string exitCodeHelp() {
   std::string text = "Exit codes:\n";
   for (const ExitCodeInfo& e : kExitCodes)

@@ -109,6 +109,11 @@ int runCommand(const std::string& command, const CommonOptions& options, const s
 // Progress and notes on stderr unless --quiet.
 void note(const CommonOptions& options, const std::string& line);
 
+// "hairgen CMD: warning: FILE: N strand(s) of fewer than two points (bare follicles) left out: ..." on
+// stderr, even with
+// --quiet (what a file does not hold), when the format dropped any.
+void warnDropped(const std::string& command, const std::string& file, const WriteReport& report);
+
 // The exit-code table shown in `hairgen --help`; every command's help points there in one line.
 std::string exitCodeHelp();
 

@@ -244,19 +244,51 @@ TEST(Usd, OneLinearBasisCurvesPrimWithWhatHairgenKnows) {
   EXPECT_EQ(usda.rfind("#usda 1.0\n", 0), 0u);
   for (const char* want :
        {"defaultPrim = \"hair\"", "metersPerUnit = 1", "upAxis = \"Y\"", "def BasisCurves \"hair\"",
-        "uniform token type = \"linear\"", "int[] curveVertexCounts = [2, 5, 8, 2]", "point3f[] points = [",
-        "float[] widths = [", "normal3f[] normals = [", "color3f[] primvars:displayColor = [",
-        "int[] primvars:groom_id = [1000, 1001, 1002, 1003] (\n        interpolation = \"uniform\"",
-        "float2[] primvars:groom_root_uv", "int3[] primvars:groom_closest_guides = [(0, 1, 2), (1, 2, 3)",
-        "float3[] primvars:groom_guide_weights", "string configDigest = \"0123456789abcdef\""})
+        "uniform token type = \"linear\"", "int[] curveVertexCounts = [2,5,8,2]", "point3f[] points = [",
+        "float[] widths = [", "normal3f[] primvars:hairgen:volumeNormal = [",
+        "color3f[] primvars:displayColor = [",
+        "int[] primvars:groom_id = [1000,1001,1002,1003] (\n        interpolation = \"uniform\"",
+        "int primvars:groom_guide = 0 (", "float2[] primvars:groom_root_uv",
+        "int3[] primvars:groom_closest_guides = [(0,1,2),(1,2,3)", "float3[] primvars:groom_guide_weights",
+        "string configDigest = \"0123456789abcdef\""})
     EXPECT_NE(usda.find(want), std::string::npos) << want;
+  // Volume normals are a hairgen primvar: `normals` would make USD draw the curves as ribbons.
+  EXPECT_EQ(usda.find(" normals = "), std::string::npos);
   // The widths are the diameters, one per vertex, in their shortest exact form.
   const size_t widths = usda.find("float[] widths = [");
   EXPECT_EQ(usda.substr(widths + 18, formatFloat(s.thickness[0]).size()), formatFloat(s.thickness[0]));
   EXPECT_NE(usda.find("interpolation = \"vertex\"", widths), std::string::npos);
+  // What grow or simulate made is guides.
+  s.provenance.stage = "simulate";
+  EXPECT_NE(usdaOf(s).find("int primvars:groom_guide = 1 ("), std::string::npos);
 }
 
-TEST(Usd, UnknownUnitsAreNotClaimedAndCurvesUsdCannotHoldAreRefused) {
+// The numbers of the array that follows `key`, as floats, in order.
+std::vector<float> floatsAfter(const std::string& text, const std::string& key) {
+  size_t at = text.find('[', text.find(key) + key.size()) + 1;
+  const size_t end = text.find(']', at);
+  std::vector<float> out;
+  while (at < end) {
+    while (at < end && std::string("(),\n ").find(text[at]) != std::string::npos) ++at;
+    if (at >= end) break;
+    size_t used = 0;
+    out.push_back(std::stof(text.substr(at, 40), &used));
+    at += used;
+  }
+  return out;
+}
+
+TEST(Usd, ExtentIsThePointsBoxGrownByHalfTheWidestWidth) {
+  Strands s;
+  s.addStrand({glm::vec3(0, 0, 0), glm::vec3(1, 2, 3)});
+  s.thickness = {0.1f, 0.3f};
+  const std::vector<float> extent = floatsAfter(usdaOf(s), "float3[] extent");
+  ASSERT_EQ(extent.size(), 6u);
+  const float pad = 0.3f * 0.5f;
+  EXPECT_EQ(extent, (std::vector<float>{-pad, -pad, -pad, 1 + pad, 2 + pad, 3 + pad}));
+}
+
+TEST(Usd, UnknownUnitsAreNotClaimedAndOnePointStrandsAreLeftOut) {
   Strands s;
   s.addStrand({glm::vec3(0), glm::vec3(1)});
   s.provenance.metres = s.provenance.yUp = false;
@@ -264,11 +296,87 @@ TEST(Usd, UnknownUnitsAreNotClaimedAndCurvesUsdCannotHoldAreRefused) {
   EXPECT_EQ(usda.find("metersPerUnit"), std::string::npos);
   EXPECT_EQ(usda.find("upAxis"), std::string::npos);
   EXPECT_NE(usda.find("float[] widths = [7e-05] (\n        interpolation = \"constant\""), std::string::npos);
-  s.addStrand({glm::vec3(2)});  // one point: not a linear curve
-  EXPECT_THROW(usdaOf(s), InputError);
+  // A bare follicle (USC-HairSalon's one-point strand) is no linear curve: left out and counted.
+  s.addStrand({glm::vec3(2)});
+  s.addStrand({glm::vec3(3), glm::vec3(4), glm::vec3(5)});
+  s.strandId = {7, 8, 9};
+  std::ostringstream out;
+  EXPECT_EQ(encodeUsda(out, s).droppedStrands, 1u);
+  EXPECT_NE(out.str().find("int[] curveVertexCounts = [2,3]"), std::string::npos);
+  EXPECT_NE(out.str().find("int[] primvars:groom_id = [7,9]"), std::string::npos);
+  EXPECT_EQ(floatsAfter(out.str(), "point3f[] points").size(), 15u);
+  Strands bare;
+  bare.addStrand({glm::vec3(2)});
+  EXPECT_THROW(usdaOf(bare), InputError);  // nothing left to write
   Strands ids = test::sampleStrands(2);
   ids.strandId[1] = 1u << 31;
   EXPECT_THROW(usdaOf(ids), InputError);
+}
+
+// A shot of `frames` frames of sampleStrands moving along +x by 0.5 m a frame, simulated at 25 fps.
+UsdShotPrim movingPrim(int firstFrame, const std::string& stage) {
+  return UsdShotPrim{[firstFrame, stage](int f) {
+                       Strands s = test::sampleStrands(3);
+                       s.provenance.stage = stage;
+                       s.provenance.frame = f;
+                       s.provenance.time = (f - firstFrame) / 25.0;
+                       for (glm::vec3& p : s.points) p.x += 0.5f * float(f);
+                       return s;
+                     },
+                     "moving.####.hair"};
+}
+
+TEST(Usd, AShotTimeSamplesWhatMovesAtTheCachesFrameRate) {
+  test::TempDir dir("usdshot");
+  UsdShot shot;
+  shot.frames = {3, 5};
+  shot.strands = movingPrim(1, "interpolate");
+  shot.guides = movingPrim(1, "simulate");
+  EXPECT_EQ(writeUsdShot(dir / "shot.usda", shot).droppedStrands, 0u);
+  const std::string usda = readFileText(dir / "shot.usda");
+  for (const char* want : {"startTimeCode = 3\n", "endTimeCode = 5\n", "timeCodesPerSecond = 25\n",
+                           "def Xform \"hair\"", "def BasisCurves \"strands\"", "def BasisCurves \"guides\"",
+                           "point3f[] points.timeSamples = {\n            3: [",
+                           "float3[] extent.timeSamples", "int primvars:groom_guide = 1"})
+    EXPECT_NE(usda.find(want), std::string::npos) << want;
+  // Frame 4's points are the cache's, to the float.
+  Strands four = shot.strands->frame(4);
+  const std::vector<float> sample = floatsAfter(usda, "            4: ");
+  ASSERT_EQ(sample.size(), 3 * four.pointCount());
+  for (size_t i = 0; i < four.pointCount(); ++i) EXPECT_EQ(sample[3 * i], four.points[i].x);
+  // What does not move is written once.
+  EXPECT_EQ(usda.find("widths.timeSamples"), std::string::npos);
+  EXPECT_EQ(usda.find("volumeNormal.timeSamples"), std::string::npos);
+}
+
+TEST(Usd, AShotRefusesFramesOfOtherStrandsAndCachesWithoutTheirTime) {
+  test::TempDir dir("usdshot");
+  UsdShot shot;
+  shot.frames = {1, 3};
+  shot.strands = movingPrim(1, "interpolate");
+  auto frame = shot.strands->frame;
+  shot.strands->frame = [frame](int f) {
+    Strands s = frame(f);
+    if (f == 3) s.strandId[0] = 5;
+    return s;
+  };
+  try {
+    writeUsdShot(dir / "shot.usda", shot);
+    ADD_FAILURE() << "frame 3's other strands were written";
+  } catch (const InputError& e) {
+    EXPECT_EQ(e.where().file, "moving.0003.hair");
+  }
+  EXPECT_FALSE(std::filesystem::exists(dir / "shot.usda"));
+  shot.strands = movingPrim(1, "interpolate");
+  shot.strands->frame = [frame](int f) {
+    Strands s = frame(f);
+    s.provenance.frame.reset();
+    return s;
+  };
+  EXPECT_THROW(writeUsdShot(dir / "shot.usda", shot), InputError);
+  shot.framesPerSecond = 30.0;  // given, it needs no frame times
+  writeUsdShot(dir / "shot.usda", shot);
+  EXPECT_NE(readFileText(dir / "shot.usda").find("timeCodesPerSecond = 30\n"), std::string::npos);
 }
 
 TEST(Provenance, AConvertedFileSaysWhereItCameFromThroughEveryFormat) {

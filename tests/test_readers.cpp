@@ -92,9 +92,12 @@ TEST(Readers, WriterRefusalsNameTheOutput) {
   s.points = {{0, 0, 0}};
   s.firstPoint = {0, 1, 1};  // strand 1 has no points
   test::TempDir dir("writer");
+  // USD leaves strands of fewer than two points out (issue 36): here nothing is left.
   for (const char* name : {"o.hair", "o.ply", "o.usda"}) {
     const std::string file = (dir.path() / name).string();
-    EXPECT_NE(inputError([&] { writeStrands(file, s); }).find(file + ": strand "), std::string::npos) << name;
+    const std::string why =
+        std::string(name) == "o.usda" ? ": no strands of two points or more" : ": strand ";
+    EXPECT_NE(inputError([&] { writeStrands(file, s); }).find(file + why), std::string::npos) << name;
     EXPECT_FALSE(std::filesystem::exists(file)) << name;
   }
 }

@@ -84,21 +84,28 @@ Strands readStrands(const std::filesystem::path& file, const UnitConversion& con
   return strands;
 }
 
-void writeStrands(const std::filesystem::path& file, const Strands& strands, const WriteOptions& options) {
+WriteReport writeStrands(const std::filesystem::path& file, const Strands& strands,
+                         const WriteOptions& options) {
   switch (hairFormatOf(file)) {
     case HairFormat::kHair:
-      return writeHair(file, strands);
+      writeHair(file, strands);
+      break;
     case HairFormat::kGltf:
-      return writeGltf(file, strands, false);
+      writeGltf(file, strands, false);
+      break;
     case HairFormat::kGlb:
-      return writeGltf(file, strands, true);
+      writeGltf(file, strands, true);
+      break;
     case HairFormat::kPly:
-      return writePly(file, strands, options.asciiPly);
+      writePly(file, strands, options.asciiPly);
+      break;
     case HairFormat::kData:
-      return writeHairSalon(file, strands);
+      writeHairSalon(file, strands);
+      break;
     case HairFormat::kUsda:
-      return writeUsda(file, strands);
+      return WriteReport{writeUsda(file, strands).droppedStrands};
   }
+  return {};
 }
 
 }  // namespace hairgen

@@ -6,6 +6,7 @@
 //   .usda        USD BasisCurves (usd_io)                   write only
 #pragma once
 
+#include <cstddef>
 #include <filesystem>
 #include <optional>
 #include <string>
@@ -37,8 +38,12 @@ Strands readStrands(const std::filesystem::path& file, const UnitConversion& con
 struct WriteOptions {
   bool asciiPly = false;  // PLY as ASCII text instead of binary little-endian
 };
-void writeStrands(const std::filesystem::path& file, const Strands& strands,
-                  const WriteOptions& options = {});  // atomic
+// What a format left out of the strands it was given, for the command to say.
+struct WriteReport {
+  size_t droppedStrands = 0;  // one-point strands, which USD cannot hold (usd_io.h)
+};
+WriteReport writeStrands(const std::filesystem::path& file, const Strands& strands,
+                         const WriteOptions& options = {});  // atomic
 
 // Records `file`'s name as the strands' source when they carry no hairgen provenance.
 void noteSource(Strands& strands, const std::filesystem::path& file);
