@@ -226,7 +226,7 @@ void note(const CommonOptions& options, const std::string& line) {
 void warnDropped(const std::string& command, const std::string& file, const WriteReport& report) {
   if (report.droppedStrands == 0) return;
   std::cerr << "hairgen " << command << ": warning: " << file << ": " << report.droppedStrands
-            << " strand(s) of fewer than two points (bare follicles) left out: USD linear curves need two\n";
+            << " strand(s) of fewer than two points (bare follicles) left out: a curve needs two\n";
 }
 
 std::string exitCodeHelp() {

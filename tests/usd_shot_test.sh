@@ -125,6 +125,9 @@ EOF
   grep -q "int\[\] curveVertexCounts = \[3,2\]" "$tmp/h.usda" || fail "the curves left: $(grep curveVertexCounts "$tmp/h.usda")"
   expect_rc 0 "$hairgen" convert "$tmp/h.####.data" --frames 1-2 -o "$tmp/hs.usda" --fps 24 --quiet
   expect_err "2 strand(s) of fewer than two points"
+  # glTF likewise: a one-point strand would be a loose vertex readers join to the strand before it.
+  expect_rc 0 "$hairgen" convert "$tmp/h.0001.data" "$tmp/h.glb"
+  expect_err "h.glb: 2 strand(s) of fewer than two points (bare follicles) left out"
   if [ -f "$reader/tinyusdz.wasm" ] && command -v node >/dev/null; then
     "$hairgen" info "$tmp/h.usda" >/dev/null || fail "info cannot read the header"
     node "$src/tests/validate_usd.mjs" "$reader" "$tmp/h.usda" /dev/stdin <<<'{"strands":2,"points":5,"attributes":[],"defaults":{"thickness":7e-05},"units":"unknown","upAxis":"unknown"}' >"$tmp/v" 2>&1 ||

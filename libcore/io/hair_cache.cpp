@@ -91,11 +91,11 @@ WriteReport writeStrands(const std::filesystem::path& file, const Strands& stran
       writeHair(file, strands);
       break;
     case HairFormat::kGltf:
-      writeGltf(file, strands, false);
-      break;
-    case HairFormat::kGlb:
-      writeGltf(file, strands, true);
-      break;
+    case HairFormat::kGlb: {
+      WriteReport report;
+      writeGltf(file, strands, hairFormatOf(file) == HairFormat::kGlb, &report.droppedStrands);
+      return report;
+    }
     case HairFormat::kPly:
       writePly(file, strands, options.asciiPly);
       break;

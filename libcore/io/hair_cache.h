@@ -40,7 +40,9 @@ struct WriteOptions {
 };
 // What a format left out of the strands it was given, for the command to say.
 struct WriteReport {
-  size_t droppedStrands = 0;  // one-point strands, which USD cannot hold (usd_io.h)
+  // One-point strands (bare follicles): USD's linear curves need two points (usd_io.h), and in glTF
+  // such a strand would be a loose vertex readers join to the strand before it (gltf_io.h).
+  size_t droppedStrands = 0;
 };
 WriteReport writeStrands(const std::filesystem::path& file, const Strands& strands,
                          const WriteOptions& options = {});  // atomic
