@@ -48,6 +48,8 @@ pack() {
   else
     echo "device-check: no $build/tests/hairgen_bench; the benchmarks will be skipped there" >&2
   fi
+  # The stage goldens' invariant checker (tests/stage_invariants.cpp), where this build has it.
+  [ -x "$build/tests/stage_invariants" ] && binaries+=("$build/tests/stage_invariants")
   for b in "${binaries[@]}"; do
     [ -e "$b" ] || die "$b is missing"
     cp "$b" "$stage/bin/" && strip --strip-unneeded "$stage/bin/$(basename "$b")"
@@ -56,7 +58,7 @@ pack() {
   # library's and OpenGL's.
   local skip='/(libc|libm|libdl|libpthread|librt|libresolv)\.so|/ld-linux|/libGL|/libEGL|/libOpenGL|/libGLX|/libGLdispatch'
   local lib
-  for b in "$stage/bin/hairgen" "$stage/bin/hairgen_bench"; do
+  for b in "$stage/bin/hairgen" "$stage/bin/hairgen_bench" "$stage/bin/stage_invariants"; do
     [ -e "$b" ] || continue
     ldd "$b" | awk '$2 == "=>" && $3 ~ /^\// {print $3}'
   done | sort -u | grep -vE "$skip" | while read -r lib; do
@@ -128,11 +130,14 @@ run() {
 
   say "== 2. golden cases"
   local golden="$work/golden" failed=0 passed=0 case
+  # A build without the stage goldens' checker (before they existed) checks no invariants.
+  local invariants="$bin/stage_invariants"
+  [ -x "$invariants" ] || invariants=true
   mkdir -p "$golden" "$work/sheets"
   for case_file in "$src"/golden/*/case.sh; do
     case=$(basename "$(dirname "$case_file")")
     local started=$SECONDS
-    if timeout 120 bash "$src/tests/golden_test.sh" "$hairgen" "$src" "$case" "$golden" >"$work/sheets/$case.log" 2>&1; then
+    if timeout 120 bash "$src/tests/golden_test.sh" "$hairgen" "$src" "$case" "$golden" "$invariants" >"$work/sheets/$case.log" 2>&1; then
       passed=$((passed + 1))
       say "golden $case: ok ($((SECONDS - started)) s)"
     else
