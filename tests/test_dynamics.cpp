@@ -401,6 +401,10 @@ TEST(AnjyoDynamics, JointLimitsHoldAndSegmentsKeepTheirLength) {
                          rb = glm::normalize(rest[p + 1] - rest[p]);
         const double allowed =
             std::max(glm::radians(10.0), std::acos(std::clamp(glm::dot(ra, rb), -1.0, 1.0)));
+        // Where the limit would leave the node inside the head, the head wins: a node held at its rest
+        // depth may pass its joint's limit.
+        const double restDepth = std::max(0.0, penetration(f.head.shapes[0], rest[p + 1]));
+        if (penetration(f.head.shapes[0], nodes[p + 1]) > restDepth - 1e-4) continue;
         worstTurn = std::max(worstTurn, std::acos(std::clamp(glm::dot(a, b), -1.0, 1.0)) - allowed);
       }
   }
@@ -473,6 +477,49 @@ TEST(Simulate, StillHairStaysStill) {
       for (size_t p = 0; p < rest.pointCount(); ++p) moved += guides.points[p] != rest.points[p];
     });
     EXPECT_EQ(moved, 0u) << "points moved under gravity " << gravity;
+  }
+}
+
+// Collisions keep every node at or above the depth it sat at in each shape at rest (a millionth of the
+// shape's size of float slack, and float rounding of the head frame's points), in every frame of the
+// bundled Anjyo shots: the gust and the head turn.
+TEST(Simulate, NoNodeSinksBelowItsRestDepthInTheBundledShots) {
+  for (const char* setup : {"anjyo/gust/setup.txt", "shots/headturn/setup.txt"}) {
+    const test::Job job = test::loadJob(setup);
+    Mesh few = job.wick;
+    few.positions.clear();
+    few.normals.clear();
+    for (size_t i = 0; i < job.wick.vertexCount(); i += 5) {
+      few.positions.push_back(job.wick.positions[i]);
+      few.normals.push_back(job.wick.normals[i]);
+    }
+    few.triangles.clear();
+    const Strands rest = grow(few, job.config.hairstyle, job.config.collision, GrowOptions{}).guides;
+    const HeadMotion head = headMotionOf(job.config);
+    const std::vector<CollisionShape>& shapes = job.config.collision.shapes;
+    double worst = -1.0;
+    int worstFrame = 0;
+    simulate(rest, job.config,
+             frames(job.config, {job.config.dynamics.firstFrame, job.config.dynamics.lastFrame}),
+             [&](int frame, const Strands& guides) {
+               const Pose pose = head.pose(frame);
+               const glm::dmat3 back = glm::transpose(pose.rotation);
+               for (const CollisionShape& shape : shapes) {
+                 if (shape.penalty <= 0.0) continue;
+                 for (size_t p = 0; p < rest.pointCount(); ++p) {
+                   const glm::dvec3 at =
+                       back * (glm::dvec3(guides.points[p]) - pose.centre - pose.translation) + pose.centre;
+                   const double sunk =
+                       penetration(shape, at) - std::max(0.0, penetration(shape, glm::dvec3(rest.points[p])));
+                   if (sunk > worst) {
+                     worst = sunk;
+                     worstFrame = frame;
+                   }
+                 }
+               }
+             });
+    EXPECT_LT(worst, 2e-6) << setup << ": a node sank " << worst * 1e3 << " mm below its rest depth in frame "
+                           << worstFrame;
   }
 }
 
