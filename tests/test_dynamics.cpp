@@ -12,7 +12,6 @@
 
 #include "libcore/physics/anjyo_dynamics.h"
 #include "libcore/physics/head_motion.h"
-#include "libcore/physics/lane_trig.h"
 #include "libcore/physics/strand_energy.h"
 #include "libcore/util/cpu.h"
 #include "stages/grow.h"
@@ -186,30 +185,8 @@ TEST(Simulate, TheHeadTurnsAboutTheHeadShape) {
   EXPECT_GT(glm::length(pose.apply(c.shapes[0].centre) - c.shapes[0].centre), 0.1);
 }
 
-// The step's own sin and cos (lane_trig.h): the library's to within a float's ulp over many turns, and
-// exactly 0 and 1 at rest, which is what keeps still hair still.
-TEST(AnjyoDynamics, TheStepsSinAndCosAreTheLibrarysToAFloat) {
-  double worst = 0.0;
-  for (int i = -200000; i <= 200000; i += 16) {
-    lanes16::F x;
-    for (size_t l = 0; l < lanes16::kWidth; ++l) x[l] = float((i + int(l)) * 3.7e-4);  // ±74 rad
-    lanes16::F s, c;
-    lanes16::sinCos(x, s, c);
-    for (size_t l = 0; l < lanes16::kWidth; ++l)
-      worst =
-          std::max({worst, std::abs(s[l] - std::sin(double(x[l]))), std::abs(c[l] - std::cos(double(x[l])))});
-  }
-  EXPECT_LT(worst, 1.2e-7);
-  lanes16::F s, c;
-  lanes16::sinCos(lanes16::F{}, s, c);
-  for (size_t l = 0; l < lanes16::kWidth; ++l) {
-    EXPECT_EQ(s[l], 0.0f);
-    EXPECT_EQ(c[l], 1.0f);
-  }
-}
-
-// The kernel's atan2, which reads a moved segment's angles back: the library's to within a few float ulps
-// in every octant, and the same bits in every build.
+// The kernel's atan2, which reads a segment's change of angle where it is large: the library's to within a
+// few float ulps in every octant, and the same bits in every build.
 TEST(AnjyoDynamics, TheKernelsAtan2IsTheLibrarysToAFloat) {
   constexpr size_t n = AnjyoHair::kLanes;
   double worst = 0.0;

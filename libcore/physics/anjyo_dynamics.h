@@ -87,8 +87,8 @@ class AnjyoHair {
 
   // What a restart needs, kStateValues floats per segment: its rotation vector from rest (a, b), and its
   // turn over the last substep in the carried frame (the velocity Verlet's; the trigonometry of the
-  // rotation is computed from them by arithmetic alone, lane_trig.h, so a resumed run computes exactly what
-  // the unbroken one did). Laid out as the step reads it: a header of kStateHeader doubles (kStateTag,
+  // rotation is computed from them by arithmetic alone, anjyo_kernel.inc, so a resumed run computes exactly
+  // what the unbroken one did). Laid out as the step reads it: a header of kStateHeader doubles (kStateTag,
   // kLanes, kStateValues, then zeros), then per block of kLanes strands, per segment, per value, the block's
   // lanes as floats, two to a double (a lane past its strand's end holds the rest state, zeros). The hair
   // keeps its state in this layout, so `swapState` lends it to a frame's cache without a copy: swap it out,
@@ -192,8 +192,9 @@ class AnjyoHair {
   // A segment's values in the state: its rotation vector from the rest direction, (a, b) along pole
   // and side, and its turn over the last substep in the frame carried from the rest frame.
   enum StateValue { kAngleA, kAngleB, kTurnA, kTurnB };
-  // Of ψ = |(a, b)|, as the step computed them (lane_trig.h): cos ψ, sin ψ / ψ, (1 − cos ψ) / ψ² and ψ,
-  // kept beside the state so that a step computes them once: per block, per segment, per value, the lanes.
+  // Of ψ = |(a, b)|, as the step computed them (anjyo_kernel.inc's trigOf): cos ψ, sin ψ / ψ, (1 − cos ψ) /
+  // ψ² and ψ, kept beside the state so that a step computes them once: per block, per segment, per value, the
+  // lanes.
   static constexpr size_t kTrigValues = 4;
   enum TrigValue { kCosPsi, kSinc, kVersine, kPsi };
 
