@@ -500,6 +500,24 @@ TEST(Simulate, NoNodeSinksBelowItsRestDepthInTheBundledShots) {
   }
 }
 
+// Gravity acts on moving hair: the same rest guides in the same wind move differently under Gravity 0,
+// 9.81 and 30 (were the rest's gravity subtracted as a constant force, they would move alike, bit for bit).
+TEST(Simulate, GravityChangesTheMotion) {
+  const Config config = dynamicJob({}, {{2, {3.0, 0.0, 0.0}, false, {}}}, 8);
+  const Strands rest = someGuides(config, 13);
+  auto last = [&](double gravity) {
+    Config c = config;
+    c.hairstyle.gravity = gravity;
+    Strands out;
+    simulate(rest, c, frames(c, {1, 8}), [&](int, const Strands& guides) { out = guides; });
+    return out.points;
+  };
+  const PointArray earth = last(9.81);
+  EXPECT_NE(earth, rest.points) << "the wind moves the hair";
+  EXPECT_NE(last(0.0), earth);
+  EXPECT_NE(last(30.0), earth);
+}
+
 TEST(Simulate, RootsFollowTheHead) {
   HeadKey start, turned;
   turned.frame = 12;
