@@ -12,7 +12,6 @@
 
 #include "libcore/physics/anjyo_dynamics.h"
 #include "libcore/physics/head_motion.h"
-#include "libcore/physics/lane_trig.h"
 #include "libcore/physics/strand_energy.h"
 #include "libcore/util/cpu.h"
 #include "stages/grow.h"
@@ -186,30 +185,8 @@ TEST(Simulate, TheHeadTurnsAboutTheHeadShape) {
   EXPECT_GT(glm::length(pose.apply(c.shapes[0].centre) - c.shapes[0].centre), 0.1);
 }
 
-// The step's own sin and cos (lane_trig.h): the library's to within a float's ulp over many turns, and
-// exactly 0 and 1 at rest, which is what keeps still hair still.
-TEST(AnjyoDynamics, TheStepsSinAndCosAreTheLibrarysToAFloat) {
-  double worst = 0.0;
-  for (int i = -200000; i <= 200000; i += 16) {
-    lanes16::F x;
-    for (size_t l = 0; l < lanes16::kWidth; ++l) x[l] = float((i + int(l)) * 3.7e-4);  // ±74 rad
-    lanes16::F s, c;
-    lanes16::sinCos(x, s, c);
-    for (size_t l = 0; l < lanes16::kWidth; ++l)
-      worst =
-          std::max({worst, std::abs(s[l] - std::sin(double(x[l]))), std::abs(c[l] - std::cos(double(x[l])))});
-  }
-  EXPECT_LT(worst, 1.2e-7);
-  lanes16::F s, c;
-  lanes16::sinCos(lanes16::F{}, s, c);
-  for (size_t l = 0; l < lanes16::kWidth; ++l) {
-    EXPECT_EQ(s[l], 0.0f);
-    EXPECT_EQ(c[l], 1.0f);
-  }
-}
-
-// The kernel's atan2, which reads a moved segment's angles back: the library's to within a few float ulps
-// in every octant, and the same bits in every build.
+// The kernel's atan2, which reads a segment's change of angle where it is large: the library's to within a
+// few float ulps in every octant, and the same bits in every build.
 TEST(AnjyoDynamics, TheKernelsAtan2IsTheLibrarysToAFloat) {
   constexpr size_t n = AnjyoHair::kLanes;
   double worst = 0.0;
@@ -401,6 +378,10 @@ TEST(AnjyoDynamics, JointLimitsHoldAndSegmentsKeepTheirLength) {
                          rb = glm::normalize(rest[p + 1] - rest[p]);
         const double allowed =
             std::max(glm::radians(10.0), std::acos(std::clamp(glm::dot(ra, rb), -1.0, 1.0)));
+        // Where the limit would leave the node inside the head, the head wins: a node held at its rest
+        // depth may pass its joint's limit.
+        const double restDepth = std::max(0.0, penetration(f.head.shapes[0], rest[p + 1]));
+        if (penetration(f.head.shapes[0], nodes[p + 1]) > restDepth - 1e-4) continue;
         worstTurn = std::max(worstTurn, std::acos(std::clamp(glm::dot(a, b), -1.0, 1.0)) - allowed);
       }
   }
@@ -461,15 +442,80 @@ TEST(AnjyoDynamics, AStateThatLeftItsBoundsIsAFault) {
   EXPECT_TRUE(fault->angle);
 }
 
+// A still head and no wind: the styling load balances the rest's gravity exactly, bit for bit, and
+// nothing moves, under the bundled coupe's gravity or any other.
 TEST(Simulate, StillHairStaysStill) {
-  const Config config = dynamicJob({}, {}, 240);
-  const Strands rest = someGuides(config, 7);
-  double worst = 0.0;
-  simulate(rest, config, frames(config, {1, 240}), [&](int, const Strands& guides) {
-    for (size_t p = 0; p < rest.pointCount(); ++p)
-      worst = std::max(worst, double(glm::length(guides.points[p] - rest.points[p])));
-  });
-  EXPECT_LT(worst, 1e-4) << "a vertex moved " << worst * 1e3 << " mm";
+  for (double gravity : {9.81, 30.0}) {
+    Config config = dynamicJob({}, {}, 240);
+    config.hairstyle.gravity = gravity;
+    const Strands rest = someGuides(config, 7);
+    size_t moved = 0;
+    simulate(rest, config, frames(config, {1, 240}), [&](int, const Strands& guides) {
+      for (size_t p = 0; p < rest.pointCount(); ++p) moved += guides.points[p] != rest.points[p];
+    });
+    EXPECT_EQ(moved, 0u) << "points moved under gravity " << gravity;
+  }
+}
+
+// Collisions keep every node at or above the depth it sat at in each shape at rest (a millionth of the
+// shape's size of float slack, and float rounding of the head frame's points), in every frame of the
+// bundled Anjyo shots: the gust and the head turn.
+TEST(Simulate, NoNodeSinksBelowItsRestDepthInTheBundledShots) {
+  for (const char* setup : {"anjyo/gust/setup.txt", "shots/headturn/setup.txt"}) {
+    const test::Job job = test::loadJob(setup);
+    Mesh few = job.wick;
+    few.positions.clear();
+    few.normals.clear();
+    for (size_t i = 0; i < job.wick.vertexCount(); i += 5) {
+      few.positions.push_back(job.wick.positions[i]);
+      few.normals.push_back(job.wick.normals[i]);
+    }
+    few.triangles.clear();
+    const Strands rest = grow(few, job.config.hairstyle, job.config.collision, GrowOptions{}).guides;
+    const HeadMotion head = headMotionOf(job.config);
+    const std::vector<CollisionShape>& shapes = job.config.collision.shapes;
+    double worst = -1.0;
+    int worstFrame = 0;
+    simulate(rest, job.config,
+             frames(job.config, {job.config.dynamics.firstFrame, job.config.dynamics.lastFrame}),
+             [&](int frame, const Strands& guides) {
+               const Pose pose = head.pose(frame);
+               const glm::dmat3 back = glm::transpose(pose.rotation);
+               for (const CollisionShape& shape : shapes) {
+                 if (shape.penalty <= 0.0) continue;
+                 for (size_t p = 0; p < rest.pointCount(); ++p) {
+                   const glm::dvec3 at =
+                       back * (glm::dvec3(guides.points[p]) - pose.centre - pose.translation) + pose.centre;
+                   const double sunk =
+                       penetration(shape, at) - std::max(0.0, penetration(shape, glm::dvec3(rest.points[p])));
+                   if (sunk > worst) {
+                     worst = sunk;
+                     worstFrame = frame;
+                   }
+                 }
+               }
+             });
+    EXPECT_LT(worst, 2e-6) << setup << ": a node sank " << worst * 1e3 << " mm below its rest depth in frame "
+                           << worstFrame;
+  }
+}
+
+// Gravity acts on moving hair: the same rest guides in the same wind move differently under Gravity 0,
+// 9.81 and 30 (were the rest's gravity subtracted as a constant force, they would move alike, bit for bit).
+TEST(Simulate, GravityChangesTheMotion) {
+  const Config config = dynamicJob({}, {{2, {3.0, 0.0, 0.0}, false, {}}}, 8);
+  const Strands rest = someGuides(config, 13);
+  auto last = [&](double gravity) {
+    Config c = config;
+    c.hairstyle.gravity = gravity;
+    Strands out;
+    simulate(rest, c, frames(c, {1, 8}), [&](int, const Strands& guides) { out = guides; });
+    return out.points;
+  };
+  const PointArray earth = last(9.81);
+  EXPECT_NE(earth, rest.points) << "the wind moves the hair";
+  EXPECT_NE(last(0.0), earth);
+  EXPECT_NE(last(30.0), earth);
 }
 
 TEST(Simulate, RootsFollowTheHead) {

@@ -194,8 +194,8 @@ Key<Dynamics> fluctuationKey() {
 Key<Dynamics> restFrequencyKey() {
   return customKey<Dynamics>(
       {"RestFrequency", "Hz",
-       "the angular spring that holds the styled shape (0 = none); auto = the hair's first bending "
-       "mode"},
+       "the angular spring that holds the styled shape (0 = none); auto = each segment's stiffness in "
+       "the elastica of the hair hanging under its weight (without gravity, its first bending mode)"},
       "auto | Hz", "[0, 1000]",
       [](SectionReader& r, Dynamics& d) {
         const ConfigLine* line = r.line("RestFrequency");

@@ -36,10 +36,11 @@ inline constexpr double kMaxSpringStretch = 0.01;
 inline constexpr double kMaxSpringSpeed = 1000.0;  // m/s
 inline constexpr size_t kSpringStateValues = 6;    // per segment: position, velocity
 
-// Anjyo's layout (anjyo_dynamics.h keeps its state in it) and its bounds: the step keeps each angle
-// within half a turn of 0, and a turn of more than kMaxAnjyoTurn in a substep is no shot's.
+// Anjyo's layout (anjyo_dynamics.h keeps its state in it) and its bounds: each segment's rotation from
+// its rest direction is at most half a turn, and a turn of more than kMaxAnjyoTurn in a substep is no
+// shot's.
 inline constexpr size_t kAnjyoStateValues = 4, kAnjyoStateHeader = 8, kAnjyoLanes = 16;
-inline constexpr double kAnjyoStateTag = 0x414e4a35;  // "ANJ5"
+inline constexpr double kAnjyoStateTag = 0x414e4a36;  // "ANJ6"
 inline constexpr double kMaxAnjyoAngle = 4.0;         // radians
 inline constexpr double kMaxAnjyoTurn = 1e3;          // radians a substep
 

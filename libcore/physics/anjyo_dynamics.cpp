@@ -28,6 +28,20 @@ void toFloats(const glm::dvec3& v, float (&to)[3]) {
   for (int c = 0; c < 3; ++c) to[c] = float(v[c]);
 }
 
+// The auto rest spring of a segment (README, Dynamics), ω² in 1/s²: `coefficient` its c_i u_i m_i (1/m),
+// g the gravity (m/s²), kappa sqrt(ρA g / EI) (1/m^1.5), `length` its hair's (m), `from` how far its
+// middle is from the root (m), `upward` the rest gravity against its rest direction (−g·rest, m/s²). A
+// hanging hair's elastica under its own weight bends in a layer at the root where its slope approaches the
+// field's as exp(−∫ds/λ), λ = sqrt(EI/T), T = ρAg(L − s) the weight below; a lone segment held by ω² settles
+// at the fraction ω²/(c g + ω²) of its departure, so ω² = c g e/(1 − e) puts it where the elastica's slope
+// is. A segment that points upward at rest is given gravity's own stiffness against it besides (its styling
+// holds it, as a hair cannot alone).
+double restSpring(double coefficient, double g, double kappa, double length, double from, double upward) {
+  const double below = std::max(length - from, 0.0);
+  const double x = 2.0 / 3.0 * kappa * (length * std::sqrt(length) - below * std::sqrt(below));
+  return coefficient * (g / std::expm1(x) + std::max(upward, 0.0));
+}
+
 }  // namespace
 
 double firstBendingFrequency(const Hairstyle& style, double length) {
@@ -148,14 +162,10 @@ AnjyoHair::AnjyoHair(const Strands& rest, const Hairstyle& style, const Dynamics
                      std::to_string(j) + " and " + std::to_string(j + 1) +
                      "); a segment needs a length that floats can hold");
   }
-  // The rest spring: RestFrequency, or the longest hair's first bending mode.
-  const float longest = totals.empty() ? 0.0f : *std::max_element(totals.begin(), totals.end());
-  const double frequency =
-      dynamics.restFrequencyAuto ? firstBendingFrequency(style, longest) : dynamics.restFrequency;
   const double jointLimit = glm::radians(style.jointLimit);
   SetupParams params;
   params.totals = totals.data();
-  params.omega2 = float(std::pow(2.0 * M_PI * frequency, 2));
+  toFloats(restAcceleration_, params.restAcceleration);
   params.cosLimit = float(std::cos(jointLimit));
   params.sinLimit = float(std::sin(jointLimit));
   params.limited = jointLimit < M_PI;
@@ -164,6 +174,37 @@ AnjyoHair::AnjyoHair(const Strands& rest, const Hairstyle& style, const Dynamics
   params.rootInertia = float(dynamics.rootInertia);
   params.inertiaExponent = float(dynamics.inertiaExponent);
   tbb::parallel_for(size_t(0), blocks, [&](size_t b) { Kernels::setup(*this, b, params, kernel); });
+  setSprings(style, dynamics, totals);
+}
+
+void AnjyoHair::setSprings(const Hairstyle& style, const Dynamics& dynamics,
+                           const std::vector<float>& totals) {
+  const float longest = totals.empty() ? 0.0f : *std::max_element(totals.begin(), totals.end());
+  const double frequency =
+      dynamics.restFrequencyAuto ? firstBendingFrequency(style, longest) : dynamics.restFrequency;
+  const bool elastica = dynamics.restFrequencyAuto && style.gravity > 0.0;
+  const float uniform = float(std::pow(2.0 * M_PI * frequency, 2));
+  const double ra = style.hairRadius1, rb = style.hairRadius2;
+  const double bending = style.young * M_PI * ra * rb * rb * rb / 4.0,
+               linear = style.massDensity * M_PI * ra * rb;
+  // ∫₀^s ds'/λ(s') = κ (2/3)(L^1.5 − (L − s)^1.5), λ = sqrt(EI / T) under the weight T = ρA g (L − s') below.
+  const double kappa = std::sqrt(linear * style.gravity / bending);
+  const size_t strands = rest_.strandCount();
+  tbb::parallel_for(size_t(0), blockCount(), [&](size_t b) {
+    for (size_t l = 0; l < kLanes && b * kLanes + l < strands; ++l) {
+      const size_t s = b * kLanes + l;
+      double along = 0.0;
+      for (uint32_t j = 0; j < firstSegment_[s + 1] - firstSegment_[s]; ++j) {
+        LaneSegment& segment = segments_[blockFirst_[b] + j];
+        const double d = segment.length[l];
+        const double upward = -restAcceleration_.y * double(segment.rest[1][l]);  // −g·rest, g along −y
+        segment.spring[l] = elastica ? float(restSpring(segment.coefficient[l], style.gravity, kappa,
+                                                        totals[s], along + 0.5 * d, upward))
+                                     : uniform;
+        along += d;
+      }
+    }
+  });
 }
 
 void AnjyoHair::requireState() const {
@@ -179,7 +220,6 @@ bool AnjyoHair::fluctuates(int frame, bool firstSubstep) const {
 AnjyoHair::StepParams AnjyoHair::paramsOf(const AccelerationField& field, double dt, int frame,
                                           bool firstSubstep) const {
   StepParams p;
-  toFloats(field.base - restAcceleration_, p.base);
   toFloats(field.base, p.fieldBase);
   toFloats(restAcceleration_, p.restAcceleration);
   toFloats(field.omega, p.omega);

@@ -8,11 +8,12 @@
 // is kept out of the collision shapes.
 //
 // hairgen's choices where the paper is open (README, Dynamics):
-// - Angles: the paper measures θ from the vertical. A hanging segment then sits at the pole, where φ is
-//   undefined and (5) loses its force, and a small sideways push turns into a spin of φ. hairgen
-//   measures each segment's angles in a frame of its own whose pole is perpendicular to the segment's
-//   rest direction: the rest is θ = φ = 0 on the equator, where (4) and (5) are exactly the equations of
-//   a stick turning about its root, and the pole is 90° of departure away.
+// - Angles: the paper measures θ from the vertical; a hanging segment then sits at the pole, where φ is
+//   undefined, and (4) and (5) as written are a stick turning about its root only on the equator (off
+//   it they lose the terms that keep a swing in its plane). hairgen keeps each segment's rotation vector
+//   from its rest direction, (a, b) along `pole` and `side`, and measures its turn in the rest frame
+//   carried to it by that rotation: re-centred on the segment every substep, where (4) and (5) are the
+//   same in every direction. Only the fold straight back (half a turn) is singular.
 // - Units: F is the segment's mass times an acceleration field (gravity, wind, and in the head's frame the
 //   head's own acceleration, with the rotating frame's Euler, centrifugal and Coriolis terms). I_i is
 //   (k/i)^p m_i d_i L/3 (times a root factor for the first n segments), so c_i u_i m_i = 3 (i/k)^p/(2L):
@@ -20,18 +21,20 @@
 //   compound pendulum ρL³/3), toward the root the inertia grows as 1/i, and at a given fraction of the
 //   length the response does not depend on how many segments the hair has. (The paper's own
 //   normalisation, I_k = ρ(kd)²/3, is k times this: `Inertia 1 k k`.)
-// - Rest: the guides were styled under gravity, which the equations alone do not hold. The hair moves by
-//   its departure from the styled state: the force is the field minus the styling load (the rest pose's
-//   gravity), and an angular spring at RestFrequency pulls each segment toward its rest direction. Still
-//   hair (a still head, no wind) therefore stays exactly at rest, a wind or a turn of the head moves it,
-//   and a nod moves it as gravity turns in the head's frame.
-// - The pseudo-force field (§3.2.2) scales the departure force, not gravity: near the head (headShape), a
-//   departure pointing into it (D·F < α|D||F|, D the head's gradient) is multiplied by ε.
+// - Rest: the guides were styled under gravity, which the equations alone do not hold. Gravity acts whole
+//   on the moving hair, its torque following the segment; the styled shape is held by the styling load,
+//   the rest pose's gravity across each segment carried with it as a constant torque in its own frame,
+//   and an angular spring −ω_i²ψ toward the rest direction (RestFrequency; auto: the stiffness the
+//   hanging elastica of the hair's EI gives each place, anjyo_dynamics.cpp's restSpring). Still hair (a
+//   still head, no wind) therefore stays exactly at rest; wind, a turn of the head and a nod move it, and
+//   gravity pulls it back.
+// - The pseudo-force field (§3.2.2) scales the field's departure from the rest's gravity: near the head
+//   (headShape), a departure pointing into it (D·F < α|D||F|, D the head's gradient) is multiplied by ε.
 // - Joint limits and collisions are measured against the rest shape: a node may turn as much as it did at
 //   rest, and sink as deep into a shape as it sat at rest, so the styled shape is always allowed.
 // - Precision: everything is floats, the precision the caches store, sixteen strands at a time
-//   (anjyo_kernel.inc). The recurrences are velocity Verlet: each segment keeps its angles (within half
-//   a turn of 0) and its turn over the last substep, so the turn keeps its own precision. Positions are
+//   (anjyo_kernel.inc). The recurrences are velocity Verlet: each segment keeps its rotation (at most half
+//   a turn) and its turn over the last substep, so the turn keeps its own precision. Positions are
 //   kept relative to the centre of the rest hair's bounds, where a float resolves a tenth of a
 //   micrometre on a head.
 #pragma once
@@ -82,17 +85,17 @@ class AnjyoHair {
   // The same into `out`, reusing its arrays.
   void posedInto(const Pose& pose, Strands& out, Kernel kernel = Kernel::kFastest) const;
 
-  // What a restart needs, kStateValues floats per segment: θ and φ (within half a turn of 0), and their
-  // turn over the last substep (the velocity Verlet's; their sin and cos are computed from them by
-  // arithmetic alone, lane_trig.h, so a resumed run computes exactly what the unbroken one did). Laid
-  // out as the step reads it: a header of kStateHeader doubles (kStateTag, kLanes, kStateValues, then
-  // zeros), then per block of kLanes strands, per segment, per value, the block's lanes as floats, two
-  // to a double (a lane past its strand's end holds the rest state, zeros). The hair keeps its state in
-  // this layout, so `swapState` lends it to a frame's cache without a copy: swap it out, write the
-  // cache, swap it back (stepping in between is an error).
-  // (The layout and its bounds are declared once, in libcore/io/restart_state.h.)
+  // What a restart needs, kStateValues floats per segment: its rotation vector from rest (a, b), and its
+  // turn over the last substep in the carried frame (the velocity Verlet's; the trigonometry of the
+  // rotation is computed from them by arithmetic alone, anjyo_kernel.inc, so a resumed run computes exactly
+  // what the unbroken one did). Laid out as the step reads it: a header of kStateHeader doubles (kStateTag,
+  // kLanes, kStateValues, then zeros), then per block of kLanes strands, per segment, per value, the block's
+  // lanes as floats, two to a double (a lane past its strand's end holds the rest state, zeros). The hair
+  // keeps its state in this layout, so `swapState` lends it to a frame's cache without a copy: swap it out,
+  // write the cache, swap it back (stepping in between is an error). (The layout and its bounds are declared
+  // once, in libcore/io/restart_state.h.)
   static constexpr size_t kStateValues = kAnjyoStateValues, kStateHeader = kAnjyoStateHeader;
-  static constexpr double kStateTag = kAnjyoStateTag;  // "ANJ5": a state of this layout
+  static constexpr double kStateTag = kAnjyoStateTag;  // "ANJ6": a state of this layout
   static constexpr double kMaxAngle = kMaxAnjyoAngle;  // radians: the most an angle of a state may be
   static constexpr double kMaxTurn = kMaxAnjyoTurn;    // radians: the most its turn in a substep may be
   std::vector<double> state() const { return state_; }
@@ -110,8 +113,8 @@ class AnjyoHair {
     double value = 0.0;
   };
   std::optional<Fault> fault() const;
-  // One segment's values (θ, φ, and their turns over the last substep), and setting them: segment j < the
-  // strand's segments, strand < the guides'.
+  // One segment's values (a, b, and the turn over the last substep along the carried pole and side), and
+  // setting them: segment j < the strand's segments, strand < the guides'.
   std::array<double, kStateValues> segmentState(size_t strand, uint32_t j) const;
   void setSegmentState(size_t strand, uint32_t j, const std::array<double, kStateValues>& values);
 
@@ -124,12 +127,14 @@ class AnjyoHair {
 
  private:
   // Segment j of a block of kLanes consecutive strands, lane by lane (a lane past its strand's last
-  // segment holds zeros): its frame (README, Dynamics: `rest` its rest direction, `pole` perpendicular
-  // to it, `side` = pole × rest), d_i, c_i u_i m_i (1/m), ω² / c_i (the rest spring as an acceleration),
-  // and the turn allowed at the node before it (cos −2 where there is no limit).
+  // segment holds zeros): its frame (`rest` its rest direction, `pole` perpendicular to it, `side` =
+  // pole × rest), d_i, c_i u_i m_i (1/m), the rest spring's ω_i² (1/s²), the rest's gravity along pole
+  // and side (m/s²: the styling load, a torque carried with the segment), and the turn allowed at the
+  // node before it (cos −2 where there is no limit).
   struct LaneSegment {
     float rest[3][kLanes], pole[3][kLanes], side[3][kLanes];
-    float length[kLanes], coefficient[kLanes], springOverC[kLanes], cosAllowed[kLanes], sinAllowed[kLanes];
+    float length[kLanes], coefficient[kLanes], spring[kLanes], restLoad[2][kLanes];
+    float cosAllowed[kLanes], sinAllowed[kLanes];
   };
   // Point j of a block's strands, lane by lane (a lane past its strand's last point repeats it): the
   // input point and tangent that posing starts from, and the rest node as the step computes it (relative
@@ -150,16 +155,17 @@ class AnjyoHair {
   // What a substep reads besides the hair: the field in floats (relative to origin_), the recurrences'
   // constants, and the fluctuations' key.
   struct StepParams {
-    float base[3], fieldBase[3], restAcceleration[3], omega[3], alpha[3], centre[3];
+    float fieldBase[3], restAcceleration[3], omega[3], alpha[3], centre[3];
     bool rotating = false, fluctuate = false;
     float keep = 1.0f, dt2 = 0.0f, invDt = 0.0f;
     uint64_t fluctuationBlock = 0;
   };
-  // What setup needs besides the hair: each strand's length (per strand), ω² of the rest spring, the
-  // joint limit, and the inertia's arrangement (Dynamics Info's Inertia).
+  // What setup needs besides the hair: each strand's length (per strand), the rest's gravity (m/s², head
+  // frame), the joint limit, and the inertia's arrangement (Dynamics Info's Inertia).
   struct SetupParams {
     const float* totals;
-    float omega2, cosLimit, sinLimit;
+    float restAcceleration[3];
+    float cosLimit, sinLimit;
     bool limited;  // a JointAngleLimit below 180°
     int jointFrom, rootSegments;
     float rootInertia, inertiaExponent;
@@ -183,12 +189,18 @@ class AnjyoHair {
     static void atan2(const float* y, const float* x, float* out, Kernel kernel);
     static constexpr uint64_t kFluctuationKey = 0x666c756374ull;  // "fluct": apart from every other stream
   };
-  enum StateValue { kTheta, kPhi, kThetaRate, kPhiRate };  // a segment's values in the state
-  // The sin and cos of a segment's current angles, as the step computed them (lane_trig.h), kept beside
-  // the state so that a step computes them once: per block, per segment, per value, the block's lanes.
+  // A segment's values in the state: its rotation vector from the rest direction, (a, b) along pole
+  // and side, and its turn over the last substep in the frame carried from the rest frame.
+  enum StateValue { kAngleA, kAngleB, kTurnA, kTurnB };
+  // Of ψ = |(a, b)|, as the step computed them (anjyo_kernel.inc's trigOf): cos ψ, sin ψ / ψ, (1 − cos ψ) /
+  // ψ² and ψ, kept beside the state so that a step computes them once: per block, per segment, per value, the
+  // lanes.
   static constexpr size_t kTrigValues = 4;
-  enum TrigValue { kSinTheta, kCosTheta, kSinPhi, kCosPhi };
+  enum TrigValue { kCosPsi, kSinc, kVersine, kPsi };
 
+  // Each segment's rest spring (README, Dynamics: RestFrequency, or auto), after setup; `totals` per
+  // strand, its length.
+  void setSprings(const Hairstyle& style, const Dynamics& dynamics, const std::vector<float>& totals);
   bool fluctuates(int frame, bool firstSubstep) const;  // whether this substep draws the fluctuations
   void requireState() const;  // throws std::logic_error while the state is lent out (swapState)
   StepParams paramsOf(const AccelerationField& field, double dt, int frame, bool firstSubstep) const;

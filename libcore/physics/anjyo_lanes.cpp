@@ -6,7 +6,6 @@
 
 #include "libcore/physics/anjyo_dynamics.h"
 #include "libcore/physics/float_lanes.h"
-#include "libcore/physics/lane_trig.h"
 #include "libcore/util/random.h"
 
 namespace hairgen {
