@@ -299,8 +299,9 @@ double SpringHair::maxStretch() const {
 }
 
 void SpringHair::factor(double dt) {
-  // Per strand, over its free points 1..n: A = M(1 + cΔt) + Δt² Σ_j k_j B_jᵀ B_j, pentadiagonal, where
-  // row j of B (joint j) has 1/l_{j+1} at point j + 1, −1/l_{j+1} − 1/l_j at j and 1/l_j at j − 1.
+  // Per strand, over its free points 1..n: A = M(1 + cΔt/2) + kAhead Δt² K, K = Σ_j k_j B_jᵀ B_j + the
+  // rest tension's stiffness, pentadiagonal, where row j of B (joint j) has 1/l_{j+1} at point j + 1,
+  // −1/l_{j+1} − 1/l_j at j and 1/l_j at j − 1.
   dt_ = dt;
   const size_t points = x_.size();
   inverseD_.assign(points, 0.0);
@@ -311,8 +312,20 @@ void SpringHair::factor(double dt) {
     if (count < 2) return;
     const uint32_t n = count - 1;
     std::vector<double> diag(n + 1, 0.0), off1(n + 1, 0.0), off2(n + 1, 0.0);  // (i,i), (i,i+1), (i,i+2)
-    for (uint32_t i = 1; i <= n; ++i) diag[i] = mass_[p0 + i] * (1.0 + damping_ * dt);
-    const double dt2 = dt * dt;
+    for (uint32_t i = 1; i <= n; ++i) diag[i] = mass_[p0 + i] * (1.0 + 0.5 * damping_ * dt);
+    // kAhead Δt² (¼ would be the trapezoidal rule): stable at any step for the linear forces it carries.
+    const double dt2 = kAhead * dt * dt;
+    // The rest tension's force −T_j e_j / l_j is linear in the points too: stiffness T_j / l_j between
+    // the segment's two ends (the root drops out). Implicit, so a long hanging chain's fast string modes
+    // (ω up to 2n √(g/L)) stay stable at any substep.
+    for (uint32_t j = 1; j <= n; ++j) {
+      const double w = dt2 * (restTension_[p0 + j] / length_[p0 + j]);
+      diag[j] += w;
+      if (j >= 2) {
+        diag[j - 1] += w;
+        off1[j - 1] -= w;
+      }
+    }
     for (uint32_t j = 0; j < n; ++j) {
       // Coefficients of joint j on points j − 1, j, j + 1 (point 0 is fixed and drops out).
       const double lNext = length_[p0 + j + 1], lThis = j > 0 ? length_[p0 + j] : 0.0;
@@ -532,15 +545,21 @@ void SpringHair::predict(size_t s, const AccelerationField& field, double dt, gl
   thread_local std::vector<double> inverseLength;
   unit.resize(n + 2);
   inverseLength.resize(n + 2);
+  // The linear forces (bending, rest tension) at y = x − kBehind Δt v: f(y) = f(x) + kBehind Δt K v, so
+  // the right-hand side M v + Δt f(x) + kBehind Δt² K v takes one evaluation.
   unit[0] = rootDirection_[s];
   inverseLength[n + 1] = 0.0;
+  const double back = kBehind * dt;
   for (uint32_t j = 1; j <= n; ++j) {
     inverseLength[j] = 1.0 / length_[p0 + j];
-    unit[j] = (x_[p0 + j] - x_[p0 + j - 1]) * inverseLength[j];
+    const glm::dvec3 e =
+        (x_[p0 + j] - x_[p0 + j - 1]) - back * (v_[p0 + j] - (j > 1 ? v_[p0 + j - 1] : glm::dvec3(0.0)));
+    unit[j] = e * inverseLength[j];
   }
   unit[n + 1] = glm::dvec3(0.0);
   for (uint32_t j = 0; j < n; ++j) turn[j] = bend_[p0 + j] * (target_[p0 + j] - (unit[j + 1] - unit[j]));
   turn[n] = turn[n + 1] = glm::dvec3(0.0);  // no joint at the tip
+  const double keep = 1.0 - 0.5 * damping_ * dt;
   for (uint32_t i = 1; i <= n; ++i) {
     const uint32_t p = p0 + i;
     // Row i of Bᵀ: joints i − 1, i and i + 1 (turn[n] is 0, and 1/l_{n+1} is 0).
@@ -561,9 +580,10 @@ void SpringHair::predict(size_t s, const AccelerationField& field, double dt, gl
       if (size > 1.0) push /= size;
       f += mass_[p] * densityStrength_ * push;
     }
-    force[i] = mass_[p] * v_[p] + dt * f;
+    force[i] = (mass_[p] * keep) * v_[p] + dt * f;
   }
-  // Backward Euler for the bending (and damping): A v⁺ = M v + Δt f, A = L D Lᵀ.
+  // The linear forces at x + kAhead Δt v⁺ − kBehind Δt v, the damping at the mean of v and v⁺:
+  // A v⁺ = M (1 − cΔt/2) v + Δt f(y), A = M (1 + cΔt/2) + kAhead Δt² K = L D Lᵀ.
   for (uint32_t i = 1; i <= n; ++i) {
     const uint32_t p = p0 + i;
     if (i >= 2) force[i] -= lower1_[p] * force[i - 1];

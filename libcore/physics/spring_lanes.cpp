@@ -187,9 +187,11 @@ void SpringHair::projectStretchLanes(size_t block, const size_t* strands, size_t
     for (uint32_t j = 1; j <= n; ++j) setLane(v[j], l, hair.v_[b.p0[l] + j]);
   }
   inverseLength[n + 1] = splat(0.0);
+  v[0] = splat(glm::dvec3(0.0));  // the root's (predict reads none)
+  const Vd back = splat(kBehind * dt);
   for (uint32_t j = 1; j <= n; ++j) {
     inverseLength[j] = 1.0 / b.length[j];
-    unit[j] = inverseLength[j] * (b.x[j] - b.x[j - 1]);
+    unit[j] = inverseLength[j] * ((b.x[j] - b.x[j - 1]) - back * (v[j] - v[j - 1]));
   }
   unit[n + 1] = splat(glm::dvec3(0.0));
   for (uint32_t j = 0; j < n; ++j)
@@ -197,6 +199,7 @@ void SpringHair::projectStretchLanes(size_t block, const size_t* strands, size_t
   turn[n] = turn[n + 1] = splat(glm::dvec3(0.0));
   const V3 base = splat(field.base), centre = splat(field.centre), alpha = splat(field.alpha),
            omega = splat(field.omega);
+  const Vd keep = splat(1.0 - 0.5 * hair.damping_ * dt);
   for (uint32_t i = 1; i <= n; ++i) {
     V3 f = inverseLength[i] * turn[i - 1] + inverseLength[i + 1] * turn[i + 1] -
            (inverseLength[i] + inverseLength[i + 1]) * turn[i];
@@ -209,7 +212,7 @@ void SpringHair::projectStretchLanes(size_t block, const size_t* strands, size_t
     }
     const Vd mass = load(at[i].mass);
     f = f + mass * a;
-    force[i] = mass * v[i] + splat(dt) * f;
+    force[i] = (mass * keep) * v[i] + splat(dt) * f;
   }
   for (uint32_t i = 1; i <= n; ++i) {
     if (i >= 2) force[i] = force[i] - load(at[i].lower1) * force[i - 1];
