@@ -331,7 +331,8 @@ void SimulateAnjyo(benchmark::State& state) {
   config.dynamics.given = true;
   config.dynamics.firstFrame = 1;
   config.dynamics.lastFrame = 25;
-  config.dynamics.wind = {{1, {-14.0, 0.0, 0.0}, false, {}}, {16, {-1.4, -17.6, 0.0}, false, {}}};
+  config.dynamics.wind = {{1, {-15.6, 0.0, 0.0}, false, {}},
+                          {16, {-1.56, -19.6, 0.0}, false, {}}};  // the gust's
   HeadKey still, turned;
   still.frame = 1;
   turned.frame = 25;
