@@ -79,6 +79,46 @@ UsdWritten convertToShot(const ConvertOptions& o, const FrameRange& frames, Stat
   return written;
 }
 
+// --frames with #### in IN and OUT: each frame converted on its own; what was written, for the note.
+std::string convertFrames(const ConvertOptions& o, const FrameRange& frames, Stats& stats,
+                          WriteReport& report) {
+  Stopwatch clock;
+  requirePattern(o.input, "IN");
+  requirePattern(o.output, "OUT");
+  requireFrames(o.input, frames);
+  requireWritableOutput(framePath(o.output, frames.first));
+  Progress progress("convert", "frames", size_t(frames.count()), !o.common.quiet);
+  // No keepCommittedOutputs: a frame that fails removes the frames written before it.
+  for (int f = frames.first; f <= frames.last; ++f) {
+    const Strands strands = readForConvert(framePath(o.input, f).string(), o.units);
+    stats.add("read", clock.lap());
+    report.droppedStrands +=
+        writeStrands(framePath(o.output, f), strands, WriteOptions{o.ascii}).droppedStrands;
+    stats.add("write", clock.lap());
+    progress.advance();
+  }
+  progress.finish();
+  stats.counts()["frames"] = frames.count();
+  return std::to_string(frames.count()) + " frames";
+}
+
+// The output named once, its format known and the flags fitting it, before anything is read. Returns the
+// output's format.
+HairFormat checkOptions(ConvertOptions& o) {
+  if (!o.outputFlag.empty() && !o.output.empty()) throw InputError("give the output once, as OUT or as -o");
+  if (o.output.empty()) o.output = o.outputFlag;
+  if (o.output.empty()) throw InputError("convert needs an output: hairgen convert IN OUT (or -o OUT)");
+  const HairFormat format = hairFormatOf(o.output);  // a bad extension before reading anything
+  if (o.ascii && format != HairFormat::kPly)
+    throw InputError("--ascii is for a .ply output; " + o.output + " is " + describe(format));
+  const bool sequence = !o.frames.empty();
+  const bool stage = sequence && format == HairFormat::kUsda && !isFramePattern(o.output);
+  if (!o.guides.empty() && !stage)
+    throw InputError("--guides is for one animated stage: --frames A-B and an OUT .usda without ####");
+  if (o.fps > 0.0 && !stage) throw InputError("--fps is for one animated stage: --frames A-B and a .usda");
+  return format;
+}
+
 }  // namespace
 
 void registerConvert(CLI::App& app, int& exitCode) {
@@ -112,19 +152,9 @@ void registerConvert(CLI::App& app, int& exitCode) {
     exitCode = runCommand("convert", options->common, [&] {
       Stats stats("convert");
       ConvertOptions& o = *options;
-      if (!o.outputFlag.empty() && !o.output.empty())
-        throw InputError("give the output once, as OUT or as -o");
-      if (o.output.empty()) o.output = o.outputFlag;
-      if (o.output.empty()) throw InputError("convert needs an output: hairgen convert IN OUT (or -o OUT)");
-      const HairFormat format = hairFormatOf(o.output);  // a bad extension before reading anything
-      if (o.ascii && format != HairFormat::kPly)
-        throw InputError("--ascii is for a .ply output; " + o.output + " is " + describe(format));
+      const HairFormat format = checkOptions(o);
       const bool sequence = !o.frames.empty();
       const bool stage = sequence && format == HairFormat::kUsda && !isFramePattern(o.output);
-      if (!o.guides.empty() && !stage)
-        throw InputError("--guides is for one animated stage: --frames A-B and an OUT .usda without ####");
-      if (o.fps > 0.0 && !stage)
-        throw InputError("--fps is for one animated stage: --frames A-B and a .usda");
       const FrameRange frames = sequence ? parseFrameRange(o.frames, "--frames") : FrameRange{0, 0};
       Stopwatch clock;
       WriteReport report;
@@ -135,23 +165,7 @@ void registerConvert(CLI::App& app, int& exitCode) {
         stats.time("convert", clock.lap());
         what = "frames " + std::to_string(frames.first) + "-" + std::to_string(frames.last) + " as one stage";
       } else if (sequence) {
-        requirePattern(o.input, "IN");
-        requirePattern(o.output, "OUT");
-        requireFrames(o.input, frames);
-        requireWritableOutput(framePath(o.output, frames.first));
-        Progress progress("convert", "frames", size_t(frames.count()), !o.common.quiet);
-        // No keepCommittedOutputs: a frame that fails removes the frames written before it.
-        for (int f = frames.first; f <= frames.last; ++f) {
-          const Strands strands = readForConvert(framePath(o.input, f).string(), o.units);
-          stats.add("read", clock.lap());
-          report.droppedStrands +=
-              writeStrands(framePath(o.output, f), strands, WriteOptions{o.ascii}).droppedStrands;
-          stats.add("write", clock.lap());
-          progress.advance();
-        }
-        progress.finish();
-        stats.counts()["frames"] = frames.count();
-        what = std::to_string(frames.count()) + " frames";
+        what = convertFrames(o, frames, stats, report);
       } else {
         const Strands strands = readForConvert(o.input, o.units);
         stats.time("read", clock.lap());

@@ -44,12 +44,109 @@ ShadeResult shadeStage(const CommonOptions& common, const Config& config, Strand
   return result;
 }
 
+namespace {
+
+struct Options {
+  CommonOptions common;
+  std::string first, hair, rest, output, vdb, frames;
+  UnitOptions units;
+};
+
+// --rest: the rest coupe's normals carried onto a deformed coupe, or onto every frame of a sequence.
+void reposeCoupes(const Options& o, Stats& stats) {
+  Stopwatch clock;
+  if (!o.vdb.empty()) throw InputError("--vdb needs a volume, which --rest does not build");
+  if (!o.hair.empty() && !o.first.empty())
+    throw InputError("with --rest no Setup is read: give the deformed coupe once, as --hair or on its own");
+  const std::string& coupeFile = o.hair.empty() ? o.first : o.hair;
+  if (coupeFile.empty())
+    throw InputError("--rest needs the deformed coupe: hairgen shade --rest REST COUPE -o OUT");
+  const Strands rest = readStrandsAs(o.rest, o.units);
+  // One coupe, or every frame of a sequence (--frames): the rest's normals on each.
+  const bool sequence = !o.frames.empty();
+  const FrameRange frames = sequence ? parseFrameRange(o.frames, "--frames") : FrameRange{0, 0};
+  if (sequence)
+    for (const std::string* pattern : {&coupeFile, static_cast<const std::string*>(&o.output)})
+      if (!isFramePattern(*pattern))
+        throw InputError(*pattern + ": with --frames, write #### where the frame number goes");
+  if (sequence) requireWritableOutput(framePath(o.output, frames.first));
+  Progress progress("shade", "frames", size_t(frames.count()), sequence && !o.common.quiet);
+  for (int f = frames.first; f <= frames.last; ++f) {
+    const std::string in = sequence ? framePath(coupeFile, f).string() : coupeFile;
+    const std::string written = sequence ? framePath(o.output, f).string() : o.output;
+    const Strands deformed = readStrandsAs(in, o.units);
+    stats.add("read", clock.lap());
+    // What repose refuses is this frame's: its file goes in the message.
+    const Strands out = namingFile(in, [&] { return repose(rest, deformed); });
+    stats.add("repose", clock.lap());
+    stats.counts()["strands"] = out.strandCount();
+    stats.counts()["points"] = out.pointCount();
+    warnDropped("shade", written, writeStrands(written, out));
+    stats.add("write", clock.lap());
+    if (!sequence) continue;
+    keepCommittedOutputs();  // a finished frame stays, whatever a later one does
+    progress.advance();
+  }
+  progress.finish();
+  note(o.common, "shade: re-posed the normals of " + o.rest + " onto " +
+                     (sequence ? std::to_string(frames.count()) + " frames" : coupeFile) + "; wrote " +
+                     o.output);
+}
+
+// The volume's normals (and Anjyo's ambient) on a coupe, or on every frame of a sequence, each with its
+// own volume; --vdb writes the volume too.
+void shadeCoupes(const Options& o, Stats& stats) {
+  Stopwatch clock;
+  if (o.first.empty() || o.hair.empty())
+    throw InputError("shade needs a Setup and a coupe: hairgen shade SETUP --hair COUPE -o OUT");
+  if (!o.vdb.empty() && !toLower(o.vdb).ends_with(".vdb"))
+    throw InputError("--vdb " + o.vdb + ": the volume file must end in .vdb");
+  // One coupe, or every frame of a sequence (--frames), each with its own volume.
+  const bool sequence = !o.frames.empty();
+  const FrameRange frames = sequence ? parseFrameRange(o.frames, "--frames") : FrameRange{0, 0};
+  if (sequence) {
+    for (const std::string* pattern : {&o.hair, &o.output})
+      if (!isFramePattern(*pattern))
+        throw InputError(*pattern + ": with --frames, write #### where the frame number goes");
+    if (!o.vdb.empty() && !isFramePattern(o.vdb))
+      throw InputError("--vdb " + o.vdb +
+                       ": with --frames, each frame has its volume: write #### where the frame number goes");
+    requireWritableOutput(framePath(o.output, frames.first));
+  }
+  Config config = loadStageConfig(o.first, o.common, SetupUse::kRender, stats);
+  Progress progress("shade", "frames", size_t(frames.count()), sequence && !o.common.quiet);
+  for (int f = frames.first; f <= frames.last; ++f) {
+    auto frameOf = [&](const std::string& name) {
+      return name.empty() || !sequence ? name : framePath(name, f).string();
+    };
+    const std::string hair = frameOf(o.hair), output = frameOf(o.output), vdb = frameOf(o.vdb);
+    Strands coupe = readStrandsAs(hair, o.units);
+    stats.add("read", clock.lap());
+    ShadeResult shaded;
+    try {
+      shaded = shadeStage(o.common, config, std::move(coupe), stats, !vdb.empty());
+    } catch (const InputError& e) {  // what is wrong with the coupe, said of its file
+      if (!e.where().file.empty()) throw;
+      throw InputError({hair, 0}, e.message());
+    }
+    clock.lap();
+    // The volume first: if the coupe then cannot be written, runCommand removes the volume (no
+    // partial output).
+    if (!vdb.empty()) writeVdb(vdb, shaded.volume);
+    warnDropped("shade", output, writeStrands(output, shaded.coupe));
+    stats.add("write", clock.lap());
+    if (!sequence) continue;
+    keepCommittedOutputs();  // a finished frame stays, whatever a later one does
+    progress.advance();
+  }
+  progress.finish();
+  note(o.common, "shade: wrote " + (sequence ? std::to_string(frames.count()) + " frames " : std::string()) +
+                     o.output + (o.vdb.empty() ? "" : " and " + o.vdb));
+}
+
+}  // namespace
+
 void registerShade(CLI::App& app, int& exitCode) {
-  struct Options {
-    CommonOptions common;
-    std::string first, hair, rest, output, vdb, frames;
-    UnitOptions units;
-  };
   auto options = std::make_shared<Options>();
   CLI::App* cmd = app.add_subcommand(
       "shade",
@@ -84,96 +181,10 @@ void registerShade(CLI::App& app, int& exitCode) {
       Stats stats("shade");
       hairFormatOf(options->output);
       if (!isFramePattern(options->output)) requireWritableOutput(options->output);
-      Stopwatch clock;
-      if (!options->rest.empty()) {
-        if (!options->vdb.empty()) throw InputError("--vdb needs a volume, which --rest does not build");
-        if (!options->hair.empty() && !options->first.empty())
-          throw InputError(
-              "with --rest no Setup is read: give the deformed coupe once, as --hair or on its own");
-        const std::string& coupeFile = options->hair.empty() ? options->first : options->hair;
-        if (coupeFile.empty())
-          throw InputError("--rest needs the deformed coupe: hairgen shade --rest REST COUPE -o OUT");
-        const Strands rest = readStrandsAs(options->rest, options->units);
-        // One coupe, or every frame of a sequence (--frames): the rest's normals on each.
-        const bool sequence = !options->frames.empty();
-        const FrameRange frames = sequence ? parseFrameRange(options->frames, "--frames") : FrameRange{0, 0};
-        if (sequence)
-          for (const std::string* pattern : {&coupeFile, static_cast<const std::string*>(&options->output)})
-            if (!isFramePattern(*pattern))
-              throw InputError(*pattern + ": with --frames, write #### where the frame number goes");
-        if (sequence) requireWritableOutput(framePath(options->output, frames.first));
-        Progress progress("shade", "frames", size_t(frames.count()), sequence && !options->common.quiet);
-        for (int f = frames.first; f <= frames.last; ++f) {
-          const std::string in = sequence ? framePath(coupeFile, f).string() : coupeFile;
-          const std::string written = sequence ? framePath(options->output, f).string() : options->output;
-          const Strands deformed = readStrandsAs(in, options->units);
-          stats.add("read", clock.lap());
-          // What repose refuses is this frame's: its file goes in the message.
-          const Strands out = namingFile(in, [&] { return repose(rest, deformed); });
-          stats.add("repose", clock.lap());
-          stats.counts()["strands"] = out.strandCount();
-          stats.counts()["points"] = out.pointCount();
-          warnDropped("shade", written, writeStrands(written, out));
-          stats.add("write", clock.lap());
-          if (!sequence) continue;
-          keepCommittedOutputs();  // a finished frame stays, whatever a later one does
-          progress.advance();
-        }
-        progress.finish();
-        note(options->common, "shade: re-posed the normals of " + options->rest + " onto " +
-                                  (sequence ? std::to_string(frames.count()) + " frames" : coupeFile) +
-                                  "; wrote " + options->output);
-        stats.write(options->common);
-        return;
-      }
-      if (options->first.empty() || options->hair.empty())
-        throw InputError("shade needs a Setup and a coupe: hairgen shade SETUP --hair COUPE -o OUT");
-      if (!options->vdb.empty() && !toLower(options->vdb).ends_with(".vdb"))
-        throw InputError("--vdb " + options->vdb + ": the volume file must end in .vdb");
-      // One coupe, or every frame of a sequence (--frames), each with its own volume.
-      const bool sequence = !options->frames.empty();
-      const FrameRange frames = sequence ? parseFrameRange(options->frames, "--frames") : FrameRange{0, 0};
-      if (sequence) {
-        for (const std::string* pattern : {&options->hair, &options->output})
-          if (!isFramePattern(*pattern))
-            throw InputError(*pattern + ": with --frames, write #### where the frame number goes");
-        if (!options->vdb.empty() && !isFramePattern(options->vdb))
-          throw InputError(
-              "--vdb " + options->vdb +
-              ": with --frames, each frame has its volume: write #### where the frame number goes");
-        requireWritableOutput(framePath(options->output, frames.first));
-      }
-      Config config = loadStageConfig(options->first, options->common, SetupUse::kRender, stats);
-      Progress progress("shade", "frames", size_t(frames.count()), sequence && !options->common.quiet);
-      for (int f = frames.first; f <= frames.last; ++f) {
-        auto frameOf = [&](const std::string& name) {
-          return name.empty() || !sequence ? name : framePath(name, f).string();
-        };
-        const std::string hair = frameOf(options->hair), output = frameOf(options->output),
-                          vdb = frameOf(options->vdb);
-        Strands coupe = readStrandsAs(hair, options->units);
-        stats.add("read", clock.lap());
-        ShadeResult shaded;
-        try {
-          shaded = shadeStage(options->common, config, std::move(coupe), stats, !vdb.empty());
-        } catch (const InputError& e) {  // what is wrong with the coupe, said of its file
-          if (!e.where().file.empty()) throw;
-          throw InputError({hair, 0}, e.message());
-        }
-        clock.lap();
-        // The volume first: if the coupe then cannot be written, runCommand removes the volume (no
-        // partial output).
-        if (!vdb.empty()) writeVdb(vdb, shaded.volume);
-        warnDropped("shade", output, writeStrands(output, shaded.coupe));
-        stats.add("write", clock.lap());
-        if (!sequence) continue;
-        keepCommittedOutputs();  // a finished frame stays, whatever a later one does
-        progress.advance();
-      }
-      progress.finish();
-      note(options->common, "shade: wrote " +
-                                (sequence ? std::to_string(frames.count()) + " frames " : std::string()) +
-                                options->output + (options->vdb.empty() ? "" : " and " + options->vdb));
+      if (!options->rest.empty())
+        reposeCoupes(*options, stats);
+      else
+        shadeCoupes(*options, stats);
       stats.write(options->common);
     });
   });
