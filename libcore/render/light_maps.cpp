@@ -3,10 +3,8 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
-#include <vector>
 
 #include <tbb/blocked_range.h>
-#include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
 
 namespace hairgen {
@@ -245,36 +243,27 @@ HairLightMaps rasteriseLightMaps(const Strands& hair, const View& light, double 
     cumulative += layerSizes[k];
     ends[k] = std::llround(cumulative / kDepthUnit);
   }
-  // Each band by one thread: its segments drawn once into the thread's list of fragments, from which
-  // first where the hair begins in its rows, then the layers' sums (the same fragments in the same order
-  // as drawing twice, at half the cost; a list holds one band's fragments, so it stays small).
-  struct Fragment {
-    uint32_t texel;
-    int32_t depth;
-    uint32_t coverage;
-  };
-  tbb::enumerable_thread_specific<std::vector<Fragment>> fragmentLists;
+  // Each band by one thread: first where the hair begins in its rows, then the layers' sums.
   tbb::parallel_for(0, bands, [&](int band) {
     const int64_t rowLo = int64_t(band) * kBandRows, rowHi = std::min<int64_t>(size, rowLo + kBandRows);
-    std::vector<Fragment>& fragments = fragmentLists.local();
-    fragments.clear();
-    for (size_t k = bandFirst[band]; k < bandFirst[band + 1]; ++k) {
-      const uint32_t first = segments[bandSegments[k]];
-      rasteriseSegment(vertices[first], vertices[first + 1], rowLo, rowHi,
-                       [&](int64_t i, int64_t j, int32_t depth, uint32_t coverage) {
-                         if (coverage == 0 || j < rowLo || j >= rowHi || i < 0 || i >= size) return;
-                         const uint32_t t = uint32_t(size_t(j) * size + size_t(i));
-                         maps.start[t] = std::min(maps.start[t], depth);
-                         fragments.push_back({t, depth, coverage});
-                       });
-    }
-    for (const Fragment& f : fragments) {
-      const int64_t behind = int64_t(f.depth) - maps.start[f.texel];
-      glm::uvec4& sum = maps.layers[f.texel];
+    auto eachFragment = [&](auto&& texel) {
+      for (size_t k = bandFirst[band]; k < bandFirst[band + 1]; ++k) {
+        const uint32_t first = segments[bandSegments[k]];
+        rasteriseSegment(vertices[first], vertices[first + 1], rowLo, rowHi,
+                         [&](int64_t i, int64_t j, int32_t depth, uint32_t coverage) {
+                           if (coverage == 0 || j < rowLo || j >= rowHi || i < 0 || i >= size) return;
+                           texel(size_t(j) * size + size_t(i), depth, coverage);
+                         });
+      }
+    };
+    eachFragment([&](size_t t, int32_t depth, uint32_t) { maps.start[t] = std::min(maps.start[t], depth); });
+    eachFragment([&](size_t t, int32_t depth, uint32_t coverage) {
+      const int64_t behind = int64_t(depth) - maps.start[t];
+      glm::uvec4& sum = maps.layers[t];
       for (int k = 0; k < 3; ++k)
-        if (behind < ends[k]) sum[k] += f.coverage;
-      sum[3] += f.coverage;
-    }
+        if (behind < ends[k]) sum[k] += coverage;
+      sum[3] += coverage;
+    });
   });
   return maps;
 }
