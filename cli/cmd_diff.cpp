@@ -43,7 +43,7 @@ void printReport(const std::string& a, const std::string& b, const HairDiff& d) 
   if (d.colorsCompared) std::cout << "  colours: max " << number(d.maxColor) << "\n";
 }
 
-struct Options {
+struct DiffArgs {
   CommonOptions common;
   std::string a, b, out, sheet;
   DiffThresholds thresholds;
@@ -53,7 +53,7 @@ struct Options {
 };
 
 // Either two hair caches or two images; a flag of the other kind is a usage error.
-bool comparesCaches(const Options& options) {
+bool comparesCaches(const DiffArgs& options) {
   const bool a = hairFormatFor(options.a).has_value(), b = hairFormatFor(options.b).has_value();
   if (a != b)
     throw InputError((a ? options.a : options.b) + " is a hair cache and " + (a ? options.b : options.a) +
@@ -65,7 +65,7 @@ bool comparesCaches(const Options& options) {
   return a;
 }
 
-ExitCode compareCaches(const Options& options, Stats& stats) {
+ExitCode compareCaches(const DiffArgs& options, Stats& stats) {
   const Strands a = readStrands(options.a), b = readStrands(options.b);
   const HairDiff d = diffHair(a, b, options.tolerances);
   if (!options.common.quiet) printReport(options.a, options.b, d);
@@ -75,7 +75,7 @@ ExitCode compareCaches(const Options& options, Stats& stats) {
   return d.code;
 }
 
-ExitCode compareImages(const Options& options, Stats& stats) {
+ExitCode compareImages(const DiffArgs& options, Stats& stats) {
   const Image a = readImage(options.a), b = readImage(options.b);
   const ImageDiff d = diffImages(a, b, options.channels, options.thresholds, options.a);
   if (!options.common.quiet && !d.channels.empty()) printReport(options.a, options.b, d, options.thresholds);
@@ -91,7 +91,7 @@ ExitCode compareImages(const Options& options, Stats& stats) {
 }  // namespace
 
 void registerDiff(CLI::App& app, int& exitCode) {
-  auto options = std::make_shared<Options>();
+  auto options = std::make_shared<DiffArgs>();
   CLI::App* cmd = app.add_subcommand(
       "diff",
       "Compare two images channel by channel (mean, RMS and max error, the worst pixel) or two hair caches "

@@ -15,14 +15,14 @@ namespace hairgen::cli {
 
 namespace {
 
-struct Options {
+struct InterpolateArgs {
   CommonOptions common;
   std::string setup, guides, output, frames, shard;
   UnitOptions units;
 };
 
 // --frames: every frame of a simulated sequence, each with the same strands, ids and weights.
-void interpolateSequence(const Options& o, const Config& config, const Mesh& wick, Stats& stats) {
+void interpolateSequence(const InterpolateArgs& o, const Config& config, const Mesh& wick, Stats& stats) {
   Stopwatch clock;
   const FrameRange frames = parseFrameRange(o.frames, "--frames");
   for (const std::string* pattern : {&o.guides, &o.output})
@@ -57,7 +57,7 @@ void interpolateSequence(const Options& o, const Config& config, const Mesh& wic
 }  // namespace
 
 void registerInterpolate(CLI::App& app, int& exitCode) {
-  auto options = std::make_shared<Options>();
+  auto options = std::make_shared<InterpolateArgs>();
   CLI::App* cmd = app.add_subcommand(
       "interpolate",
       "Fill every wick triangle with strands blended from its corner guides (clumping, stray hairs); with "

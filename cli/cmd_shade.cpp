@@ -46,14 +46,14 @@ ShadeResult shadeStage(const CommonOptions& common, const Config& config, Strand
 
 namespace {
 
-struct Options {
+struct ShadeArgs {
   CommonOptions common;
   std::string first, hair, rest, output, vdb, frames;
   UnitOptions units;
 };
 
 // --rest: the rest coupe's normals carried onto a deformed coupe, or onto every frame of a sequence.
-void reposeCoupes(const Options& o, Stats& stats) {
+void reposeCoupes(const ShadeArgs& o, Stats& stats) {
   Stopwatch clock;
   if (!o.vdb.empty()) throw InputError("--vdb needs a volume, which --rest does not build");
   if (!o.hair.empty() && !o.first.empty())
@@ -95,7 +95,7 @@ void reposeCoupes(const Options& o, Stats& stats) {
 
 // The volume's normals (and Anjyo's ambient) on a coupe, or on every frame of a sequence, each with its
 // own volume; --vdb writes the volume too.
-void shadeCoupes(const Options& o, Stats& stats) {
+void shadeCoupes(const ShadeArgs& o, Stats& stats) {
   Stopwatch clock;
   if (o.first.empty() || o.hair.empty())
     throw InputError("shade needs a Setup and a coupe: hairgen shade SETUP --hair COUPE -o OUT");
@@ -147,7 +147,7 @@ void shadeCoupes(const Options& o, Stats& stats) {
 }  // namespace
 
 void registerShade(CLI::App& app, int& exitCode) {
-  auto options = std::make_shared<Options>();
+  auto options = std::make_shared<ShadeArgs>();
   CLI::App* cmd = app.add_subcommand(
       "shade",
       "Shading attributes into the cache: volumetric normals from the hair's density grid and shell (Render "

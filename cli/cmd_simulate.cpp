@@ -14,7 +14,7 @@ namespace hairgen::cli {
 
 namespace {
 
-struct Options {
+struct SimulateArgs {
   CommonOptions common;
   std::string setup, guides, output, frames;
 };
@@ -27,7 +27,7 @@ struct Inputs {
   std::string restartName;
 };
 
-Inputs readInputs(const Options& o, const Dynamics& d, const FrameRange& frames) {
+Inputs readInputs(const SimulateArgs& o, const Dynamics& d, const FrameRange& frames) {
   Inputs in{readStrands(o.guides), {}, {}, {}};
   if (frames.first > d.firstFrame) {
     in.restartName = framePath(o.output, frames.first - 1).string();
@@ -41,7 +41,7 @@ Inputs readInputs(const Options& o, const Dynamics& d, const FrameRange& frames)
 }  // namespace
 
 void registerSimulate(CLI::App& app, int& exitCode) {
-  auto options = std::make_shared<Options>();
+  auto options = std::make_shared<SimulateArgs>();
   CLI::App* cmd = app.add_subcommand(
       "simulate",
       "Move the guides through time under the Setup's Dynamics Info (wind, head motion, gravity): one guide "
