@@ -22,39 +22,19 @@
 #include "libcore/io/obj_io.h"
 #include "libcore/model/shape_fit.h"
 #include "stages/preflight/scene.h"
+#include "tests/geometry_util.h"
 
 namespace fs = std::filesystem;
 using namespace hairgen;
 
 namespace {
 
-// The distance from p to triangle abc (Ericson, Real-Time Collision Detection §5.1.5).
-double pointTriangle(const glm::dvec3& p, const glm::dvec3& a, const glm::dvec3& b, const glm::dvec3& c) {
-  const glm::dvec3 ab = b - a, ac = c - a, ap = p - a;
-  const double d1 = glm::dot(ab, ap), d2 = glm::dot(ac, ap);
-  if (d1 <= 0 && d2 <= 0) return glm::length(p - a);
-  const glm::dvec3 bp = p - b;
-  const double d3 = glm::dot(ab, bp), d4 = glm::dot(ac, bp);
-  if (d3 >= 0 && d4 <= d3) return glm::length(p - b);
-  const double vc = d1 * d4 - d3 * d2;
-  if (vc <= 0 && d1 >= 0 && d3 <= 0) return glm::length(p - (a + d1 / (d1 - d3) * ab));
-  const glm::dvec3 cp = p - c;
-  const double d5 = glm::dot(ab, cp), d6 = glm::dot(ac, cp);
-  if (d6 >= 0 && d5 <= d6) return glm::length(p - c);
-  const double vb = d5 * d2 - d1 * d6;
-  if (vb <= 0 && d2 >= 0 && d6 <= 0) return glm::length(p - (a + d2 / (d2 - d6) * ac));
-  const double va = d3 * d6 - d5 * d4;
-  if (va <= 0 && (d4 - d3) >= 0 && (d5 - d6) >= 0)
-    return glm::length(p - (b + (d4 - d3) / ((d4 - d3) + (d5 - d6)) * (c - b)));
-  const double denom = 1.0 / (va + vb + vc);
-  return glm::length(p - (a + ab * (vb * denom) + ac * (vc * denom)));
-}
-
 double distanceToMesh(const glm::dvec3& p, const Mesh& m) {
   double best = HUGE_VAL;
   for (const glm::uvec3& t : m.triangles)
-    best = std::min(best, pointTriangle(p, glm::dvec3(m.positions[t.x]), glm::dvec3(m.positions[t.y]),
-                                        glm::dvec3(m.positions[t.z])));
+    best =
+        std::min(best, test::distanceToTriangle(p, glm::dvec3(m.positions[t.x]), glm::dvec3(m.positions[t.y]),
+                                                glm::dvec3(m.positions[t.z])));
   return best;
 }
 

@@ -21,6 +21,7 @@
 #include "libcore/io/hair_cache.h"
 #include "libcore/io/obj_io.h"
 #include "libcore/util/error.h"
+#include "tests/geometry_util.h"
 
 namespace hairgen {
 namespace {
@@ -44,29 +45,6 @@ std::string number(double v) {
   return text;
 }
 
-// Distance from p to triangle abc (Ericson, Real-Time Collision Detection §5.1.5, by regions).
-double distanceToTriangle(const glm::dvec3& p, const glm::dvec3& a, const glm::dvec3& b,
-                          const glm::dvec3& c) {
-  const glm::dvec3 ab = b - a, ac = c - a, ap = p - a;
-  const double d1 = glm::dot(ab, ap), d2 = glm::dot(ac, ap);
-  if (d1 <= 0 && d2 <= 0) return glm::length(p - a);
-  const glm::dvec3 bp = p - b;
-  const double d3 = glm::dot(ab, bp), d4 = glm::dot(ac, bp);
-  if (d3 >= 0 && d4 <= d3) return glm::length(p - b);
-  const double vc = d1 * d4 - d3 * d2;
-  if (vc <= 0 && d1 >= 0 && d3 <= 0) return glm::length(p - (a + ab * (d1 / (d1 - d3))));
-  const glm::dvec3 cp = p - c;
-  const double d5 = glm::dot(ab, cp), d6 = glm::dot(ac, cp);
-  if (d6 >= 0 && d5 <= d6) return glm::length(p - c);
-  const double vb = d5 * d2 - d1 * d6;
-  if (vb <= 0 && d2 >= 0 && d6 <= 0) return glm::length(p - (a + ac * (d2 / (d2 - d6))));
-  const double va = d3 * d6 - d5 * d4;
-  if (va <= 0 && d4 - d3 >= 0 && d5 - d6 >= 0)
-    return glm::length(p - (b + (c - b) * ((d4 - d3) / ((d4 - d3) + (d5 - d6)))));
-  const double denominator = 1.0 / (va + vb + vc);
-  return glm::length(p - (a + ab * (vb * denominator) + ac * (vc * denominator)));
-}
-
 int rootsOnMesh(const Strands& hair, const Mesh& mesh) {
   double worst = 0.0;
   size_t worstStrand = 0;
@@ -75,9 +53,9 @@ int rootsOnMesh(const Strands& hair, const Mesh& mesh) {
     const glm::dvec3 root(hair.points[hair.firstPoint[s]]);
     double nearest = INFINITY;
     for (const glm::uvec3& t : mesh.triangles)
-      nearest = std::min(
-          nearest, distanceToTriangle(root, glm::dvec3(mesh.positions[t.x]), glm::dvec3(mesh.positions[t.y]),
-                                      glm::dvec3(mesh.positions[t.z])));
+      nearest = std::min(nearest, test::distanceToTriangle(root, glm::dvec3(mesh.positions[t.x]),
+                                                           glm::dvec3(mesh.positions[t.y]),
+                                                           glm::dvec3(mesh.positions[t.z])));
     if (nearest > worst) worst = nearest, worstStrand = s;
   }
   return verdict(worst <= kOnMesh, std::to_string(hair.strandCount()) + " roots on the mesh (farthest " +

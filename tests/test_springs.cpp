@@ -39,15 +39,6 @@ Dynamics springs() {
   return d;
 }
 
-// The times at which `signal` crosses zero downward, interpolated between samples `dt` apart.
-std::vector<double> downCrossings(const std::vector<double>& signal, double dt) {
-  std::vector<double> out;
-  for (size_t n = 1; n < signal.size(); ++n)
-    if (signal[n - 1] > 0.0 && signal[n] <= 0.0)
-      out.push_back((double(n - 1) + signal[n - 1] / (signal[n - 1] - signal[n])) * dt);
-  return out;
-}
-
 double meanPeriod(const std::vector<double>& crossings) {
   return (crossings.back() - crossings.front()) / double(crossings.size() - 1);
 }
@@ -80,7 +71,7 @@ TEST(Springs, AHangingChainSwingsAtTheContinuumFundamental) {
     hair.step(field, dt, true, false);
     tip.push_back(hair.positions()[size_t(segments)].x);
   }
-  const std::vector<double> crossings = downCrossings(tip, dt);
+  const std::vector<double> crossings = test::downCrossings(tip, dt);
   ASSERT_GE(crossings.size(), 9u);
   const double period = meanPeriod(crossings);
   EXPECT_NEAR(period / expected, 1.0, 0.02) << "period " << period << " s, continuum " << expected << " s";
@@ -117,7 +108,7 @@ TEST(Springs, AClampedCantileverRingsAtItsFirstMode) {
     hair.step(AccelerationField{}, dt, true, false);
     tip.push_back(hair.positions()[size_t(segments)].y);
   }
-  const std::vector<double> crossings = downCrossings(tip, dt);
+  const std::vector<double> crossings = test::downCrossings(tip, dt);
   ASSERT_GE(crossings.size(), 5u);
   const double period = meanPeriod(crossings);
   EXPECT_NEAR(period / expected, 1.0, 0.05) << "period " << period << " s, beam theory " << expected << " s";

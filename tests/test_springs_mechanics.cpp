@@ -8,6 +8,7 @@
 
 #include "libcore/physics/head_motion.h"
 #include "libcore/physics/spring_dynamics.h"
+#include "tests/test_util.h"
 
 namespace hairgen {
 namespace {
@@ -124,14 +125,6 @@ std::vector<double> tipTrace(SpringHair& hair, double dt, int steps,
   return out;
 }
 
-std::vector<double> downCrossings(const std::vector<double>& signal, double dt) {
-  std::vector<double> out;
-  for (size_t n = 1; n < signal.size(); ++n)
-    if (signal[n - 1] > 0.0 && signal[n] <= 0.0)
-      out.push_back((double(n - 1) + signal[n - 1] / (signal[n - 1] - signal[n])) * dt);
-  return out;
-}
-
 // A step load on a linear system at rest takes each mode to at most twice its static response. A
 // hanging chain under a sideways acceleration a tilts as a whole to the angle a/g (its tip (a/g)·L
 // aside; any bending stiffness only holds it nearer), and its first mode carries most of that, so a
@@ -214,7 +207,8 @@ TEST(SpringsMechanics, AHangingChainRingsAtItsExactDiscreteModes) {
     const ChainMode mode = exactChainMode(hair, length, segments, m);
     displace(hair, mode.shape, 1e-4 * length);
     const double period = 2.0 * M_PI / mode.omega;
-    const std::vector<double> crossings = downCrossings(tipTrace(hair, dt, int(10.5 * period / dt)), dt);
+    const std::vector<double> crossings =
+        test::downCrossings(tipTrace(hair, dt, int(10.5 * period / dt)), dt);
     ASSERT_GE(crossings.size(), 9u) << "mode " << m;
     const double measured = (crossings.back() - crossings.front()) / double(crossings.size() - 1);
     EXPECT_NEAR(measured / period, 1.0, 0.005) << "mode " << m << ": " << measured << " s, exact " << period;

@@ -6,6 +6,7 @@
 #include <filesystem>
 #include <random>
 #include <string>
+#include <vector>
 
 #include "libcore/config/reader.h"
 #include "libcore/config/setup.h"
@@ -155,6 +156,15 @@ inline Strands kernelHair(const std::vector<int>& counts) {
 
 inline ConfigText text(const std::string& body, const std::string& name = "test.txt") {
   return parseConfigText(body, name, ".");
+}
+
+// The times at which `signal` crosses zero downward, interpolated between samples `dt` apart.
+inline std::vector<double> downCrossings(const std::vector<double>& signal, double dt) {
+  std::vector<double> out;
+  for (size_t n = 1; n < signal.size(); ++n)
+    if (signal[n - 1] > 0.0 && signal[n] <= 0.0)
+      out.push_back((double(n - 1) + signal[n - 1] / (signal[n - 1] - signal[n])) * dt);
+  return out;
 }
 
 }  // namespace hairgen::test

@@ -7,26 +7,13 @@
 import fs from 'fs';
 import path from 'path';
 
-globalThis.window = globalThis;  // the package is built for browsers; it runs in Node as in Electron
-process.type = 'renderer';
+import { readLayer } from './tinyusdz_layer.mjs';
 
 const [dir, file, prim, firstText, lastText, fps, plyPattern] = process.argv.slice(2);
 const first = Number(firstText), last = Number(lastText);
-const { default: init } = await import(path.resolve(dir, 'tinyusdz.js'));
-const usd = await init({ wasmBinary: fs.readFileSync(path.resolve(dir, 'tinyusdz.wasm')) });
-const bytes = new Uint8Array(fs.readFileSync(file));
 let failed = false;
 const fail = (message) => { console.log(`FAIL ${file}: ${message}`); failed = true; };
-
-const stage = new usd.TinyUSDZLoaderNative();
-if (!stage.loadFromBinary(bytes, path.basename(file))) fail(`TinyUSDZ cannot build the stage: ${stage.error()}`);
-stage.delete();
-const layer = new usd.TinyUSDZLoaderNative();
-if (!layer.loadAsLayerFromBinary(bytes, path.basename(file))) {
-  fail(`TinyUSDZ cannot read the layer: ${layer.error()}`);
-  process.exit(1);
-}
-const text = layer.layerToString();
+const text = await readLayer(dir, file, fail);
 
 for (const [key, want] of [['startTimeCode', first], ['endTimeCode', last], ['timeCodesPerSecond', Number(fps)]]) {
   const m = new RegExp(`\\b${key} = ([-0-9.e]+)`).exec(text);

@@ -10,9 +10,7 @@ namespace hairgen {
 namespace {
 
 std::string number(double v) {
-  char text[32];
-  std::snprintf(text, sizeof text, "%.6g", v);
-  return text;
+  return formatSignificant(v, 6);
 }
 
 // Exactly, since roots are compared bit for bit.

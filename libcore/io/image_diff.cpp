@@ -10,9 +10,7 @@ namespace hairgen {
 namespace {
 
 std::string number(double v) {
-  char text[32];
-  std::snprintf(text, sizeof text, "%.6g", v);
-  return text;
+  return formatSignificant(v, 6);
 }
 
 // A channel pair ready to compare: where both hold the same non-finite value the pair is (0, 0); where
