@@ -9,19 +9,10 @@
 
 #include "libcore/physics/anjyo_dynamics.h"
 #include "libcore/physics/head_motion.h"
+#include "tests/test_util.h"
 
 namespace hairgen {
 namespace {
-
-// One strand from the origin along `dirs`, each segment `d` long.
-Strands chain(const std::vector<glm::dvec3>& dirs, double d) {
-  std::vector<glm::vec3> points{glm::vec3(0.0f)};
-  glm::dvec3 p(0.0);
-  for (const glm::dvec3& dir : dirs) points.push_back(glm::vec3(p += d * glm::normalize(dir)));
-  Strands s;
-  s.addStrand(points);
-  return s;
-}
 
 // The paper's equations alone: no damping, no rest spring, no pseudo-force.
 Dynamics bare() {
@@ -57,7 +48,7 @@ Swing swing(double azimuth, double amplitude, double g, double periods, double d
   const double length = 0.1;
   Hairstyle style;
   style.gravity = g;
-  AnjyoHair hair(chain({{0, -1, 0}}, length), style, bare(), Collision{}, 0);
+  AnjyoHair hair(test::chain(glm::dvec3(0.0), {{0, -1, 0}}, length), style, bare(), Collision{}, 0);
   // The rest frame of a hanging segment: pole +z, side +x; (a, b) is the rotation vector along them.
   const glm::dvec2 plane(std::sin(azimuth), std::cos(azimuth));
   hair.setSegmentState(0, 0, {amplitude * plane.x, amplitude * plane.y, 0.0, 0.0});
@@ -172,9 +163,11 @@ glm::dvec3 settled(const Hairstyle& style, double length, int segments, double r
   Dynamics dynamics = bare();
   dynamics.restFrequencyAuto = true;  // the hair's own stiffness
   dynamics.damping = 4.0;
-  AnjyoHair hair(chain(std::vector<glm::dvec3>(size_t(segments), {std::sin(root), -std::cos(root), 0.0}),
-                       length / segments),
-                 style, dynamics, Collision{}, 0);
+  AnjyoHair hair(
+      test::chain(glm::dvec3(0.0),
+                  std::vector<glm::dvec3>(size_t(segments), {std::sin(root), -std::cos(root), 0.0}),
+                  length / segments),
+      style, dynamics, Collision{}, 0);
   AccelerationField f;
   f.base = field;
   for (int n = 0; n < 96 * 12; ++n) hair.step(f, 1.0 / 96.0, 1, false);

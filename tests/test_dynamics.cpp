@@ -21,16 +21,6 @@
 namespace hairgen {
 namespace {
 
-// One strand from `root` along `dirs`, each segment `d` long.
-Strands chain(const glm::dvec3& root, const std::vector<glm::dvec3>& dirs, double d) {
-  std::vector<glm::vec3> points{glm::vec3(root)};
-  glm::dvec3 p = root;
-  for (const glm::dvec3& dir : dirs) points.push_back(glm::vec3(p += d * glm::normalize(dir)));
-  Strands s;
-  s.addStrand(points);
-  return s;
-}
-
 Dynamics still() {
   Dynamics d;
   d.given = true;
@@ -48,7 +38,7 @@ TEST(AnjyoDynamics, ASingleSegmentSwingsWithTheCompoundPendulumsPeriodAndKeepsIt
   // gravity arrives as the departure.
   Hairstyle style;
   style.gravity = 0.0;
-  AnjyoHair hair(chain(glm::dvec3(0.0), {{0, -1, 0}}, length), style, still(), Collision{}, 0);
+  AnjyoHair hair(test::chain(glm::dvec3(0.0), {{0, -1, 0}}, length), style, still(), Collision{}, 0);
   // Displaced and let go: θ, φ, and their turns over the last step.
   hair.setSegmentState(0, 0, {amplitude, 0.0, 0.0, 0.0});
   AccelerationField field;
@@ -336,7 +326,7 @@ TEST(AnjyoDynamics, ATurnAcrossTheWrapKeepsItsSize) {
         {ShapeKind::kSphere, 0.0, 1.0, glm::dvec3(0.0, 1.0, z), glm::dvec3(radius), glm::dmat3(1.0), {}});
     Hairstyle style;
     style.gravity = 0.0;
-    AnjyoHair dynamic(chain(glm::dvec3(0.0), {{0, -1, 0}}, 1.0), style, still(), ball, 1);
+    AnjyoHair dynamic(test::chain(glm::dvec3(0.0), {{0, -1, 0}}, 1.0), style, still(), ball, 1);
     dynamic.setSegmentState(0, 0, {3.13, 0.0, 0.0, 0.0});  // hanging down, turned nearly up into the ball
     for (int n = 0; n < 5; ++n) {
       dynamic.step(AccelerationField{}, 0.01, 2, false);

@@ -167,4 +167,14 @@ inline std::vector<double> downCrossings(const std::vector<double>& signal, doub
   return out;
 }
 
+// One strand from `root` along `dirs`, each segment `d` long.
+inline Strands chain(const glm::dvec3& root, const std::vector<glm::dvec3>& dirs, double d) {
+  std::vector<glm::vec3> points{glm::vec3(root)};
+  glm::dvec3 p = root;
+  for (const glm::dvec3& dir : dirs) points.push_back(glm::vec3(p += d * glm::normalize(dir)));
+  Strands s;
+  s.addStrand(points);
+  return s;
+}
+
 }  // namespace hairgen::test

@@ -86,14 +86,15 @@ Strands readStrands(const std::filesystem::path& file, const UnitConversion& con
 
 WriteReport writeStrands(const std::filesystem::path& file, const Strands& strands,
                          const WriteOptions& options) {
-  switch (hairFormatOf(file)) {
+  const HairFormat format = hairFormatOf(file);
+  switch (format) {
     case HairFormat::kHair:
       writeHair(file, strands);
       break;
     case HairFormat::kGltf:
     case HairFormat::kGlb: {
       WriteReport report;
-      writeGltf(file, strands, hairFormatOf(file) == HairFormat::kGlb, &report.droppedStrands);
+      writeGltf(file, strands, format == HairFormat::kGlb, &report.droppedStrands);
       return report;
     }
     case HairFormat::kPly:
