@@ -63,6 +63,7 @@ RenderOutput renderStage(const CommonOptions& common, const Config& config, GlCo
   stats.counts()["points"] = points;
   stats.counts()["samples"] = out.samples;
   stats.json()["device"]["lightMaps"] = out.lightMapsOnCpu ? "cpu" : "opengl";
+  stats.counts()["hairFragments"] = out.hairFragments;
   stats.json()["device"]["hairReadInPlace"] = out.hairReadInPlace;
   return out;
 }
@@ -139,7 +140,7 @@ struct RenderArgs {
   UnitOptions units;
   double scale = 1.0;
   std::vector<double> translate;
-  bool frame = false, motion = false;
+  bool frame = false, motion = false, reference = false;
   bool sequence() const { return !frames.empty(); }
   bool fromGuides() const { return !guides.empty(); }
   // A file of the command: with --frames, frame `f`'s file of its pattern.
@@ -177,6 +178,9 @@ void addRenderFlags(CLI::App& cmd, RenderArgs& args) {
       ->type_name("X Y Z")
       ->check(CLI::Range(-1e4, 1e4));
   cmd.add_flag("--frame", args.frame, "Aim the camera and light at the hair and fit it in the view");
+  cmd.add_flag("--reference", args.reference,
+               "Render the converged reference: 64 samples a pixel, each blending every hair fragment it "
+               "sees (slow; what Samples is measured against, docs/rendering.md)");
   cmd.add_option(
          "--frames", args.frames,
          "Render these frames of a sequence in one process, one device: --hair, -o, --dom and --preview "
@@ -246,6 +250,7 @@ RenderOptions renderOptionsOf(const RenderArgs& args) {
   renderOptions.zUp = conversion.upAxis == UpAxis::kZ;
   renderOptions.scale = conversion.metresPerUnit.value_or(args.scale);
   renderOptions.keepDom = !args.dom.empty();
+  renderOptions.reference = args.reference;
   return renderOptions;
 }
 

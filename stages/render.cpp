@@ -121,6 +121,10 @@ RenderOutput render(GlContext& gl, const Strands& hair, const Mesh* head, const 
   input.domResolution = options.domResolution;
   input.keepDom = options.keepDom;
   input.lightMaps = options.lightMaps;
+  if (options.reference) {
+    input.settings.samples = 64;
+    input.keptFragments = kReferenceFragments;
+  }
   input.uploaded = [&] {  // render's own copies (conformed, framing) go with the caller's hair
     copy.reset();
     copyBefore.reset();

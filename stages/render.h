@@ -62,6 +62,9 @@ struct RenderOptions {
   int domResolution = 0;  // texels per side of the light's maps; 0: as the image needs (RenderInput)
   RenderInput::LightMaps lightMaps = RenderInput::LightMaps::kAuto;  // who draws them (RenderInput)
   bool force = false;  // render work estimated to take absurdly long (never work that cannot fit)
+  // The converged reference: Samples 64 (as far as the device allows) and kReferenceFragments per
+  // sub-pixel, the ground truth the Setup's Samples are measured against (docs/rendering.md).
+  bool reference = false;
   // The hair the camera is aimed at (--frame, CameraPosition auto), as read; null: the hair rendered.
   // A sequence names its shot's first frame, so the camera holds still over the shot.
   const Strands* framing = nullptr;

@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <bit>
 #include <limits>
 
 #include <tbb/global_control.h>
@@ -14,6 +15,7 @@
 
 #include "libcore/io/exr_io.h"
 #include "libcore/io/obj_io.h"
+#include "libcore/render/camera_fragments.h"
 #include "libcore/render/gl_context.h"
 #include "libcore/render/gl_resources.h"
 #include "libcore/render/light_maps.h"
@@ -168,12 +170,15 @@ TEST(HairLightMaps, OpacityFallsInTheLayersBehindWhereTheHairBegins) {
   const HairLightMaps maps = rasteriseLightMaps(s, texelView(16), 0.5, kLayers);
   const std::vector<float> start = maps.startMetres(1e10f);
   const std::vector<glm::vec4> opacity = maps.opacity(0.8);
+  // A strand w texels wide along a texel row's middle: the texel's tent holds w − w²/4 of its
+  // cross-section (the rest falls to the rows either side), opacity 0.8.
+  auto held = [](double w) { return float(0.8 * (w - w * w / 4.0)); };
   for (int x = 4; x <= 10; ++x) {
     const size_t t = 4 * 16 + x;
     EXPECT_EQ(start[t], 1.0f) << x;
-    // Each strand covers half of each texel it crosses, opacity 0.8: 0.4 each.
-    EXPECT_NEAR(opacity[t].x, 0.4f, 1e-4f) << x;
-    EXPECT_NEAR(opacity[t].y, 0.4f + 0.4f / 1.004f, 1e-4f) << x;
+    // (The cross-section is kept to 1/256 texel.)
+    EXPECT_NEAR(opacity[t].x, held(0.5), 5e-4f) << x;
+    EXPECT_NEAR(opacity[t].y, held(0.5) + held(0.5 / 1.004), 5e-4f) << x;
     EXPECT_EQ(opacity[t].y, opacity[t].z);
     EXPECT_EQ(opacity[t].z, opacity[t].w);
   }
@@ -223,6 +228,96 @@ TEST(HairLightMaps, AStrandMovedAHundredthOfATexelChangesTheMapsByAboutAHundredt
     EXPECT_LT(largest, 0.03 * 0.3) << angle;
   }
 }
+
+// The camera's fragments (camera_fragments.h) on the texel view: pixel (x, y) is the world's x and y,
+// depth −z.
+
+// A fragment's coverage (kCoverageOne a pixel) and the sum of a pixel's fragments' and tail's.
+double coverageOf(const CameraFragments& f, size_t j) {
+  return double(f.words[3 * j + 2] & ((1u << kCoverageBits) - 1u)) / kCoverageOne;
+}
+double pixelCoverage(const CameraFragments& f, size_t p) {
+  double sum = double(f.tail[p]) / kCoverageOne;
+  for (size_t j = f.first[p]; j < f.first[p + 1]; ++j) sum += coverageOf(f, j);
+  return sum;
+}
+float depthOf(const CameraFragments& f, size_t j) {
+  return std::bit_cast<float>(f.words[3 * j + 1]);
+}
+
+// Kajiya & Kay's thin cylinder covers a pixel by its projected width × its length within the pixel: a
+// strand's coverage summed down a column is its width in pixels over cos θ (its length per column), for
+// strands far thinner than a pixel as for wider ones; made of many short segments, a strand is one
+// fragment per pixel (its pieces there summed), not several blended over each other.
+TEST(CameraFragments, AStrandCoversEachColumnByItsWidth) {
+  for (const double width : {0.05, 0.2, 0.37, 1.0, 2.5})
+    for (const double angle : {0.0, 0.5})
+      for (const int points : {2, 200}) {
+        const glm::dvec2 d(std::cos(angle), std::sin(angle));
+        std::vector<glm::vec3> line;
+        for (int i = 0; i < points; ++i) {
+          const glm::dvec2 p = glm::dvec2(6.2, 21.7) + 50.0 / d.x * double(i) / (points - 1) * d;
+          line.push_back({p.x, p.y, -1.0f});
+        }
+        Strands s;
+        s.addStrand(line);
+        const CameraFragments f = rasteriseCameraFragments(s, texelView(64), width, kKeptFragments);
+        for (int x = 16; x < 48; ++x) {
+          double column = 0.0;
+          for (int y = 0; y < 64; ++y) {
+            const size_t p = size_t(y) * 64 + size_t(x);
+            column += pixelCoverage(f, p);
+            EXPECT_LE(f.first[p + 1] - f.first[p], 1u) << "one strand, one fragment a pixel";
+          }
+          EXPECT_NEAR(column, width / d.x, 0.01 * width / d.x)
+              << width << " pixels wide at " << angle << " rad, " << points << " points, column " << x;
+        }
+      }
+}
+
+// Twelve strands over the same pixels, 1 cm apart in depth, added in a shuffled order: each pixel keeps
+// the eight nearest, nearest first, and the four behind add their coverage to its tail.
+TEST(CameraFragments, APixelKeepsItsNearestFragmentsInDepthOrderAndTheRestInItsTail) {
+  Strands s;
+  for (int i : {7, 2, 11, 0, 5, 9, 3, 10, 1, 6, 8, 4})
+    s.addStrand({{4.0f, 10.0f, -1.0f - 0.01f * float(i)}, {60.0f, 10.0f, -1.0f - 0.01f * float(i)}});
+  const CameraFragments f = rasteriseCameraFragments(s, texelView(64), 0.5, 8);
+  for (int x = 10; x < 54; ++x) {
+    const size_t p = 9 * 64 + size_t(x);  // the strands' row: y 10 is the edge between rows 9 and 10
+    ASSERT_EQ(f.first[p + 1] - f.first[p], 8u) << x;
+    for (size_t k = 0; k < 8; ++k)
+      EXPECT_NEAR(depthOf(f, f.first[p] + k), 1.0 + 0.01 * double(k), 1e-6) << x << ", fragment " << k;
+    double behind = 0.0;
+    for (int i = 8; i < 12; ++i) behind += 0.25 / (1.0 + 0.01 * i);  // half of each width in this row
+    EXPECT_NEAR(double(f.tail[p]) / kCoverageOne, behind, 1e-3) << x;
+  }
+}
+
+// Many strands crossing in every direction: the same fragments on one thread as on all, and again.
+TEST(CameraFragments, TheFragmentsAreTheSameBitsOnOneThreadAsOnAll) {
+  Strands s;
+  for (int i = 0; i < 3000; ++i) {
+    const float a = 0.37f * float(i), r = 40.0f + 30.0f * std::sin(0.11f * float(i));
+    std::vector<glm::vec3> points;
+    for (int k = 0; k < 12; ++k) {
+      const float t = float(k) / 11.0f;
+      points.push_back({128.0f + r * std::cos(a + 2.0f * t), 128.0f + r * std::sin(a * 1.3f + 3.0f * t),
+                        -1.0f - 0.01f * float(i % 7)});
+    }
+    s.addStrand(points);
+  }
+  auto fragments = [&] { return rasteriseCameraFragments(s, texelView(256), 0.7, kKeptFragments); };
+  const CameraFragments all = fragments(), again = fragments();
+  tbb::global_control one(tbb::global_control::max_allowed_parallelism, 1);
+  const CameraFragments single = fragments();
+  EXPECT_GT(all.count(), 100000u);
+  EXPECT_TRUE(all.words == single.words && all.words == again.words);
+  EXPECT_TRUE(all.first == single.first && all.tail == single.tail && all.tail == again.tail);
+}
+
+// A pixel the hair covers whole: its pieces' coverages are integers rounded down (hair_raster.h), so a
+// strand's inside sums to within a few 1/65536 of a pixel.
+constexpr float kCovered = 0.999f;
 
 GlContext& gl() {
   static GlContext context;  // every test here needs it; failing to open one fails them (exit 3 in the CLI)
@@ -288,7 +383,7 @@ int compareStrandWithCpu(RenderSettings r, const glm::dvec3& normal) {
   int checked = 0;
   for (int y = 0; y < r.resolution.y; ++y)
     for (int x = 0; x < r.resolution.x; ++x) {
-      if (out.beauty.at(kChannelOpacity, x, y) < 1.0f) continue;
+      if (out.beauty.at(kChannelOpacity, x, y) < kCovered) continue;
       glm::dvec3 p = onPlane(r, x, y);
       p.y = 0.0;  // shading is at the centreline
       const float shadow = out.beauty.at(kChannelShadow, x, y);
@@ -363,6 +458,34 @@ TEST(Render, VolumetricWithBlendZeroIsKajiyaKay) {
   }
 }
 
+// A strand thinner than a pixel is a faint line, as in a photograph: its A summed across it, down each
+// column, is its projected width in pixels (over cos θ when it is tilted), within 5%.
+TEST(Render, AStrandsAlphaAcrossItsWidthIsItsProjectedWidth) {
+  RenderSettings r = frontCamera(96, 1);
+  const double focal = 0.5 * 96 / std::tan(glm::radians(15.0));  // pixels per metre at 1 m
+  for (const double pixels : {0.2, 0.37, 0.8, 1.6})
+    for (const double angle : {0.0, 0.4}) {
+      r.strandWidth = pixels * 0.3 / focal;
+      const glm::vec3 d(std::cos(angle), std::sin(angle), 0.0f);
+      Strands s;
+      addStraight(s, -0.06f * d, 0.06f * d, 40);
+      const RenderOutput out = renderStrands(s, r);
+      float largest = 0.0f;
+      for (int x = 30; x < 66; ++x) {
+        double column = 0.0;
+        for (int y = 0; y < 96; ++y) {
+          column += out.beauty.at("A", x, y);
+          largest = std::max(largest, out.beauty.at("A", x, y));
+        }
+        EXPECT_NEAR(column, pixels / std::cos(angle), 0.05 * pixels / std::cos(angle))
+            << pixels << " pixels wide at " << angle << " rad, column " << x;
+      }
+      if (pixels < 1.0) {
+        EXPECT_LT(largest, pixels / std::cos(angle) + 0.01) << "a thin strand is faint";
+      }
+    }
+}
+
 // DESIGN §6: R G B A premultiplied. A pixel nothing covers is 0 in all four, A is the covered fraction of
 // a pixel's sub-pixels (1 inside a strand, between 0 and 1 on its edges), and no channel exceeds what A
 // allows of the brightest colour drawn.
@@ -370,7 +493,7 @@ TEST(Render, TheBeautyIsPremultiplied) {
   Strands s;
   addStraight(s, {-0.04f, -0.01f, 0}, {0.04f, 0.012f, 0});
   RenderSettings r = frontCamera(64, 4);
-  r.strandWidth = 0.004;
+  r.strandWidth = 0.01;
   RenderOutput out = renderStrands(s, r);
   int edges = 0, inside = 0;
   for (int y = 0; y < 64; ++y)
@@ -381,8 +504,8 @@ TEST(Render, TheBeautyIsPremultiplied) {
       if (a == 0.0f) {
         for (const char* c : {"R", "G", "B"}) ASSERT_EQ(out.beauty.at(c, x, y), 0.0f) << x << "," << y;
       }
-      edges += a > 0.0f && a < 1.0f;
-      inside += a == 1.0f;
+      edges += a > 0.0f && a < kCovered;
+      inside += a >= kCovered;
     }
   EXPECT_GT(edges, 20);
   EXPECT_GT(inside, 20);
@@ -407,7 +530,7 @@ TEST(Render, AStrandBetweenTheLightAndAnotherDarkensOnlyThatOne) {
     SCOPED_TRACE(maps == RenderInput::LightMaps::kCpu ? "hairgen's light maps" : "light maps by OpenGL");
     // Light straight above; strand A 2 cm above strand B; the camera sees both from the front.
     RenderSettings r = frontCamera(96, 1);
-    r.strandWidth = 0.004;
+    r.strandWidth = 0.008;
     r.lightPosition = {0.0, 1.0, 0.0};
     Strands both, aAlone, bAlone;
     addStraight(both, {-0.04f, 0.02f, 0}, {0.04f, 0.02f, 0});
@@ -420,11 +543,13 @@ TEST(Render, AStrandBetweenTheLightAndAnotherDarkensOnlyThatOne) {
     int aPixels = 0, bPixels = 0;
     for (int y = 0; y < 96; ++y)
       for (int x = 20; x < 76; ++x) {
-        if (a.beauty.at(kChannelOpacity, x, y) == 1.0f && all.beauty.at(kChannelOpacity, x, y) == 1.0f) {
+        if (a.beauty.at(kChannelOpacity, x, y) >= kCovered &&
+            all.beauty.at(kChannelOpacity, x, y) >= kCovered) {
           EXPECT_NEAR(all.beauty.at("R", x, y), a.beauty.at("R", x, y), 1e-3) << "A at " << x << "," << y;
           ++aPixels;
         }
-        if (b.beauty.at(kChannelOpacity, x, y) == 1.0f && all.beauty.at(kChannelOpacity, x, y) == 1.0f) {
+        if (b.beauty.at(kChannelOpacity, x, y) >= kCovered &&
+            all.beauty.at(kChannelOpacity, x, y) >= kCovered) {
           EXPECT_LT(all.beauty.at(kChannelShadow, x, y), 0.7f);
           EXPECT_LT(all.beauty.at("R", x, y), 0.8f * b.beauty.at("R", x, y)) << "B at " << x << "," << y;
           ++bPixels;
@@ -441,6 +566,7 @@ TEST(Render, AStrandBetweenTheLightAndAnotherDarkensOnlyThatOne) {
 // range each step, never by the jump of a texel (0.5 and more with a nearest-texel lookup).
 TEST(Render, AStrandMovedAHundredthOfATexelChangesTheShadowByAboutAHundredth) {
   RenderSettings r = frontCamera(96, 1);
+  r.fieldOfView = 6.0;  // B about a third of a pixel wide
   r.strandWidth = 1.2e-4;
   r.lightPosition = {0.0, 1.0, 0.0};
   // The light's map holds the scene's sphere at 512 texels: a texel at A's depth, in metres.
@@ -458,10 +584,12 @@ TEST(Render, AStrandMovedAHundredthOfATexelChangesTheShadowByAboutAHundredth) {
     addStraight(both, {-0.04f, 0.0f, 0}, {0.04f, 0.0f, 0});
     const RenderOutput out = renderStrands(both, r);
     std::vector<float> shadow;
+    // B's own shadow where it covers a tenth of a pixel or more: the channel blends it with the open's 1
+    // by B's coverage (its opacity).
     for (int y = 48; y < 96; ++y)  // B's half of the image: y down, B below A
       for (int x = 20; x < 76; ++x)
-        if (out.beauty.at(kChannelOpacity, x, y) > 0.0f)
-          shadow.push_back(out.beauty.at(kChannelShadow, x, y));
+        if (const float a = out.beauty.at(kChannelOpacity, x, y); a > 0.1f)
+          shadow.push_back(1.0f - (1.0f - out.beauty.at(kChannelShadow, x, y)) / a);
     ASSERT_GT(shadow.size(), 40u);
     for (float v : shadow) range = std::max(range, 1.0 - double(v));
     if (!before.empty() && before.size() == shadow.size())
@@ -543,7 +671,11 @@ TEST(Render, ACustomHairVertexMovesTheHairAndItsShadow) {
   }
 }
 
-TEST(Render, SupersamplingChangesOnlyStrandEdges) {
+// Each pixel's hair is its analytic coverage (camera_fragments.h), so a lone strand needs no
+// supersampling: Samples 9 changes no pixel by more than a few hundredths, and none away from the
+// strand's edges by more than 0.01 (what it still changes there is where in the pixel the strand is
+// shaded).
+TEST(Render, SupersamplingChangesALoneStrandLittle) {
   Strands s;
   addStraight(s, {-0.05f, -0.01f, 0}, {0.05f, 0.012f, 0});
   RenderSettings r = frontCamera(80, 1);
@@ -552,16 +684,17 @@ TEST(Render, SupersamplingChangesOnlyStrandEdges) {
   RenderOutput one = renderStrands(s, r);
   r.samples = 9;
   RenderOutput nine = renderStrands(s, r);
-  int edges = 0, changedEdges = 0;
+  int edges = 0;
+  double edgeChange = 0.0;
   for (int y = 1; y < 79; ++y)
     for (int x = 1; x < 79; ++x) {
-      // An edge pixel: partly covered when supersampled, or next to a coverage change without.
-      bool edge =
-          nine.beauty.at(kChannelOpacity, x, y) > 0.0f && nine.beauty.at(kChannelOpacity, x, y) < 1.0f;
+      // An edge pixel: partly covered, or next to one that is.
+      bool edge = false;
       for (int dy = -1; dy <= 1; ++dy)
-        for (int dx = -1; dx <= 1; ++dx)
-          edge =
-              edge || one.beauty.at(kChannelOpacity, x + dx, y + dy) != one.beauty.at(kChannelOpacity, x, y);
+        for (int dx = -1; dx <= 1; ++dx) {
+          const float a = one.beauty.at(kChannelOpacity, x + dx, y + dy);
+          edge = edge || (a > 0.0f && a < kCovered);
+        }
       double change = 0.0;
       for (const char* c : {"R", "G", "B", "A"})
         change = std::max(change, double(std::abs(one.beauty.at(c, x, y) - nine.beauty.at(c, x, y))));
@@ -569,11 +702,11 @@ TEST(Render, SupersamplingChangesOnlyStrandEdges) {
         ASSERT_LT(change, 0.01) << "pixel " << x << "," << y << " is not on an edge";
       } else {
         ++edges;
-        changedEdges += change > 0.01;
+        edgeChange = std::max(edgeChange, change);
       }
     }
   EXPECT_GT(edges, 100);
-  EXPECT_GT(changedEdges, edges / 4) << "supersampling should soften the edges";
+  EXPECT_LT(edgeChange, 0.05) << "the largest change at an edge";
 }
 
 // A Setup naming `glsl` as its HairFrag at setup.txt:9, the file written to `dir` and read back as
@@ -601,15 +734,15 @@ TEST(Render, ACustomHairFragmentGivesItsColorWhereTheHairIs) {
   Strands s;
   addStraight(s, {-0.04f, 0, 0}, {0.04f, 0, 0});
   RenderSettings r = frontCamera(64, 1);
-  r.strandWidth = 0.006;
+  r.strandWidth = 0.012;
   RenderOutput out = renderStrands(s, r, nullptr, Visuality{}, shaders);
   int hair = 0;
   for (int y = 0; y < 64; ++y)
     for (int x = 0; x < 64; ++x) {
-      if (out.beauty.at(kChannelOpacity, x, y) < 1.0f) continue;
-      EXPECT_EQ(out.beauty.at("R", x, y), 0.25f) << x << "," << y;
-      EXPECT_EQ(out.beauty.at("G", x, y), 0.75f) << x << "," << y;
-      EXPECT_EQ(out.beauty.at("B", x, y), 0.5f) << x << "," << y;
+      if (out.beauty.at(kChannelOpacity, x, y) < kCovered) continue;
+      EXPECT_NEAR(out.beauty.at("R", x, y), 0.25f, 1e-3f) << x << "," << y;
+      EXPECT_NEAR(out.beauty.at("G", x, y), 0.75f, 1e-3f) << x << "," << y;
+      EXPECT_NEAR(out.beauty.at("B", x, y), 0.5f, 1e-3f) << x << "," << y;
       ++hair;
     }
   EXPECT_GT(hair, 40);
@@ -678,6 +811,7 @@ TEST(Render, ConformTurnsZUpCentimetresIntoYUpMetres) {
 // depth (0.45 m and 0.5 m) in pixels; where nothing is drawn, 0. Lines and ribbons alike.
 TEST(Render, MotionVectorsAreTheMoveOnTheImageInPixels) {
   HairOverAPlane before, after;
+  before.settings.strandWidth = after.settings.strandWidth = 0.006;  // 3 pixels: their middles covered whole
   for (glm::vec3& p : after.hair.points) p += glm::vec3(0.002f, 0.0f, -0.001f);
   for (glm::vec3& p : after.head.positions) p += glm::vec3(0.0f, 0.0f, 0.001f);
   const double focal = 0.5 * 128 / std::tan(glm::radians(15.0));
@@ -694,7 +828,7 @@ TEST(Render, MotionVectorsAreTheMoveOnTheImageInPixels) {
     for (int y = 0; y < 128; ++y)
       for (int x = 0; x < 128; ++x) {
         const float u = out.beauty.at(kChannelMotionU, x, y), v = out.beauty.at(kChannelMotionV, x, y);
-        if (out.beauty.at(kChannelOpacity, x, y) == 1.0f) {
+        if (out.beauty.at(kChannelOpacity, x, y) >= kCovered) {
           ASSERT_NEAR(u, 0.002 * focal / 0.45, 2e-3) << samples << " samples, hair at " << x << "," << y;
           ASSERT_NEAR(v, 0.001 * focal / 0.45, 2e-3) << samples << " samples, hair at " << x << "," << y;
           ++hair;
@@ -790,8 +924,9 @@ TEST(Render, HairReadInPlaceGivesTheImageOfACopy) {
 // hairgen's rasteriser (every machine's) and from OpenGL's lines (a custom HairVert's) hold about as much
 // opacity in all: OpenGL's lines cover a texel per step along the major axis, so a segment at angle θ to
 // it counts cos θ of its length (0.71-1). (The nearer layers differ more: the rasteriser's start is the
-// nearest strand that reaches a texel through its bilinear footprint, a line's the nearest through its
-// one texel.) The two give the same picture but for the shadows' edges.
+// nearest strand that reaches a texel through its footprint, its cross-section through the texels'
+// tents, a line's the nearest through its one texel.) The two give the same picture but for the
+// shadows' edges: under a tenth of the hair's pixels differ by more than 0.1.
 TEST(Render, TheRasterisersLightMapsAreOpenGlsLines) {
   test::Job job = test::loadJob("thesis/coupe3/setup.txt", SetupUse::kRender);
   Hairstyle h = job.config.hairstyle;
@@ -825,7 +960,7 @@ TEST(Render, TheRasterisersLightMapsAreOpenGlsLines) {
       shadowed += std::abs(own.beauty.at(kChannelShadow, x, y) - ogl.beauty.at(kChannelShadow, x, y)) > 0.1f;
     }
   EXPECT_GT(pixels, 5000u);
-  EXPECT_LT(double(shadowed), 0.05 * double(pixels)) << shadowed << " of " << pixels << " pixels";
+  EXPECT_LT(double(shadowed), 0.1 * double(pixels)) << shadowed << " of " << pixels << " pixels";
 }
 
 // Left to the renderer, the light's maps follow the image: at the scene's centre a texel is no larger

@@ -130,7 +130,8 @@ TEST(KeptObjects, ASequenceCompilesOnceAndRendersAsAFreshContext) {
     }
     EXPECT_GT(afterFirst, 0u) << "the first frame's programs are kept";
     EXPECT_EQ(afterSecond, afterFirst) << "the second frame made what the first had kept again";
-    EXPECT_GT(gl.keptCount(), afterSecond) << "sub-pixels need programs of their own";
+    // The rasteriser's fragments are shaded one sample each at any Samples: no programs of their own.
+    EXPECT_EQ(gl.keptCount(), afterSecond) << "sub-pixels compiled programs of their own";
   }
   for (int frame = 0; frame < 3; ++frame) {
     GlContext fresh;
@@ -152,7 +153,8 @@ TEST(KeptObjects, AContextOpenedInTheBackgroundRendersOnThisThread) {
   const RenderOutput out = render(*gl, crossing(0.0f), nullptr, {}, smallView(1), {}, {});
   float covered = 0.0f;
   for (float a : out.beauty.plane("A")) covered += a;
-  EXPECT_GT(covered, 10.0f) << "the strands were drawn";
+  // 40 strands of 80 µm, 7 cm long, at 0.7 opacity cover about 7 pixels' worth of the image.
+  EXPECT_GT(covered, 3.0f) << "the strands were drawn";
   gl.reset();
   EXPECT_EQ(GlContext::current(), nullptr);
   context();

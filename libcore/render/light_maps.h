@@ -1,15 +1,7 @@
 // The light's two hair maps (where the hair begins, and the deep opacity layers behind it: Yuksel &
-// Keyser 2008, as the thesis uses them in §4.1.6), drawn by hairgen's own rasteriser on every machine,
-// so a GPU and llvmpipe shadow the hair with the same bits.
-//
-// Every point is projected once in double precision and quantised: window x and y to 1/kSubTexel of a
-// texel, depth along the light's axis to kDepthUnit, the strand's projected width to 1/kWidthUnit of a
-// texel. From there on everything is integer arithmetic. Each segment is a thin ribbon of the strand's
-// width (Kajiya & Kay's cylinder seen from the light), cut at the texel boundaries along its major axis
-// (x or y, whichever it moves more along): each piece covers the strand's width × its true length
-// within that texel column (or row), exactly, and is shared linearly between the two texels across it
-// whose centres it lies between (a ribbon wider than a texel is first cut into strips a texel wide),
-// so the maps change continuously as a strand moves, and a strip's shared point counts once.
+// Keyser 2008, as the thesis uses them in §4.1.6), drawn by hairgen's own integer rasteriser
+// (hair_raster.h, the one the camera's view uses) on every machine, so a GPU and llvmpipe shadow the
+// hair with the same bits.
 //
 // The depth map keeps, per texel, the nearest sample that reaches it; the opacity map adds each
 // sample's coverage (texel² in 1/kCoverageOne) to its layer and every layer behind it, measured from
@@ -23,20 +15,10 @@
 #include <glm/glm.hpp>
 
 #include "libcore/model/strands.h"
+#include "libcore/render/hair_raster.h"
 #include "libcore/render/views.h"
 
 namespace hairgen {
-
-// Window positions are kept in 1/kSubTexel texel: 8 bits of sub-texel position, as GPUs snap vertices.
-inline constexpr int kSubTexel = 256;
-// A strand's projected width in 1/kWidthUnit texel, so a strand a tenth of a texel wide covers what it
-// should to 0.2% (products with a length in 1/kSubTexel still fit in 64 bits).
-inline constexpr int kWidthUnit = 1 << 16;
-// Depth along the light's axis in whole micrometres: a 40 µm strand is 40 units, and 2^31 units reach
-// 2 km.
-inline constexpr double kDepthUnit = 1.0e-6;
-// A texel fully covered once, in coverage units.
-inline constexpr uint32_t kCoverageOne = 1u << 16;
 
 // The light's maps as integers, and as the floats the shadow lookup reads.
 struct HairLightMaps {

@@ -6,6 +6,7 @@
 #include <tbb/task_group.h>
 
 #include "glsl/embedded_glsl.h"
+#include "libcore/render/camera_fragments.h"
 #include "libcore/render/light_maps.h"
 #include "libcore/render/line_decimation.h"
 #include "libcore/render/readback.h"
@@ -118,25 +119,36 @@ std::string hairShadingDefines(ShadingModel model, bool colored) {
 }
 
 Programs::Programs(bool ribbons, int block, const CustomShaders& custom, bool motion, ShadingModel model,
-                   bool colored)
+                   bool colored, bool rasterised)
     : hairDepth(stage(glsl::kHairVertex, custom.hairVert, "HairVert"), stage(glsl::kDepthFragment),
                 "hair depth"),
       headDepth(stage(glsl::kHeadVertex, custom.headVert, "HeadVert"), stage(glsl::kDepthFragment),
                 "head depth"),
       opacity(stage(glsl::kHairVertex, custom.hairVert, "HairVert"), stage(glsl::kOpacityFragment),
               "deep opacity"),
-      hairShade(stage(glsl::kHairVertex, custom.hairVert, "HairVert", {.ribbon = ribbons}),
-                stage(glsl::kHairFragment, custom.hairFrag, "HairFrag",
-                      {.ribbon = ribbons,
-                       .shadowFunction = true,
-                       .screenDoor = true,
-                       .singleSample = block == 1,
-                       .defines = custom.hairFrag ? "" : hairShadingDefines(model, colored)}),
-                "hair shading"),
       headShade(stage(glsl::kHeadVertex, custom.headVert, "HeadVert"),
                 stage(glsl::kHeadFragment, custom.headFrag, "HeadFrag", {.shadowFunction = true}),
                 "head shading"),
       resolve(stage(glsl::kFullscreenVertex), stage(glsl::kResolveFragment), "resolve") {
+  const std::string defines = custom.hairFrag ? "" : hairShadingDefines(model, colored);
+  if (rasterised) {
+    // One point per fragment, each its own sample: no screen door.
+    hairAtlas.emplace(
+        stage(glsl::kAtlasVertex),
+        stage(glsl::kHairFragment, custom.hairFrag, "HairFrag",
+              {.shadowFunction = true, .screenDoor = true, .singleSample = true, .defines = defines}),
+        "hair shading");
+    blend.emplace(stage(glsl::kFullscreenVertex), stage(glsl::kBlendFragment), "blend");
+  } else {
+    hairShade.emplace(stage(glsl::kHairVertex, custom.hairVert, "HairVert", {.ribbon = ribbons}),
+                      stage(glsl::kHairFragment, custom.hairFrag, "HairFrag",
+                            {.ribbon = ribbons,
+                             .shadowFunction = true,
+                             .screenDoor = true,
+                             .singleSample = block == 1,
+                             .defines = defines}),
+                      "hair shading");
+  }
   if (!motion) return;
   hairMotion.emplace(stage(glsl::kHairVertex, std::nullopt, "", {.ribbon = ribbons, .motion = true}),
                      stage(glsl::kMotionFragment, std::nullopt, "",
@@ -148,9 +160,10 @@ Programs::Programs(bool ribbons, int block, const CustomShaders& custom, bool mo
                         "motion resolve");
 }
 
-// The light's maps (light_maps.h), and the strands' drawing order and chords (line_decimation.h) for the
-// shading pass, computed on TBB's threads while the main thread, which holds the GL context, uploads the
-// hair and compiles the programs.
+// The light's maps (light_maps.h), and where OpenGL draws the camera's hair (a custom HairVert, the
+// motion pass) the strands' drawing order and chords (line_decimation.h), computed on TBB's threads
+// while the main thread, which holds the GL context, uploads the hair and compiles the programs. (The
+// camera's fragments wait for the head's depth: the shading pass.)
 //
 // Order: only without sub-pixels, where the shading stage is tested for depth before it runs (the screen
 // door's discard would defer the test); a different order could only change which of two fragments of
@@ -176,10 +189,11 @@ struct Scene::Preparation {
       return depth / v.focalPx / (1.0 + tanX * tanX + tanY * tanY);
     };
     const double cameraPixel = nearestPixel(scene.subpixel);
-    cameraChords = !in.shaders.hairVert && !scene.ribbons && cameraPixel > 0.0;
+    const bool openGlCamera = !scene.rasterised || scene.motion;
+    cameraChords = openGlCamera && !in.shaders.hairVert && !scene.ribbons && cameraPixel > 0.0;
     const Strands& hair = *in.hair;
     const double cameraTolerance = kChordPixels * cameraPixel;
-    const bool ordered = scene.block == 1;
+    const bool ordered = openGlCamera && scene.block == 1;
     const glm::dmat4 view = scene.camera.view;
     const bool lightByRasteriser = !in.shaders.hairVert && in.lightMaps != RenderInput::LightMaps::kGl;
     const View& lightView = scene.light;
@@ -214,12 +228,16 @@ Scene::Scene(const RenderInput& in)
       light(lightView(in.settings, sphere, lightMapSize(in, sphere, camera))),
       ribbons(drawsRibbons(in.settings, sphere, camera, block)),
       motion(in.previous.has_value()),
+      rasterised(!in.shaders.hairVert),
+      kept(in.keptFragments),
+      strands(in.hair),
       preparing(std::make_unique<Preparation>(*this, in)),
       hair(*in.hair, tangentsFor(*in.hair), motion ? in.previous->hair : nullptr, in.readInPlace),
       head(in.head && !in.head->triangles.empty()
                ? std::make_unique<HeadGeometry>(*in.head, motion ? in.previous->head : nullptr)
                : nullptr),
-      programs(ribbons, block, in.shaders, motion, in.settings.shadingModel, !in.hair->colors.empty()) {
+      programs(ribbons, block, in.shaders, motion, in.settings.shadingModel, !in.hair->colors.empty(),
+               rasterised) {
   if (motion) {
     // The projection's x and y do not depend on the near and far planes, so the previous camera is
     // the Render Info camera on this frame's sphere.
@@ -316,33 +334,11 @@ Texture deepOpacityPass(const Scene& scene, const LightDepth& depth) {
   return opacity;
 }
 
-ShadedImage shadingPass(const Scene& scene, const LightDepth& depth, const Texture& opacity) {
+namespace {
+
+// The hair's shading stage's uniforms, for OpenGL's strands and for the rasteriser's fragments alike.
+void setHairShading(const Program& p, const Scene& scene) {
   const RenderSettings& r = scene.settings;
-  const int w = scene.subpixel.width, h = scene.subpixel.height;
-  ShadedImage image{Texture(GL_RGBA16F, w, h), Texture(GL_RGBA32F, w, h)};
-  Framebuffer fb({&image.color, &image.data}, w, h, true);
-  fb.bind();
-  // Premultiplied: what nothing covers is 0 in every channel; the background belongs to the preview.
-  const float background[4] = {0.0f, 0.0f, 0.0f, 0.0f};
-  const float nothing[4] = {kBackgroundZ, 0.0f, 1.0f, 0.0f};
-  const float one = 1.0f;
-  glClearBufferfv(GL_COLOR, 0, background);
-  glClearBufferfv(GL_COLOR, 1, nothing);
-  glClearBufferfv(GL_DEPTH, 0, &one);
-  glEnable(GL_DEPTH_TEST);
-  glBindTextureUnit(kUnitHairStart, depth.hairStart.id);
-  glBindTextureUnit(kUnitHeadDepth, depth.head.id);
-  glBindTextureUnit(kUnitOpacityMap, opacity.id);
-  if (scene.head) {
-    const Program& p = scene.programs.headShade;
-    p.use();
-    setView(p, scene.subpixel);
-    setShadowUniforms(p, scene);
-    p.set("uHeadColor", glm::vec3(r.headColor));
-    scene.head->draw();
-  }
-  const Program& p = scene.programs.hairShade;
-  useForHairStrips(p, scene, r);
   setShadowUniforms(p, scene);
   p.set("uEye", glm::vec3(r.cameraPosition));
   p.set("uAmbientColor", glm::vec3(scene.visuality.ambientColor));
@@ -353,23 +349,125 @@ ShadedImage shadingPass(const Scene& scene, const LightDepth& depth, const Textu
   p.set("uBlend", float(r.volumetricBlend));
   p.set("uHasColor", scene.hair.hasColors ? 1 : 0);
   p.set("uHasNormal", scene.hair.hasNormals ? 1 : 0);
-  if (scene.ribbons)
-    scene.hair.draw(true);
-  else
-    scene.hair.drawLines(scene.cameraLines.get());
-  checkGl("the shading pass");
+}
+
+// Texels per row of the atlas the kept fragments are shaded in.
+constexpr int kAtlasWidth = 4096;
+
+// The rasteriser's kept fragments shaded one texel each in an atlas by the hair's shading stage, then
+// blended front to back over the head (`head`: what the head's drawing left) into the returned image.
+ShadedImage blendHair(const Scene& scene, const CameraFragments& f, const ShadedImage& head) {
+  const int w = scene.subpixel.width, h = scene.subpixel.height;
+  GLint maxSize = 4096;
+  glGetIntegerv(GL_MAX_TEXTURE_SIZE, &maxSize);
+  const int atlasWidth = std::min(kAtlasWidth, int(maxSize));
+  const size_t rows = std::max<size_t>(1, (f.count() + size_t(atlasWidth) - 1) / size_t(atlasWidth));
+  if (rows > size_t(maxSize))
+    renderFailure("the camera sees " + std::to_string(f.count()) +
+                  " hair fragments, more than this device's largest texture holds; lower Samples");
+  const bool inPlace = scene.hair.readsStrandsInPlace();  // the fragments live as long as the hair
+  const Buffer words(f.words.data(), f.words.size() * sizeof(uint32_t), inPlace);
+  const Buffer first(f.first.data(), f.first.size() * sizeof(uint32_t), inPlace);
+  const Buffer tail(f.tail.data(), f.tail.size() * sizeof(uint32_t), inPlace);
+  Texture atlasColor(GL_RGBA16F, atlasWidth, int(rows)), atlasData(GL_RGBA16F, atlasWidth, int(rows));
+  {
+    Framebuffer fb({&atlasColor, &atlasData}, atlasWidth, int(rows), false);
+    fb.bind();
+    glDisable(GL_DEPTH_TEST);
+    scene.hair.draw(true, false);  // binds the hair's storage buffers
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 5, words.id);
+    const Program& p = *scene.programs.hairAtlas;
+    p.use();
+    setHairShading(p, scene);
+    p.set("uOpacity", float(scene.settings.strandOpacity));
+    p.set("uAtlasWidth", atlasWidth);
+    p.set("uAtlasSize", glm::vec2(atlasWidth, float(rows)));
+    drawPoints(f.count());
+    checkGl("the hair's shading");
+  }
+  ShadedImage image{Texture(GL_RGBA16F, w, h), Texture(GL_RGBA32F, w, h), true};
+  Framebuffer fb({&image.color, &image.data}, w, h, false);
+  fb.bind();
+  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 6, first.id);
+  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 7, tail.id);
+  glBindTextureUnit(kUnitSubpixelColor, head.color.id);
+  glBindTextureUnit(kUnitSubpixelData, head.data.id);
+  glBindTextureUnit(kUnitAtlasColor, atlasColor.id);
+  glBindTextureUnit(kUnitAtlasData, atlasData.id);
+  const Program& p = *scene.programs.blend;
+  p.use();
+  p.set("uAtlasWidth", atlasWidth);
+  p.set("uImageWidth", w);
+  p.set("uOpacity", float(scene.settings.strandOpacity));
+  glDrawArrays(GL_TRIANGLES, 0, 3);
+  checkGl("the hair's blending");
   return image;
+}
+
+}  // namespace
+
+ShadedImage shadingPass(const Scene& scene, const LightDepth& depth, const Texture& opacity,
+                        size_t& fragments) {
+  const RenderSettings& r = scene.settings;
+  const int w = scene.subpixel.width, h = scene.subpixel.height;
+  ShadedImage image{Texture(GL_RGBA16F, w, h), Texture(GL_RGBA32F, w, h), false};
+  {
+    Framebuffer fb({&image.color, &image.data}, w, h, true);
+    fb.bind();
+    // Premultiplied: what nothing covers is 0 in every channel; the background belongs to the preview.
+    const float background[4] = {0.0f, 0.0f, 0.0f, 0.0f};
+    const float nothing[4] = {kBackgroundZ, 0.0f, 1.0f, 0.0f};
+    const float one = 1.0f;
+    glClearBufferfv(GL_COLOR, 0, background);
+    glClearBufferfv(GL_COLOR, 1, nothing);
+    glClearBufferfv(GL_DEPTH, 0, &one);
+    glEnable(GL_DEPTH_TEST);
+    glBindTextureUnit(kUnitHairStart, depth.hairStart.id);
+    glBindTextureUnit(kUnitHeadDepth, depth.head.id);
+    glBindTextureUnit(kUnitOpacityMap, opacity.id);
+    if (scene.head) {
+      const Program& p = scene.programs.headShade;
+      p.use();
+      setView(p, scene.subpixel);
+      setShadowUniforms(p, scene);
+      p.set("uHeadColor", glm::vec3(r.headColor));
+      scene.head->draw();
+    }
+    if (!scene.rasterised) {
+      const Program& p = *scene.programs.hairShade;
+      useForHairStrips(p, scene, r);
+      setHairShading(p, scene);
+      if (scene.ribbons)
+        scene.hair.draw(true);
+      else
+        scene.hair.drawLines(scene.cameraLines.get());
+    }
+    checkGl("the shading pass");
+  }
+  if (!scene.rasterised) return image;
+  // The hair the head hides is no fragment of the pixel: the rasteriser gets the head's depth.
+  std::vector<float> headDepth(size_t(w) * size_t(h));
+  glBindBuffer(GL_PIXEL_PACK_BUFFER, 0);  // into client memory, not a readback buffer
+  glGetTextureImage(image.data.id, 0, GL_RED, GL_FLOAT, GLsizei(headDepth.size() * sizeof(float)),
+                    headDepth.data());
+  checkGl("reading the head's depth");
+  const CameraFragments f =
+      rasteriseCameraFragments(*scene.strands, scene.subpixel, r.strandWidth, scene.kept, headDepth.data());
+  headDepth = {};
+  fragments = f.count();
+  return blendHair(scene, f, image);
 }
 
 ShadedImage resolvePass(const Scene& scene, const ShadedImage& subpixels) {
   const int w = scene.camera.width, h = scene.camera.height;
-  ShadedImage image{Texture(GL_RGBA32F, w, h), Texture(GL_RGBA32F, w, h)};
+  ShadedImage image{Texture(GL_RGBA32F, w, h), Texture(GL_RGBA32F, w, h), true};
   Framebuffer fb({&image.color, &image.data}, w, h, false);
   fb.bind();
   glDisable(GL_DEPTH_TEST);
   const Program& p = scene.programs.resolve;
   p.use();
   p.set("uBlock", scene.block);
+  p.set("uBlended", subpixels.blended ? 1 : 0);
   glBindTextureUnit(kUnitSubpixelColor, subpixels.color.id);
   glBindTextureUnit(kUnitSubpixelData, subpixels.data.id);
   glBindVertexArray(scene.hair.vao);  // core profile draws need a vertex array; the triangle reads none

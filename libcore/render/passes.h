@@ -5,7 +5,10 @@
 //   2. deepOpacityPass: 4 layers from where the hair begins, each strand fragment adding its opacity to
 //                       its layer and every layer behind it;
 //   3. shadingPass:     from the camera on the sub-pixel grid, the head and the hair lit and shadowed
-//                       through both maps;
+//                       through both maps: the head drawn by OpenGL, the hair's kept fragments from
+//                       hairgen's rasteriser (camera_fragments.h) shaded one texel each in an atlas and
+//                       blended front to back over it (a custom HairVert's hair: OpenGL's lines or
+//                       ribbons, opaque samples with a screen door);
 //   4. resolvePass:     each block of sub-pixels box-filtered to a pixel;
 //   (with the previous frame) motionPass and motionResolvePass: the same sub-pixel grid, what is seen
 //                       in each sub-pixel drawn again with its screen motion since the previous frame,
@@ -29,10 +32,14 @@ struct HairLightMaps;  // light_maps.h
 // their place (HairVert in every program that draws hair, HeadVert in every one that draws the head).
 // `block`: k, sub-pixels per pixel side; at 1 the screen door is compiled out of the fragment stages.
 // hairgen's own hair shading stage is compiled for `model`, and for white hair unless `colored`.
+// `rasterised`: the camera's hair comes from hairgen's rasteriser (hairAtlas and blend), else OpenGL
+// draws it (hairShade).
 struct Programs {
   Programs(bool ribbons, int block, const CustomShaders& custom, bool motion, ShadingModel model,
-           bool colored);
-  Program hairDepth, headDepth, opacity, hairShade, headShade, resolve;
+           bool colored, bool rasterised);
+  Program hairDepth, headDepth, opacity, headShade, resolve;
+  std::optional<Program> hairShade;                              // OpenGL's lines or ribbons
+  std::optional<Program> hairAtlas, blend;                       // the rasteriser's fragments
   std::optional<Program> hairMotion, headMotion, motionResolve;  // with the previous frame
 };
 
@@ -44,18 +51,21 @@ struct Scene {
 
   const RenderSettings& settings;
   const Visuality& visuality;
-  BoundingSphere sphere;  // around the hair and the head
-  int block;              // k: sub-pixels per pixel side (Samples = k², as far as the device allows)
-  View camera, subpixel;  // the camera on pixels and on sub-pixels
-  View light;             // domResolution texels per side
-  bool ribbons;           // the shading pass draws ribbons, not lines
-  bool motion;            // the previous frame was given: motion vectors too
+  BoundingSphere sphere;   // around the hair and the head
+  int block;               // k: sub-pixels per pixel side (Samples = k², as far as the device allows)
+  View camera, subpixel;   // the camera on pixels and on sub-pixels
+  View light;              // domResolution texels per side
+  bool ribbons;            // OpenGL draws the camera's hair as ribbons, not lines
+  bool motion;             // the previous frame was given: motion vectors too
+  bool rasterised;         // the camera's hair comes from hairgen's rasteriser (not a custom HairVert)
+  int kept;                // the fragments kept per sub-pixel (RenderInput::keptFragments)
+  const Strands* strands;  // the hair, as RenderInput gives it (the camera's rasteriser reads it)
   glm::dmat4 viewProj{1.0}, previousViewProj{1.0};  // world to clip: this frame's camera, the previous one's
   // What the CPU prepares for drawing while the GL objects below are made (passes.cpp).
   struct Preparation;
   std::unique_ptr<Preparation> preparing;
   HairGeometry hair;
-  // The hair as chords for the shading pass when it draws lines (null: every point; a custom HairVert
+  // The hair as chords when OpenGL draws the camera's lines (null: every point; a custom HairVert
   // always gets every point, since what it does to them is its own).
   std::unique_ptr<LineStrips> cameraLines;
   // The light's hair maps from hairgen's rasteriser (light_maps.h); null when OpenGL draws them from
@@ -79,15 +89,18 @@ struct LightDepth {
 
 // An image the shading pass draws and the resolve averages.
 struct ShadedImage {
-  Texture color;  // R G B of what was drawn (0 where nothing was), A unused (the resolve counts coverage)
+  Texture color;  // R G B of what was drawn (0 where nothing was), A (with `blended`) as the data says
   Texture data;   // Z (metres along the camera's axis), hair opacity, shadow (the light arriving)
+  bool blended;   // R G B premultiplied and A the blended opacity; else opaque samples (A unused)
 };
 
 LightDepth lightDepthPass(const Scene& scene);
 // RGBA32F, one layer per channel, the light's map size.
 Texture deepOpacityPass(const Scene& scene, const LightDepth& depth);
-// At sub-pixel resolution.
-ShadedImage shadingPass(const Scene& scene, const LightDepth& depth, const Texture& opacity);
+// At sub-pixel resolution; `fragments`: how many hair fragments the rasteriser kept (0 when OpenGL drew
+// the hair).
+ShadedImage shadingPass(const Scene& scene, const LightDepth& depth, const Texture& opacity,
+                        size_t& fragments);
 // At the image's resolution.
 ShadedImage resolvePass(const Scene& scene, const ShadedImage& subpixels);
 // At sub-pixel resolution, RGBA32F: motion u, v (pixels of the image), 1 where something was drawn.

@@ -1,15 +1,16 @@
 // Hair rendering with deep opacity maps (Yuksel & Keyser 2008, as the thesis uses them in §4.1.6).
 //
-// Strands are read by the vertex shader from storage buffers. A strand that is thinner than about a
-// pixel everywhere in the view (real hair, unless the camera is very close) is drawn as a line strip;
-// a wider one as a camera-facing ribbon StrandWidth wide (two vertices per point, a triangle strip).
-// Either way a strand is at least one pixel wide with StrandOpacity as its opacity.
+// The hair is drawn by hairgen's own integer rasteriser (hair_raster.h) for the light's maps and for
+// the camera (camera_fragments.h): at its true width, each pixel's nearest fragments kept in depth
+// order. OpenGL draws the head, shades every kept fragment with the hair's fragment stage, and blends
+// each pixel's fragments front to back over the head. A custom HairVert, whose vertices only OpenGL can
+// place, gets OpenGL's lines (or ribbons where a strand is wider than about a pixel and a half) at least
+// a pixel wide instead, opaque samples with a screen door.
 //
-// Antialiasing is supersampling: Samples = k² renders the shading pass at k times the resolution
-// (k = round(√Samples)), ribbons k sub-pixels wide, and a strand's opacity becomes screen-door
-// coverage of each k×k block (an ordered threshold per sub-pixel: order-independent, no sorting, the
-// same result on every run). A resolve pass box-filters each block: colour, hair opacity and shadow
-// are averaged, Z is the nearest. (llvmpipe's multisampled lines cost four times as much.)
+// Antialiasing: hair's coverage is exact at any Samples; Samples = k² renders the shading pass at k
+// times the resolution (k = round(√Samples)) for the head's edges and the order of strands within a
+// pixel, and a resolve pass box-filters each block: colour, A, hair opacity and shadow are averaged,
+// Z is the nearest.
 //
 // The pieces: gl_resources.h (the GL objects), views.h (camera and light), shader_interface.h (what
 // C++ and GLSL share), glsl/ (the stages), passes.h (one function per pass).
@@ -45,7 +46,11 @@ RenderOutput renderHair(GlContext&, const RenderInput& in) {
   out.timings.upload = seconds(clock);
   out.hairReadInPlace = scene.hair.readsStrandsInPlace();
   out.lightMapsOnCpu = scene.lightMaps != nullptr;
-  if (in.uploaded && !out.hairReadInPlace) in.uploaded();
+  // The hair is read no more once the device holds a copy, and the camera's rasteriser has drawn it.
+  auto released = [&] {
+    if (in.uploaded && !out.hairReadInPlace) in.uploaded();
+  };
+  if (!scene.rasterised) released();
   auto passDone = [&] {
     if (in.progress) in.progress->advance();
   };
@@ -58,7 +63,8 @@ RenderOutput renderHair(GlContext&, const RenderInput& in) {
   scene.releaseLightMaps();
   out.timings.opacity = seconds(clock);
   passDone();
-  const ShadedImage image = resolvePass(scene, shadingPass(scene, depth, opacity));
+  const ShadedImage image = resolvePass(scene, shadingPass(scene, depth, opacity, out.hairFragments));
+  if (scene.rasterised) released();
   out.timings.shading = seconds(clock);
   passDone();
   std::optional<Texture> motion;

@@ -15,6 +15,7 @@
 #include "libcore/model/image.h"
 #include "libcore/model/mesh.h"
 #include "libcore/model/strands.h"
+#include "libcore/render/camera_fragments.h"
 #include "libcore/render/custom_shaders.h"
 #include "libcore/render/shader_interface.h"
 #include "libcore/util/progress.h"
@@ -24,11 +25,12 @@ namespace hairgen {
 class GlContext;
 
 // The beauty image's channels (DESIGN §6): R G B A premultiplied (a pixel nothing covers is 0 in all
-// four; A is the fraction of its sub-pixels the hair or the head covers), Z, and the AOVs as layers a
+// four; A is the share of its light the hair and the head stop), Z, and the AOVs as layers a
 // compositor sorts, each a single grey channel: OpenEXR names a layer's channels LAYER.CHANNEL and a
 // grey channel Y, so Nuke shows them as the layers opacity and shadow.
-inline constexpr const char* kChannelOpacity = "opacity.Y";  // hair coverage, 0-1
-inline constexpr const char* kChannelShadow = "shadow.Y";    // the light that arrives, 1 in the open
+inline constexpr const char* kChannelOpacity =
+    "opacity.Y";  // the light the hair stops in front of the head, 0-1
+inline constexpr const char* kChannelShadow = "shadow.Y";  // the light that arrives, 1 in the open
 // With the previous frame (render --motion), Nuke's motion layer: how far what covers the pixel moved on
 // the image since the previous frame, in pixels, u to the right and v up; 0 where nothing is drawn.
 inline constexpr const char* kChannelMotionU = "motion.u";
@@ -53,6 +55,7 @@ struct RenderOutput {
   int samples = 1;               // the samples used (Samples, clamped to what the device offers)
   bool hairReadInPlace = false;  // whether the device read the hair where it lay (RenderInput::readInPlace)
   bool lightMapsOnCpu = false;   // whether the CPU drew the light's hair maps (RenderInput::lightMaps)
+  size_t hairFragments = 0;      // the camera's kept hair fragments (camera_fragments.h), at the sub-pixels
   RenderSettings settings;       // what was rendered: the input's, with the camera and light the render stage
                                  // aimed when asked to frame the hair
 };
@@ -84,12 +87,16 @@ struct RenderInput {
   enum class LightMaps { kAuto, kCpu, kGl };
   LightMaps lightMaps = LightMaps::kAuto;
   // Called once renderHair reads the hair (and the frame before's) no more, so the caller may free
-  // it: after the upload when the device holds a copy (the passes then do not run with both held);
-  // after the last pass that draws it when the device reads it in place (readInPlace).
+  // it: when the device holds a copy, after the upload (a custom HairVert's) or after the shading pass
+  // (whose rasteriser reads the hair); after the last pass that draws it when the device reads it in
+  // place (readInPlace).
   std::function<void()> uploaded;
   // Let the device read the hair's large arrays where they lie, where it can (GL_AMD_pinned_memory,
   // llvmpipe): no copy, no second coupe held while it is made. The same images either way.
   bool readInPlace = true;
+  // The hair fragments blended per sub-pixel, nearest first (camera_fragments.h); those behind blend as
+  // one layer. kReferenceFragments with Samples 64 is the converged reference (render --reference).
+  int keptFragments = kKeptFragments;
 };
 
 // The passes renderHair reports to its Progress: upload, light depth, opacity, shading, (motion,)

@@ -7,10 +7,12 @@
 
 #include "glsl/embedded_glsl.h"
 #include "libcore/config/params.h"
+#include "libcore/render/camera_fragments.h"
+#include "libcore/render/hair_raster.h"
 
 namespace hairgen {
 
-static_assert(kUnitSubpixelMotion + 1 == kTextureUnitCount, "kTextureUnitCount counts every TextureUnit");
+static_assert(kUnitAtlasData + 1 == kTextureUnitCount, "kTextureUnitCount counts every TextureUnit");
 
 const char* name(TextureUnit unit) {
   switch (unit) {
@@ -25,9 +27,13 @@ const char* name(TextureUnit unit) {
     case kUnitSubpixelData:
       return "kUnitSubpixelData";
     case kUnitSubpixelMotion:
+      return "kUnitSubpixelMotion";
+    case kUnitAtlasColor:
+      return "kUnitAtlasColor";
+    case kUnitAtlasData:
       break;
   }
-  return "kUnitSubpixelMotion";
+  return "kUnitAtlasData";
 }
 
 namespace {
@@ -70,6 +76,9 @@ std::string glslConstants() {
   out += "const float kShadowOffsetHead = " + glslFloat(kShadowOffsetHead) + ";\n";
   out += "const float kShadowBiasHeadDepth = " + glslFloat(kShadowBiasHeadDepth) + ";\n";
   out += "const float kBackgroundZ = " + glslFloat(kBackgroundZ) + ";\n";
+  out += "const uint kCoverageOne = " + std::to_string(kCoverageOne) + "u;\n";
+  out += "const int kCoverageBits = " + std::to_string(kCoverageBits) + ";\n";
+  out += "const uint kSpanUnit = " + std::to_string(kSpanUnit) + "u;\n";
   return out;
 }
 

@@ -17,8 +17,10 @@ enum TextureUnit : int {
   kUnitSubpixelColor = 3,  // RGBA16F, the shading pass's sub-pixels: color and opacity
   kUnitSubpixelData = 4,   // RGBA32F, the shading pass's sub-pixels: Z, hair opacity, shadow
   kUnitSubpixelMotion = 5,  // RGBA32F, the motion pass's sub-pixels: motion u, v (pixels), covered
+  kUnitAtlasColor = 6,      // RGBA16F, the camera's kept hair fragments shaded: color and opacity
+  kUnitAtlasData = 7,       // RGBA16F, the same fragments: Z, hair opacity, shadow
 };
-inline constexpr int kTextureUnitCount = 6;
+inline constexpr int kTextureUnitCount = 8;
 
 // The unit's name as C++ and GLSL spell it ("kUnitHairStart").
 const char* name(TextureUnit unit);
@@ -57,7 +59,8 @@ struct StagePrelude {
 };
 
 // The GLSL constants: `const int kShading<Name> = <value>;` for every ShadingModel (the name from
-// name(ShadingModel) in camel case, e.g. kShadingKajiyaKay), every TextureUnit, and the shadow biases.
+// name(ShadingModel) in camel case, e.g. kShadingKajiyaKay), every TextureUnit, the shadow biases, and
+// how the camera's fragments are packed (camera_fragments.h).
 std::string glslConstants();
 
 // `#version 450 core`, RIBBON and MOTION where asked, glslConstants(), the functions asked for, then `#line

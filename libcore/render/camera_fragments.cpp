@@ -1,0 +1,118 @@
+#include "libcore/render/camera_fragments.h"
+
+#include <algorithm>
+#include <bit>
+
+#include <tbb/parallel_for.h>
+
+#include "libcore/render/hair_raster.h"
+
+namespace hairgen {
+
+namespace {
+
+// A kept fragment while its band is drawn.
+struct Slot {
+  int32_t depth;      // kDepthUnit: its nearest piece's
+  uint32_t origin;    // its first piece's segment (its first point), which orders equal depths
+  uint32_t point;     // the segment of its largest piece, where it is shaded
+  uint32_t last;      // the last segment merged into it
+  uint32_t coverage;  // kCoverageOne per pixel, all its pieces'
+  uint32_t largest;   // its largest piece's coverage
+  uint32_t span;      // where its largest piece lies along its segment, 1/kSpanUnit
+  bool nearer(const Slot& o) const { return depth != o.depth ? depth < o.depth : origin < o.origin; }
+};
+
+uint32_t spanOf(raster::Piece piece) {
+  return uint32_t(piece.twice * int64_t(kSpanUnit) / (2 * piece.length));
+}
+
+// One pixel's kept fragments, `n` of `kept`, nearest first; `tail` its coverage behind them.
+void keep(Slot* list, uint8_t& n, uint32_t& tail, int kept, int32_t depth, uint32_t coverage, uint32_t point,
+          raster::Piece piece) {
+  // Segments come in the order of their first point, so a piece of the same strand from the same
+  // segment or the one before merges into its fragment (points are one strand's when one apart: a
+  // segment joins a point to the next of its strand).
+  for (int k = 0; k < n; ++k) {
+    Slot& s = list[k];
+    if (point - s.last > 1) continue;
+    s.coverage += coverage;
+    s.last = point;
+    if (coverage > s.largest) {  // shaded where most of it is
+      s.largest = coverage;
+      s.point = point;
+      s.span = spanOf(piece);
+    }
+    if (depth < s.depth) {
+      s.depth = depth;
+      for (int j = k; j > 0 && list[j].nearer(list[j - 1]); --j) std::swap(list[j], list[j - 1]);
+    }
+    return;
+  }
+  const Slot fresh{depth, point, point, point, coverage, coverage, 0};
+  if (n == kept) {
+    if (!fresh.nearer(list[n - 1])) {
+      tail += coverage;
+      return;
+    }
+    tail += list[--n].coverage;
+  }
+  int j = n++;
+  for (; j > 0 && fresh.nearer(list[j - 1]); --j) list[j] = list[j - 1];
+  list[j] = fresh;
+  list[j].span = spanOf(piece);
+}
+
+}  // namespace
+
+CameraFragments rasteriseCameraFragments(const Strands& hair, const View& camera, double strandWidth,
+                                         int kept, const float* opaque) {
+  kept = std::clamp(kept, 1, 255);  // a pixel counts its fragments in a byte
+  const raster::Bands bands = raster::projectIntoBands(hair, camera, strandWidth);
+  const size_t width = size_t(camera.width), pixels = width * size_t(camera.height);
+  CameraFragments out;
+  out.width = camera.width;
+  out.height = camera.height;
+  out.tail.assign(pixels, 0);
+  std::vector<uint32_t> counts(pixels, 0);
+  std::vector<std::vector<uint32_t>> bandWords(size_t(bands.count));
+  tbb::parallel_for(0, bands.count, [&](int band) {
+    const size_t base = size_t(band) * raster::kBandRows * width;
+    const size_t end = std::min(pixels, base + raster::kBandRows * width);
+    std::vector<Slot> slots((end - base) * size_t(kept));
+    std::vector<uint8_t> used(end - base, 0);
+    bands.eachFragment<raster::Across::kBox>(band, [&](size_t texel, int32_t depth, uint32_t coverage,
+                                                       uint32_t point, raster::Piece piece) {
+      // Compared as the blend compares them: the fragment's depth as the float it is stored as.
+      if (opaque && float(double(depth) * kDepthUnit) >= opaque[texel]) return;
+      const size_t local = texel - base;
+      keep(&slots[local * size_t(kept)], used[local], out.tail[texel], kept, depth, coverage, point, piece);
+    });
+    std::vector<uint32_t>& words = bandWords[size_t(band)];
+    for (size_t p = 0; p < end - base; ++p) {
+      counts[base + p] = used[p];
+      for (int k = 0; k < used[p]; ++k) {
+        const Slot& s = slots[p * size_t(kept) + size_t(k)];
+        const float metres = float(double(s.depth) * kDepthUnit);
+        words.insert(words.end(), {s.point, std::bit_cast<uint32_t>(metres),
+                                   std::min(s.coverage, kCoverageOne) | (s.span << kCoverageBits)});
+      }
+    }
+  });
+  out.first.resize(pixels + 1);
+  uint32_t total = 0;
+  for (size_t p = 0; p < pixels; ++p) {
+    out.first[p] = total;
+    total += counts[p];
+  }
+  out.first[pixels] = total;
+  out.words.resize(size_t(total) * 3);
+  tbb::parallel_for(0, bands.count, [&](int band) {
+    const std::vector<uint32_t>& words = bandWords[size_t(band)];
+    const size_t at = 3 * size_t(out.first[size_t(band) * raster::kBandRows * width]);
+    std::copy(words.begin(), words.end(), out.words.begin() + ptrdiff_t(at));
+  });
+  return out;
+}
+
+}  // namespace hairgen

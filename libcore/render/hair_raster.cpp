@@ -1,0 +1,101 @@
+#include "libcore/render/hair_raster.h"
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+namespace hairgen::raster {
+
+namespace {
+
+constexpr size_t kBinChunk = size_t(1) << 14;  // segments a thread sorts into bands at once
+// A point this many image widths off the image is dropped with its segments: what it could reach of
+// the image is a ribbon the view's field already holds whole (it is made to hold the scene's sphere).
+constexpr int64_t kFarOff = 4;
+// The widest strand drawn, texels: wider is drawn this wide. With points within kFarOff image widths of
+// an image of at most 2^15 texels (OpenGL's largest), a segment is shorter than 2^27 in 1/kSubTexel, so
+// width × length × a piece's length stays below 2^28 · 2^27 · 2^8 = 2^63: every product fits 64 bits.
+constexpr double kWidest = 4096.0;
+
+}  // namespace
+
+Bands projectIntoBands(const Strands& hair, const View& v, double strandWidth) {
+  Bands out;
+  out.width = v.width;
+  out.height = v.height;
+  // Every point projected as the view places it, then quantised: from here on, integers.
+  const glm::dmat4 toClip = v.proj * v.view;
+  const glm::dvec4 depthRow(-v.view[0][2], -v.view[1][2], -v.view[2][2], -v.view[3][2]);
+  const double halfX = 0.5 * v.width, halfY = 0.5 * v.height;
+  const double farOff = double(kFarOff * std::max(v.width, v.height));
+  std::vector<Vertex>& vertices = out.vertices;
+  vertices.resize(hair.points.size());
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, hair.points.size(), 1 << 14),
+                    [&](const tbb::blocked_range<size_t>& r) {
+                      for (size_t i = r.begin(); i < r.end(); ++i) {
+                        Vertex& q = vertices[i];
+                        q = {0, 0, -1, 0};
+                        const glm::dvec4 p(glm::dvec3(hair.points[i]), 1.0);
+                        const glm::dvec4 clip = toClip * p;
+                        if (!(clip.w > 0.0) || clip.z < -clip.w) continue;  // nearer than the near plane
+                        const double x = (clip.x / clip.w + 1.0) * halfX, y = (clip.y / clip.w + 1.0) * halfY;
+                        const double depth = glm::dot(depthRow, p);
+                        if (!(std::abs(x - halfX) < farOff && std::abs(y - halfY) < farOff)) continue;
+                        if (!(depth > 0.0 && depth / kDepthUnit < 2.0e9)) continue;
+                        const double width = strandWidth * v.focalPx / depth;
+                        q = {int32_t(std::lround(x * kSubTexel)), int32_t(std::lround(y * kSubTexel)),
+                             int32_t(std::lround(depth / kDepthUnit)),
+                             int32_t(std::lround(std::min(width, kWidest) * kWidthUnit))};
+                      }
+                    });
+  // The segments: each pair of consecutive points of a strand, both drawn; by their first point.
+  std::vector<uint32_t>& segments = out.segments;
+  segments.reserve(hair.points.size());
+  for (size_t s = 0; s + 1 < hair.firstPoint.size(); ++s)
+    for (uint32_t i = hair.firstPoint[s]; i + 1 < hair.firstPoint[s + 1]; ++i)
+      if (vertices[i].depth >= 0 && vertices[i + 1].depth >= 0) segments.push_back(i);
+  // Each segment's bands: the rows its fragments can fall in.
+  const int height = v.height;
+  const int bands = out.count = (height + kBandRows - 1) / kBandRows;
+  auto bandsOf = [&](size_t s, int& lo, int& hi) {
+    const Vertex &a = vertices[segments[s]], &b = vertices[segments[s] + 1];
+    const int64_t reach = std::max(a.width, b.width) / (2 * (kWidthUnit / kSubTexel)) + 2 * kSubTexel;
+    const int64_t low = floorDiv(std::min(a.y, b.y) - reach, kSubTexel);
+    const int64_t high = floorDiv(std::max(a.y, b.y) + reach, kSubTexel);
+    lo = 1, hi = 0;
+    if (high < 0 || low >= height) return;
+    lo = int(std::max<int64_t>(low, 0)) / kBandRows;
+    hi = int(std::min<int64_t>(high, height - 1)) / kBandRows;
+  };
+  // Sorted into the bands by counting, chunk by chunk.
+  const size_t chunks = (segments.size() + kBinChunk - 1) / kBinChunk;
+  std::vector<uint32_t> counts(chunks * size_t(bands), 0);
+  tbb::parallel_for(size_t(0), chunks, [&](size_t c) {
+    for (size_t s = c * kBinChunk; s < std::min(segments.size(), (c + 1) * kBinChunk); ++s) {
+      int lo, hi;
+      bandsOf(s, lo, hi);
+      for (int b = lo; b <= hi; ++b) ++counts[c * bands + b];
+    }
+  });
+  out.bandFirst.assign(size_t(bands) + 1, 0);
+  size_t total = 0;
+  for (int b = 0; b < bands; ++b) {
+    out.bandFirst[size_t(b)] = total;
+    for (size_t c = 0; c < chunks; ++c) {
+      const uint32_t n = counts[c * bands + b];
+      counts[c * bands + b] = uint32_t(total);
+      total += n;
+    }
+  }
+  out.bandFirst[size_t(bands)] = total;
+  out.bandSegments.resize(total);
+  tbb::parallel_for(size_t(0), chunks, [&](size_t c) {
+    for (size_t s = c * kBinChunk; s < std::min(segments.size(), (c + 1) * kBinChunk); ++s) {
+      int lo, hi;
+      bandsOf(s, lo, hi);
+      for (int b = lo; b <= hi; ++b) out.bandSegments[counts[c * bands + b]++] = uint32_t(s);
+    }
+  });
+  return out;
+}
+
+}  // namespace hairgen::raster

@@ -1,0 +1,240 @@
+// hairgen's own hair rasteriser, shared by the light's maps (light_maps.h) and the camera's view
+// (camera_fragments.h), so both see a strand with the same arithmetic on every machine.
+//
+// Every point is projected once in double precision and quantised: window x and y to 1/kSubTexel of a
+// texel (or pixel), depth along the view's axis to kDepthUnit, the strand's projected width to
+// 1/kWidthUnit of a texel. From there on everything is integer arithmetic. Each segment is a thin
+// ribbon of the strand's width (Kajiya & Kay's cylinder seen from the view), cut at the texel
+// boundaries along its major axis (x or y, whichever it moves more along): each piece covers the
+// strand's width × its true length within that texel column (or row), exactly. Across, the piece's
+// cross-section (the ribbon's extent there) is shared among the texels by a filter (Across): each
+// texel's box, so a texel gets the area of the ribbon that lies in it (the camera's analytic
+// coverage), or a tent one texel either side of each texel centre, smoother still (the light's maps,
+// which a shadow lookup then interpolates). Either way the filters sum to one everywhere, so the shares
+// sum to the piece's area (the last takes the rounding), the inside of a strand wider than a texel is
+// covered exactly once, and what is drawn changes continuously as a strand moves, however thin. Pure
+// math: no OpenGL.
+//
+// The image is cut into bands of kBandRows rows, each segment listed in every band it can reach, in
+// the order of its first point; a caller draws each band on one thread, its segments in that order, so
+// what it keeps does not depend on the thread count.
+#pragma once
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <vector>
+
+#include "libcore/model/strands.h"
+#include "libcore/render/views.h"
+
+namespace hairgen {
+
+// Window positions are kept in 1/kSubTexel texel: 8 bits of sub-texel position, as GPUs snap vertices.
+inline constexpr int kSubTexel = 256;
+// A strand's projected width in 1/kWidthUnit texel, so a strand a tenth of a texel wide covers what it
+// should to 0.2% (products with a length in 1/kSubTexel still fit in 64 bits).
+inline constexpr int kWidthUnit = 1 << 16;
+// Depth along the view's axis in whole micrometres: a 40 µm strand is 40 units, and 2^31 units reach
+// 2 km.
+inline constexpr double kDepthUnit = 1.0e-6;
+// A texel fully covered once, in coverage units.
+inline constexpr uint32_t kCoverageOne = 1u << 16;
+
+namespace raster {
+
+inline constexpr int kBandRows = 32;  // rows a thread draws at once
+
+// A share's product needs 76 bits: GCC's and Clang's 128-bit integer (one multiply on x86-64).
+__extension__ using Uint128 = unsigned __int128;
+
+// Rounds toward −∞, so positions left of and right of 0 are split into texels alike.
+inline int64_t floorDiv(int64_t a, int64_t b) {
+  const int64_t q = a / b;
+  return (a % b != 0 && ((a < 0) != (b < 0))) ? q - 1 : q;
+}
+
+// A point as the rasteriser reads it: x, y in 1/kSubTexel texel (window, y up), depth in kDepthUnit,
+// the strand's projected width in 1/kWidthUnit texel; depth −1 when the point is not drawn.
+struct Vertex {
+  int32_t x, y, depth, width;
+};
+
+// Where a fragment's piece lies along its segment: its middle at twice / (2·length) of the way from
+// the segment's first point, both along the major axis in 1/kSubTexel.
+struct Piece {
+  int64_t twice, length;
+};
+
+// base + ⌊d·t / (2n)⌋ for t = t0, t0 + 2·kSubTexel, t0 + 4·kSubTexel, …: exact, with one division to
+// start and none after.
+class MidpointStep {
+ public:
+  MidpointStep(int64_t base, int64_t d, int64_t n, int64_t t0) : den_(2 * n) {
+    q_ = floorDiv(d * t0, den_);
+    r_ = d * t0 - q_ * den_;
+    q_ += base;
+    stepQ_ = floorDiv(2 * kSubTexel * d, den_);
+    stepR_ = 2 * kSubTexel * d - stepQ_ * den_;
+  }
+  int64_t value() const { return q_; }
+  void next() {
+    q_ += stepQ_;
+    r_ += stepR_;
+    if (r_ >= den_) {
+      r_ -= den_;
+      ++q_;
+    }
+  }
+
+ private:
+  int64_t den_, q_, r_, stepQ_, stepR_;
+};
+
+// How a piece's cross-section is shared among the texels across it (above).
+enum class Across { kBox, kTent };
+
+// The share of the cross-section [below, above] (1/kSubTexel texel) that texel m's filter holds, and
+// what every texel's shares sum to.
+template <Across across>
+int64_t acrossShare(int64_t m, int64_t below, int64_t above) {
+  const int64_t start = m * kSubTexel;
+  if constexpr (across == Across::kBox) {
+    return std::max<int64_t>(0, std::min(above, start + kSubTexel) - std::max(below, start));
+  } else {
+    // 2·kSubTexel² × the integral of the tent 1 − |u| (u in texels from the centre) up to x.
+    auto integral = [](int64_t x) -> int64_t {
+      if (x <= -kSubTexel) return 0;
+      if (x >= kSubTexel) return 2 * kSubTexel * kSubTexel;
+      return x < 0 ? (x + kSubTexel) * (x + kSubTexel)
+                   : 2 * kSubTexel * kSubTexel - (kSubTexel - x) * (kSubTexel - x);
+    };
+    const int64_t centre = start + kSubTexel / 2;
+    return integral(above - centre) - integral(below - centre);
+  }
+}
+template <Across across>
+constexpr int64_t acrossTotal(int64_t extent) {
+  return across == Across::kBox ? extent : 2 * kSubTexel * extent;
+}
+
+// Calls fragment(column, row, depth, coverage, piece) for each texel the segment a → b covers,
+// coverage in kCoverageOne per texel; `rowLo`, `rowHi`: the rows wanted (others may come too). Along
+// the segment's major axis it is cut at the texel boundaries: a piece of length o along that axis
+// covers the strand's width × its true length, w·o·L/|du|, exactly. Across, the piece's cross-section,
+// its extent w·L/|du| about the piece's middle, is shared among the texels by `across`. Which
+// fragments a segment has does not depend on the rows asked for.
+template <Across across, class F>
+void rasteriseSegment(Vertex a, Vertex b, int64_t rowLo, int64_t rowHi, F&& fragment) {
+  const bool alongX = std::abs(int64_t(b.x) - a.x) >= std::abs(int64_t(b.y) - a.y);
+  auto major = [&](const Vertex& v) { return int64_t(alongX ? v.x : v.y); };
+  auto minor = [&](const Vertex& v) { return int64_t(alongX ? v.y : v.x); };
+  const bool reversed = major(a) > major(b);
+  if (reversed) std::swap(a, b);
+  const int64_t u0 = major(a), u1 = major(b), v0 = minor(a);
+  const int64_t du = u1 - u0, dv = minor(b) - v0, dz = int64_t(b.depth) - a.depth;
+  if (du == 0) return;  // seen end on: no length, no area
+  // The square root of an integer below 2^53 is correctly rounded in double: the same on every machine;
+  // rounded to the nearest 1/kSubTexel, so short segments are not all a little short.
+  const uint64_t length = uint64_t(std::llround(std::sqrt(double(du * du + dv * dv))));
+  const uint64_t width = (uint64_t(a.width) + uint64_t(b.width)) / 2;  // 1/kWidthUnit texel
+  // The ribbon's extent across the major axis, 1/kWidthUnit texel; half of it in 1/kSubTexel, at least
+  // one (a thinner ribbon is shared as a line is).
+  const uint64_t extent = width * length / uint64_t(du);
+  const int64_t halfExtent =
+      std::max<int64_t>(1, int64_t((extent + kWidthUnit / kSubTexel) / (2 * (kWidthUnit / kSubTexel))));
+  // The reciprocal of what the shares of the cross-section sum to, in 1/2^40, so a texel's part of a
+  // piece's area is a multiplication and a shift.
+  const uint64_t perExtent = (uint64_t(1) << 40) / uint64_t(acrossTotal<across>(2 * halfExtent));
+  // The texels along the major axis, [first, last], narrowed to those that can reach the rows.
+  int64_t first = u0 >> 8, last = (u1 - 1) >> 8;
+  const int64_t reach = int64_t(extent / (2 * (kWidthUnit / kSubTexel))) + 2 * kSubTexel;
+  if (!alongX) {
+    first = std::max(first, rowLo);
+    last = std::min(last, rowHi - 1);
+  } else if (dv != 0) {
+    // v at a piece's middle is v0 + dv·(u − u0)/du; found in double with two texels to spare either
+    // side (a texel whose fragments fall outside the rows is dropped by the caller).
+    double c0 =
+        (double(u0) + (double(rowLo * kSubTexel - reach) - double(v0)) * double(du) / double(dv)) / kSubTexel;
+    double c1 =
+        (double(u0) + (double(rowHi * kSubTexel + reach) - double(v0)) * double(du) / double(dv)) / kSubTexel;
+    if (c0 > c1) std::swap(c0, c1);
+    if (c0 > double(last) + 2.0 || c1 < double(first) - 2.0) return;
+    first = std::max(first, int64_t(std::floor(c0)) - 2);
+    last = std::min(last, int64_t(std::ceil(c1)) + 2);
+  } else if (v0 + reach < rowLo * kSubTexel || v0 - reach >= rowHi * kSubTexel) {
+    return;
+  }
+  const uint64_t perArea = uint64_t(du) * (uint64_t(kWidthUnit) * kSubTexel / kCoverageOne);
+  static_assert(kSubTexel == 256);
+  // A whole texel's piece: its area, and its middle's v and depth stepped from texel to texel (the
+  // middle moves 2·kSubTexel in `twice` a texel); a piece cut by the segment's end is computed on its own.
+  const uint64_t wholeArea = (width * kSubTexel * length + perArea / 2) / perArea;
+  const int64_t twiceFirst = 2 * first * kSubTexel + kSubTexel - 2 * u0;
+  MidpointStep vStep(v0, dv, du, twiceFirst), depthStep(a.depth, dz, du, twiceFirst);
+  for (int64_t c = first; c <= last; ++c, vStep.next(), depthStep.next()) {
+    const int64_t lo = std::max(u0, c * kSubTexel), hi = std::min(u1, (c + 1) * kSubTexel);
+    if (hi <= lo) continue;
+    const bool whole = hi - lo == kSubTexel;
+    // The piece's middle, as a fraction of the segment: (lo + hi − 2·u0) / (2·du).
+    const int64_t twice = lo + hi - 2 * u0;
+    const int64_t v = whole ? vStep.value() : v0 + floorDiv(dv * twice, 2 * du);
+    const int32_t depth = int32_t(whole ? depthStep.value() : a.depth + floorDiv(dz * twice, 2 * du));
+    // w·o·L/|du|: 1/(kWidthUnit·kSubTexel) texel², to kCoverageOne per texel², rounded.
+    const uint64_t area = whole ? wholeArea : (width * uint64_t(hi - lo) * length + perArea / 2) / perArea;
+    // Where the piece lies from the caller's first point (the points were swapped when reversed).
+    const Piece piece{reversed ? 2 * du - twice : twice, du};
+    // The texels across whose filters reach the cross-section [v − halfExtent, v + halfExtent].
+    const int64_t below = v - halfExtent, above = v + halfExtent;
+    const int64_t reachOut = across == Across::kBox ? 0 : kSubTexel / 2;
+    const int64_t mFirst = floorDiv(below - reachOut, kSubTexel);
+    const int64_t mLast = floorDiv(above + reachOut - 1, kSubTexel);
+    uint64_t given = 0;
+    for (int64_t m = mFirst; m <= mLast; ++m) {
+      uint64_t share = area - given;
+      if (m < mLast)
+        share = uint64_t(Uint128(area * uint64_t(acrossShare<across>(m, below, above))) * perExtent >> 40);
+      given += share;
+      if (alongX)
+        fragment(c, m, depth, uint32_t(share), piece);
+      else
+        fragment(m, c, depth, uint32_t(share), piece);
+    }
+  }
+}
+
+// The hair as a view sees it, quantised, and its segments sorted into bands of rows.
+struct Bands {
+  int width = 0, height = 0, count = 0;  // the image's texels; bands of kBandRows rows
+  std::vector<Vertex> vertices;          // one per point
+  std::vector<uint32_t> segments;        // each drawn segment's first point, in order
+  std::vector<size_t> bandFirst;         // band b's segments: bandSegments[bandFirst[b], bandFirst[b + 1])
+  std::vector<uint32_t> bandSegments;    // indices into `segments`, in order within each band
+
+  // Calls fragment(texel, depth, coverage, segment's first point, piece) for every fragment of every
+  // segment of `band` that falls on the image within the band's rows, in the order of the segments;
+  // texel = row · width + column.
+  template <Across across, class F>
+  void eachFragment(int band, F&& fragment) const {
+    const int64_t rowLo = int64_t(band) * kBandRows, rowHi = std::min<int64_t>(height, rowLo + kBandRows);
+    for (size_t k = bandFirst[size_t(band)]; k < bandFirst[size_t(band) + 1]; ++k) {
+      const uint32_t point = segments[bandSegments[k]];
+      rasteriseSegment<across>(vertices[point], vertices[point + 1], rowLo, rowHi,
+                               [&](int64_t i, int64_t j, int32_t depth, uint32_t coverage, Piece piece) {
+                                 if (coverage == 0 || j < rowLo || j >= rowHi || i < 0 || i >= width) return;
+                                 fragment(size_t(j) * size_t(width) + size_t(i), depth, coverage, point,
+                                          piece);
+                               });
+    }
+  }
+};
+
+// Projects the hair with `v` (its width × height texels) and sorts its segments into bands.
+// `strandWidth`: the strands' diameter, metres. A segment with a point nearer than the near plane, or
+// far off the image, is dropped.
+Bands projectIntoBands(const Strands& hair, const View& v, double strandWidth);
+
+}  // namespace raster
+
+}  // namespace hairgen
