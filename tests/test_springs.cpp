@@ -450,6 +450,30 @@ TEST(Springs, ThreadsAndRestartsChangeNoBit) {
 // A restart state is an input: every state a simulation could not have written is refused before a step
 // (a position 1e200 m or 1e30 m away crashed the process or resumed into strands 1e16 m long), and so is
 // the state of other rest guides with the same strand layout, or of a hairgen that did not record them.
+// restart_state.h's bounds on one segment of 1 cm, the rule the step and a restart both apply: within
+// kMaxSpringStretch (1%) of its rest length, slower than kMaxSpringSpeed, finite; checked in that order.
+TEST(Springs, ASegmentsBoundsAreItsStretchSpeedAndFiniteness) {
+  const glm::dvec3 root(0.0), still(0.0);
+  const double rest = 0.01;
+  auto at = [&](double length) { return glm::dvec3(0.0, -length, 0.0); };
+  EXPECT_FALSE(springSegmentFault(root, at(0.0100999), glm::dvec3(999.0, 0.0, 0.0), rest));
+  EXPECT_FALSE(springSegmentFault(root, at(0.0099001), still, rest));
+  const auto stretched = springSegmentFault(root, at(0.0102), glm::dvec3(2000.0, 0.0, 0.0), rest);
+  ASSERT_TRUE(stretched);
+  EXPECT_EQ(stretched->kind, SpringSegmentFault::kStretch);  // before the speed
+  EXPECT_NEAR(stretched->value, 0.02, 1e-12);
+  const auto squeezed = springSegmentFault(root, at(0.0098), still, rest);
+  ASSERT_TRUE(squeezed);
+  EXPECT_NEAR(squeezed->value, -0.02, 1e-12);
+  const auto fast = springSegmentFault(root, at(rest), glm::dvec3(0.0, 0.0, -1001.0), rest);
+  ASSERT_TRUE(fast);
+  EXPECT_EQ(fast->kind, SpringSegmentFault::kSpeed);
+  EXPECT_DOUBLE_EQ(fast->value, 1001.0);
+  const auto nan = springSegmentFault(root, at(0.02), glm::dvec3(std::nan(""), 0.0, 0.0), rest);
+  ASSERT_TRUE(nan);
+  EXPECT_EQ(nan->kind, SpringSegmentFault::kNotFinite);  // before the stretch
+}
+
 TEST(Springs, ARestartStateNoSimulationWritesIsRefused) {
   HeadKey start, turned;
   turned.frame = 6;

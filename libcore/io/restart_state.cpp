@@ -35,6 +35,23 @@ void mix(uint64_t& hash, const void* data, size_t bytes) {
   for (; i < bytes; ++i) hash = (hash ^ p[i]) * kPrime;
 }
 
+}  // namespace
+
+std::optional<SpringSegmentFault> springSegmentFault(const glm::dvec3& start, const glm::dvec3& end,
+                                                     const glm::dvec3& velocity, double restLength) {
+  if (!std::isfinite(end.x) || !std::isfinite(end.y) || !std::isfinite(end.z) || !std::isfinite(velocity.x) ||
+      !std::isfinite(velocity.y) || !std::isfinite(velocity.z))
+    return SpringSegmentFault{};
+  const double stretch = glm::length(end - start) / restLength - 1.0;
+  if (!(std::abs(stretch) <= kMaxSpringStretch))
+    return SpringSegmentFault{SpringSegmentFault::kStretch, stretch};
+  const double speed = glm::length(velocity);
+  if (!(speed <= kMaxSpringSpeed)) return SpringSegmentFault{SpringSegmentFault::kSpeed, speed};
+  return std::nullopt;
+}
+
+namespace {
+
 void checkSpringState(const Strands& rest, const std::vector<double>& state, const std::string& source) {
   const size_t segments = rest.pointCount() - rest.strandCount();
   if (state.size() != segments * kSpringStateValues)
@@ -56,18 +73,16 @@ void checkSpringState(const Strands& rest, const std::vector<double>& state, con
                                           std::to_string(j) + " " + what +
                                           "; no simulation writes that: simulate from the first frame");
       };
-      for (int c = 0; c < 6; ++c)
-        if (!std::isfinite(v[c])) refuse("holds a value that is not finite");
       const double restLength =
           glm::length(glm::dvec3(rest.points[p0 + j]) - glm::dvec3(rest.points[p0 + j - 1]));
-      if (!(restLength > 0.0)) refuse("follows a rest segment of no length");
-      const double stretch = glm::length(x - previous) / restLength - 1.0;
-      if (!(std::abs(stretch) <= kMaxSpringStretch))
-        refuse("ends a segment " + formatReal(100.0 * stretch) + "% off its rest length (the bound is " +
+      const std::optional<SpringSegmentFault> fault = springSegmentFault(previous, x, velocity, restLength);
+      if (fault && fault->kind == SpringSegmentFault::kNotFinite) refuse("holds a value that is not finite");
+      if (!(restLength > 0.0)) refuse("follows a rest segment of no length");  // the guides', not the state's
+      if (fault && fault->kind == SpringSegmentFault::kStretch)
+        refuse("ends a segment " + formatReal(100.0 * fault->value) + "% off its rest length (the bound is " +
                formatReal(100.0 * kMaxSpringStretch) + "%)");
-      const double speed = glm::length(velocity);
-      if (!(speed <= kMaxSpringSpeed))
-        refuse("moves at " + formatReal(speed) + " m/s (the bound is " + formatReal(kMaxSpringSpeed) +
+      if (fault)
+        refuse("moves at " + formatReal(fault->value) + " m/s (the bound is " + formatReal(kMaxSpringSpeed) +
                " m/s)");
       previous = x;
     }
