@@ -5,37 +5,15 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdio>
 #include <cstring>
 
 #include <glm/glm.hpp>
 
 #include "libcore/util/error.h"
+#include "libcore/util/fnv.h"
 #include "libcore/util/text.h"
 
 namespace hairgen {
-namespace {
-
-// FNV-1a's step over 64-bit words in four independent lanes (then bytes for the tail), so that a
-// coupe's megabytes of rest points hash at memory speed rather than one dependent multiply a byte: the
-// digest is computed at every simulate call. An identity for equal inputs, not a cryptographic hash.
-void mix(uint64_t& hash, const void* data, size_t bytes) {
-  constexpr uint64_t kPrime = 0x100000001b3ull;
-  const auto* p = static_cast<const unsigned char*>(data);
-  uint64_t lanes[4] = {hash, hash ^ 1, hash ^ 2, hash ^ 3};
-  size_t i = 0;
-  for (; i + sizeof lanes <= bytes; i += sizeof lanes)
-    for (size_t l = 0; l < 4; ++l) {
-      uint64_t word;
-      std::memcpy(&word, p + i + l * sizeof word, sizeof word);
-      lanes[l] = (lanes[l] ^ word) * kPrime;
-    }
-  hash = lanes[0];
-  for (size_t l = 1; l < 4; ++l) hash = (hash ^ lanes[l]) * kPrime;
-  for (; i < bytes; ++i) hash = (hash ^ p[i]) * kPrime;
-}
-
-}  // namespace
 
 std::optional<SpringSegmentFault> springSegmentFault(const glm::dvec3& start, const glm::dvec3& end,
                                                      const glm::dvec3& velocity, double restLength) {
@@ -131,15 +109,13 @@ size_t anjyoStateSize(const Strands& rest) {
 }
 
 std::string restGuidesDigest(const Strands& rest) {
-  uint64_t hash = 0xcbf29ce484222325ull;
+  // fnv1aLanes: the digest is computed at every simulate call, over megabytes of points.
   const uint64_t counts[2] = {rest.strandCount(), rest.pointCount()};
-  mix(hash, counts, sizeof counts);
-  mix(hash, rest.firstPoint.data(), rest.firstPoint.size() * sizeof(uint32_t));
-  mix(hash, rest.points.data(), rest.points.size() * sizeof(glm::vec3));
-  mix(hash, rest.tangents.data(), rest.tangents.size() * sizeof(glm::vec3));
-  char hex[17];
-  std::snprintf(hex, sizeof hex, "%016llx", static_cast<unsigned long long>(hash));
-  return hex;
+  uint64_t hash = fnv1aLanes(counts, sizeof counts, kFnvOffsetBasis);
+  hash = fnv1aLanes(rest.firstPoint.data(), rest.firstPoint.size() * sizeof(uint32_t), hash);
+  hash = fnv1aLanes(rest.points.data(), rest.points.size() * sizeof(glm::vec3), hash);
+  hash = fnv1aLanes(rest.tangents.data(), rest.tangents.size() * sizeof(glm::vec3), hash);
+  return formatDigest(hash);
 }
 
 void checkStateValues(const Strands& rest, const std::vector<double>& state, DynamicsModel model,
