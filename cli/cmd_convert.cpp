@@ -128,10 +128,9 @@ void registerConvert(CLI::App& app, int& exitCode) {
       "Convert strands between .hair, .gltf, .glb, .ply and .data, or export them to .usda (format from the "
       "extension); with --frames, a sequence frame by frame, or into one animated .usda");
   cmd->add_option("IN", options->input,
-                  "Input .hair, .gltf, .glb, .ply or .data (#### for a frame with --frames)")
+                  "Input " + readHairExtensionList() + " (#### for a frame with --frames)")
       ->required();
-  cmd->add_option("OUT", options->output,
-                  "Output .hair, .gltf, .glb, .ply, .data or .usda (written atomically); or -o");
+  cmd->add_option("OUT", options->output, "Output " + hairExtensionList() + " (written atomically); or -o");
   cmd->add_option("-o,--output", options->outputFlag, "The output, instead of OUT")->type_name("FILE");
   addUnitFlags(*cmd, options->units, "IN");
   cmd->add_flag("--ascii", options->ascii, "Write a .ply as ASCII text instead of binary little-endian");

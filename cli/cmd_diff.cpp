@@ -3,6 +3,7 @@
 // hairgen diff A.hair B.hair: the same for two hair caches, point by point within a distance
 // (diffHair() in libcore/io/hair_diff.h).
 #include <iostream>
+#include <optional>
 
 #include "cli/commands.h"
 #include "cli/common.h"
@@ -52,12 +53,22 @@ struct DiffArgs {
   std::vector<const CLI::Option*> imageFlags, cacheFlags;  // to refuse one kind's flags on the other
 };
 
+// Whether `file` names a hair cache rather than an image; a hair format hairgen only writes is refused.
+bool isCache(const std::string& file) {
+  const std::optional<HairFormat> format = hairFormatFor(file);
+  if (format && !hairgenReads(*format))
+    throw InputError({file, 0}, std::string("diff reads hair caches (") + readHairExtensionList() +
+                                    ") and images; hairgen writes " + describe(*format) +
+                                    " but does not read it");
+  return format.has_value();
+}
+
 // Either two hair caches or two images; a flag of the other kind is a usage error.
 bool comparesCaches(const DiffArgs& options) {
-  const bool a = hairFormatFor(options.a).has_value(), b = hairFormatFor(options.b).has_value();
+  const bool a = isCache(options.a), b = isCache(options.b);
   if (a != b)
     throw InputError((a ? options.a : options.b) + " is a hair cache and " + (a ? options.b : options.a) +
-                     " is not; compare two images or two caches");
+                     " is not; compare two images or two caches (" + readHairExtensionList() + ")");
   for (const CLI::Option* flag : a ? options.imageFlags : options.cacheFlags)
     if (flag->count() > 0)
       throw InputError(flag->get_name() + " applies to " + (a ? "images" : "hair caches") + ", not to " +
@@ -98,7 +109,7 @@ void registerDiff(CLI::App& app, int& exitCode) {
       "point by point (mean and max distance, normals, colours): pass, or fail with exit 4");
   cmd->add_option("A", options->a,
                   "The reference: an image (any format OpenImageIO reads) or a hair cache (" +
-                      hairExtensionList() + ")")
+                      readHairExtensionList() + ")")
       ->required();
   cmd->add_option("B", options->b, "The image or cache to check")->required();
   auto& image = options->imageFlags;

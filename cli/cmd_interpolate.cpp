@@ -63,17 +63,14 @@ void registerInterpolate(CLI::App& app, int& exitCode) {
       "Fill every wick triangle with strands blended from its corner guides (clumping, stray hairs); with "
       "--frames, every frame of a simulated sequence, each with the same strands, ids and weights");
   cmd->add_option("SETUP", options->setup, "The Setup file")->required();
-  cmd->add_option(
-         "--guides", options->guides,
-         "Guides from `hairgen grow` on the same Setup (.hair, .gltf, .glb, .ply, .data); with --frames a "
-         "pattern such as sim/guides.####.hair")
+  cmd->add_option("--guides", options->guides,
+                  "Guides from `hairgen grow` on the same Setup (" + readHairExtensionList() +
+                      "); with --frames a pattern such as sim/guides.####.hair")
       ->type_name("FILE")
       ->required();
   addUnitFlags(*cmd, options->units, "the guides");
-  cmd->add_option(
-         "-o,--output", options->output,
-         "Coupe to write: .hair, .gltf, .glb, .ply, .data or .usda (written atomically); with --frames a "
-         "pattern")
+  cmd->add_option("-o,--output", options->output,
+                  "Coupe to write: " + hairExtensionList() + " (written atomically); with --frames a pattern")
       ->type_name("FILE")
       ->required();
   cmd->add_option("--frames", options->frames, "Interpolate these frames of a sequence")->type_name("A-B");

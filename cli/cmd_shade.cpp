@@ -159,7 +159,7 @@ void registerShade(CLI::App& app, int& exitCode) {
          "SETUP", options->first,
          "The Setup file (Render Info, Visuality Info, Hairstyle's Seed); with --rest, the deformed coupe")
       ->type_name("SETUP|COUPE");
-  cmd->add_option("--hair", options->hair, "The coupe (.hair, .gltf, .glb, .ply, .data)")->type_name("FILE");
+  cmd->add_option("--hair", options->hair, "The coupe (" + readHairExtensionList() + ")")->type_name("FILE");
   addUnitFlags(*cmd, options->units, "the coupe");
   cmd->add_option("--rest", options->rest,
                   "A coupe shaded at rest; its normals are carried onto the coupe by "

@@ -2,7 +2,8 @@
 # `hairgen diff A.hair B.hair` as scripts and the goldens use it: exit 0 for the same hair, 4 for hair
 # beyond the tolerance or of another structure (with the figures and the reason on stdout), 2 for a cache
 # against an image, a flag of the other kind, or an unreadable file; the same caches in another format
-# compare equal.
+# compare equal. The help and the errors name exactly the cache formats diff reads: not .usda, which
+# hairgen only writes.
 source "$(dirname "$0")/cli_lib.sh" "$@"
 
 fixture="$src/golden/fixtures/guides-default-quarter.hair"
@@ -41,6 +42,16 @@ usage)
   expect_rc 2 "$hairgen" diff "$src/golden/default/reference.exr" "$src/golden/default/reference.exr" --tolerance 1
   expect_err "--tolerance applies to hair caches"
   expect_rc 2 "$hairgen" diff "$fixture" "$tmp/absent.hair"
+  ;;
+formats)
+  readable=".hair, .gltf, .glb, .ply, .data"
+  expect_rc 0 "$hairgen" diff --help
+  grep -qF "a hair cache ($readable)" "$tmp/out" || fail "help lists other formats: $(grep -F cache "$tmp/out")"
+  expect_rc 0 "$hairgen" convert "$fixture" "$tmp/guides.usda" --quiet
+  expect_rc 2 "$hairgen" diff "$fixture" "$tmp/guides.usda"
+  expect_err "$tmp/guides.usda: diff reads hair caches ($readable) and images; hairgen writes USD"
+  expect_rc 2 "$hairgen" diff "$fixture" "$src/golden/default/reference.exr"
+  expect_err "compare two images or two caches ($readable)"
   ;;
 *) fail "unknown case" ;;
 esac

@@ -379,6 +379,28 @@ TEST(Usd, AShotRefusesFramesOfOtherStrandsAndCachesWithoutTheirTime) {
   EXPECT_NE(readFileText(dir / "shot.usda").find("timeCodesPerSecond = 30\n"), std::string::npos);
 }
 
+// The one table of formats says which are read; readStrands must read exactly those, and the list the
+// commands print for their inputs must name exactly those.
+TEST(Formats, ReadStrandsReadsExactlyTheFormatsListedAsRead) {
+  test::TempDir dir("formats");
+  const Strands s = test::sampleStrands(3);
+  std::string readable;
+  std::istringstream known(hairExtensionList());
+  for (std::string ext; known >> ext;) {
+    if (ext.back() == ',') ext.pop_back();
+    const std::filesystem::path file = dir / ("s" + ext);
+    writeStrands(file, s);
+    if (hairgenReads(hairFormatOf(file))) {
+      EXPECT_EQ(readStrands(file).strandCount(), s.strandCount()) << ext;
+      readable += (readable.empty() ? "" : ", ") + ext;
+    } else {
+      EXPECT_THROW(readStrands(file), InputError) << ext;
+    }
+  }
+  EXPECT_EQ(readHairExtensionList(), readable);
+  EXPECT_EQ(readable.find(".usda"), std::string::npos);  // USD is export only (DESIGN §6)
+}
+
 TEST(Provenance, AConvertedFileSaysWhereItCameFromThroughEveryFormat) {
   test::TempDir dir("prov");
   const std::vector<uint8_t> data = encodeHairSalon(test::sampleStrands(3));

@@ -281,6 +281,44 @@ Strands someGuides(const Config& config, size_t every) {
   return grow(few, config.hairstyle, config.collision, GrowOptions{}).guides;
 }
 
+// DESIGN §2: gravity acts on moving hair. A hanging chain with no bending swings at ω = 1.2024 sqrt(g/L)
+// (above): through the simulate stage, set by the Gravity keys a TD writes, a steady side wind sets a
+// 30 cm chain swinging, and its period shortens by sqrt(30/9.81) when Gravity is 30 instead of 9.81,
+// whether Dynamics Gravity or Hairstyle Gravity says so.
+TEST(Springs, GravitySetsTheSwingPeriodOfHangingHair) {
+  const double length = 0.3;
+  Strands rest;
+  rest.addStrand(straight({0, 0, 0}, {0, -1, 0}, length, 16));
+  auto period = [&](double hairstyleGravity, std::optional<double> dynamicsGravity) {
+    Config config = springJob({}, {{1, {0.2, 0.0, 0.0}, false, {}}}, 400);
+    config.collision = Collision{};
+    config.dynamics.damping = 0.0;
+    config.dynamics.frameRate = 100.0;
+    config.dynamics.bendStiffnessAuto = config.dynamics.twistStiffnessAuto = false;
+    config.dynamics.bendStiffness = config.dynamics.twistStiffness = 0.0;
+    config.hairstyle.gravity = hairstyleGravity;
+    config.dynamics.gravityAuto = !dynamicsGravity;
+    config.dynamics.gravity = dynamicsGravity.value_or(0.0);
+    std::vector<double> tip;
+    simulate(rest, config, frames(config, {1, 400}),
+             [&](int, const Strands& guides) { tip.push_back(guides.points.back().x); });
+    double mean = 0.0;
+    for (double x : tip) mean += x / double(tip.size());
+    for (double& x : tip) x -= mean;
+    const std::vector<double> crossings = test::downCrossings(tip, 1.0 / config.dynamics.frameRate);
+    EXPECT_GE(crossings.size(), 4u);
+    return crossings.size() < 2 ? 0.0 : meanPeriod(crossings);
+  };
+  const double earth = period(9.81, std::nullopt), heavy = period(9.81, 30.0), heavyStyle = period(30.0, {});
+  const double continuum = 2.0 * M_PI / (1.2024 * std::sqrt(9.81 / length));
+  EXPECT_NEAR(earth / continuum, 1.0, 0.03) << "period " << earth << " s, continuum " << continuum << " s";
+  EXPECT_NEAR(earth / heavy, std::sqrt(30.0 / 9.81), 0.02 * std::sqrt(30.0 / 9.81))
+      << earth << " s, " << heavy;
+  EXPECT_NEAR(heavyStyle / heavy, 1.0, 1e-3);
+  RecordProperty("period_9_81", std::to_string(earth));
+  RecordProperty("period_30", std::to_string(heavy));
+}
+
 TEST(Springs, TheGroomedCoupeDoesNotSag) {
   Config config = springJob({}, {}, 240);
   const Strands rest = someGuides(config, 3);
@@ -450,6 +488,30 @@ TEST(Springs, ThreadsAndRestartsChangeNoBit) {
 // A restart state is an input: every state a simulation could not have written is refused before a step
 // (a position 1e200 m or 1e30 m away crashed the process or resumed into strands 1e16 m long), and so is
 // the state of other rest guides with the same strand layout, or of a hairgen that did not record them.
+// restart_state.h's bounds on one segment of 1 cm, the rule the step and a restart both apply: within
+// kMaxSpringStretch (1%) of its rest length, slower than kMaxSpringSpeed, finite; checked in that order.
+TEST(Springs, ASegmentsBoundsAreItsStretchSpeedAndFiniteness) {
+  const glm::dvec3 root(0.0), still(0.0);
+  const double rest = 0.01;
+  auto at = [&](double length) { return glm::dvec3(0.0, -length, 0.0); };
+  EXPECT_FALSE(springSegmentFault(root, at(0.0100999), glm::dvec3(999.0, 0.0, 0.0), rest));
+  EXPECT_FALSE(springSegmentFault(root, at(0.0099001), still, rest));
+  const auto stretched = springSegmentFault(root, at(0.0102), glm::dvec3(2000.0, 0.0, 0.0), rest);
+  ASSERT_TRUE(stretched);
+  EXPECT_EQ(stretched->kind, SpringSegmentFault::kStretch);  // before the speed
+  EXPECT_NEAR(stretched->value, 0.02, 1e-12);
+  const auto squeezed = springSegmentFault(root, at(0.0098), still, rest);
+  ASSERT_TRUE(squeezed);
+  EXPECT_NEAR(squeezed->value, -0.02, 1e-12);
+  const auto fast = springSegmentFault(root, at(rest), glm::dvec3(0.0, 0.0, -1001.0), rest);
+  ASSERT_TRUE(fast);
+  EXPECT_EQ(fast->kind, SpringSegmentFault::kSpeed);
+  EXPECT_DOUBLE_EQ(fast->value, 1001.0);
+  const auto nan = springSegmentFault(root, at(0.02), glm::dvec3(std::nan(""), 0.0, 0.0), rest);
+  ASSERT_TRUE(nan);
+  EXPECT_EQ(nan->kind, SpringSegmentFault::kNotFinite);  // before the stretch
+}
+
 TEST(Springs, ARestartStateNoSimulationWritesIsRefused) {
   HeadKey start, turned;
   turned.frame = 6;

@@ -1,11 +1,11 @@
 #include "libcore/config/params.h"
 
 #include <cmath>
-#include <cstdio>
 #include <numeric>
 #include <sstream>
 #include <stdexcept>
 
+#include "libcore/util/fnv.h"
 #include "libcore/util/text.h"
 
 namespace hairgen {
@@ -97,15 +97,7 @@ double Hairstyle::totalLength() const {
 }
 
 std::string Config::digest() const {
-  std::string text = canonicalText();
-  uint64_t hash = 0xcbf29ce484222325ull;  // FNV-1a, 64 bit
-  for (unsigned char c : text) {
-    hash ^= c;
-    hash *= 0x100000001b3ull;
-  }
-  char hex[17];
-  std::snprintf(hex, sizeof hex, "%016llx", static_cast<unsigned long long>(hash));
-  return hex;
+  return formatDigest(fnv1a(canonicalText()));
 }
 
 }  // namespace hairgen

@@ -327,29 +327,6 @@ class Chunked {
   std::vector<T> buffer_;
 };
 
-// The strands a glTF holds: those of two points or more. A one-point strand (a bare follicle) would be
-// a vertex no segment joins, which generic readers attach to the strand before it.
-struct Kept {
-  std::vector<uint32_t> strands;                    // their indices in the Strands
-  std::vector<std::pair<uint32_t, uint32_t>> runs;  // their points, as runs [begin, end) of indices
-  size_t points = 0;
-};
-
-Kept keptStrands(const Strands& s) {
-  Kept kept;
-  for (size_t i = 0; i < s.strandCount(); ++i) {
-    const uint32_t begin = s.firstPoint[i], end = s.firstPoint[i + 1];
-    if (end - begin < 2) continue;
-    kept.strands.push_back(static_cast<uint32_t>(i));
-    if (!kept.runs.empty() && kept.runs.back().second == begin)
-      kept.runs.back().second = end;
-    else
-      kept.runs.emplace_back(begin, end);
-    kept.points += end - begin;
-  }
-  return kept;
-}
-
 // One accessor and its tightly packed bufferView. Every component hairgen writes is 4 bytes.
 struct Array {
   Array(int componentType_, int components_, size_t count_, int target_, std::function<void(Sink&)> write_)
@@ -367,32 +344,18 @@ struct Array {
   size_t bytes() const { return count * size_t(components) * 4; }
 };
 
-// A per-vertex array as it lies in memory, run by run.
-template <typename T>
-std::function<void(Sink&)> vertexBytes(const Kept& kept, const T* values) {
-  return [&kept, values](Sink& sink) {
-    for (const auto& [begin, end] : kept.runs) sink.write(values + begin, (end - begin) * sizeof(T));
-  };
+// An array as it lies in memory.
+template <typename T, class A>
+std::function<void(Sink&)> arrayBytes(const std::vector<T, A>& values) {
+  return [&values](Sink& sink) { sink.write(values.data(), values.size() * sizeof(T)); };
 }
 
-// A per-vertex array converted on its way out: value(p) for each point p kept.
+// A per-vertex array converted on its way out: value(p) for each of `points` points.
 template <typename T, class Value>
-std::function<void(Sink&)> vertexValues(const Kept& kept, Value value) {
-  return [&kept, value](Sink& sink) {
+std::function<void(Sink&)> vertexValues(size_t points, Value value) {
+  return [points, value](Sink& sink) {
     Chunked<T> out(sink);
-    for (const auto& [begin, end] : kept.runs)
-      for (uint32_t p = begin; p < end; ++p) out.push(value(p));
-    out.flush();
-  };
-}
-
-// A per-strand array, the kept strands' entries.
-template <typename T>
-std::function<void(Sink&)> strandBytes(const Kept& kept, const std::vector<T>& values) {
-  return [&kept, &values](Sink& sink) {
-    if (kept.strands.size() == values.size()) return sink.write(values.data(), values.size() * sizeof(T));
-    Chunked<T> out(sink);
-    for (uint32_t i : kept.strands) out.push(values[i]);
+    for (size_t p = 0; p < points; ++p) out.push(value(p));
     out.flush();
   };
 }
@@ -401,21 +364,10 @@ const char* typeName(int components) {
   return components == 1 ? "SCALAR" : components == 2 ? "VEC2" : "VEC3";
 }
 
-}  // namespace
-
-void encodeGltf(std::ostream& out, const Strands& s, bool binary, size_t* droppedStrands) {
-  s.validate("strands to write");
-  if (s.pointCount() == 0) throw InputError("no points to write; a glTF accessor cannot be empty");
-  if (s.pointCount() > UINT32_MAX - 1) throw InputError("too many points for uint32 glTF indices");
-  const Kept kept = keptStrands(s);
-  if (kept.strands.empty())
-    throw InputError("no strand has two points; a LINES primitive needs at least one segment");
-  if (kept.strands.size() >= kMaxStrands)
-    throw InputError(
-        std::to_string(kept.strands.size()) +
-        " strands are too many for glTF's float _STRAND attribute (exact below 16777216); use .hair");
-  if (droppedStrands) *droppedStrands = s.strandCount() - kept.strands.size();
-  const size_t strands = kept.strands.size(), points = kept.points;
+// Writes strands of two points or more each (checked by encodeGltf); `dropped` one-point strands were
+// left out of them.
+void encodeLines(std::ostream& out, const Strands& s, bool binary, size_t dropped) {
+  const size_t strands = s.strandCount(), points = s.pointCount();
 
   std::vector<Array> arrays;
   nlohmann::ordered_json attributes = nlohmann::ordered_json::object();
@@ -436,31 +388,25 @@ void encodeGltf(std::ostream& out, const Strands& s, bool binary, size_t* droppe
   const size_t indices = add(
       Array(kUintComponent, 1, 2 * (points - strands), TINYGLTF_TARGET_ELEMENT_ARRAY_BUFFER, [&](Sink& sink) {
         Chunked<uint32_t> index(sink);
-        uint32_t first = 0;
-        for (uint32_t i : kept.strands) {
-          const uint32_t n = s.firstPoint[i + 1] - s.firstPoint[i];
-          for (uint32_t v = first; v + 1 < first + n; ++v) {
+        for (size_t i = 0; i < strands; ++i)
+          for (uint32_t v = s.firstPoint[i]; v + 1 < s.firstPoint[i + 1]; ++v) {
             index.push(v);
             index.push(v + 1);
           }
-          first += n;
-        }
         index.flush();
       }));
-  Array position(kFloatComponent, 3, points, TINYGLTF_TARGET_ARRAY_BUFFER,
-                 vertexBytes(kept, s.points.data()));
+  Array position(kFloatComponent, 3, points, TINYGLTF_TARGET_ARRAY_BUFFER, arrayBytes(s.points));
   glm::vec3 lo(std::numeric_limits<float>::max()), hi(std::numeric_limits<float>::lowest());
-  for (const auto& [begin, end] : kept.runs)
-    for (uint32_t p = begin; p < end; ++p) {
-      lo = glm::min(lo, s.points[p]);
-      hi = glm::max(hi, s.points[p]);
-    }
+  for (const glm::vec3& p : s.points) {
+    lo = glm::min(lo, p);
+    hi = glm::max(hi, p);
+  }
   position.min = {double(lo.x), double(lo.y), double(lo.z)};
   position.max = {double(hi.x), double(hi.y), double(hi.z)};
   attributes["POSITION"] = add(std::move(position));
   if (!s.normals.empty())
     // glTF requires unit normals; ones already unit to float precision are kept bit for bit.
-    vertex("NORMAL", 3, vertexValues<glm::vec3>(kept, [&](uint32_t p) {
+    vertex("NORMAL", 3, vertexValues<glm::vec3>(points, [&](size_t p) {
              const glm::vec3 n = s.normals[p];
              const float length = glm::length(n);
              if (!(length > 0.0f)) return glm::vec3(0.0f, 1.0f, 0.0f);
@@ -470,39 +416,35 @@ void encodeGltf(std::ostream& out, const Strands& s, bool binary, size_t* droppe
     // glTF colours lie in [0, 1]. A shaded coupe's per-strand ambient coefficient may pass 1: COLOR_0
     // holds the colours clamped, and _COLOR the values themselves, which a reader prefers.
     vertex("COLOR_0", 3,
-           vertexValues<glm::vec3>(kept, [&](uint32_t p) { return glm::clamp(s.colors[p], 0.0f, 1.0f); }));
+           vertexValues<glm::vec3>(points, [&](size_t p) { return glm::clamp(s.colors[p], 0.0f, 1.0f); }));
     bool outside = false;
-    for (const auto& [begin, end] : kept.runs)
-      for (uint32_t p = begin; p < end && !outside; ++p)
-        outside = glm::clamp(s.colors[p], 0.0f, 1.0f) != s.colors[p];
-    if (outside) vertex("_COLOR", 3, vertexBytes(kept, s.colors.data()));
+    for (size_t p = 0; p < points && !outside; ++p)
+      outside = glm::clamp(s.colors[p], 0.0f, 1.0f) != s.colors[p];
+    if (outside) vertex("_COLOR", 3, arrayBytes(s.colors));
   }
-  if (!s.transparency.empty()) vertex("_TRANSPARENCY", 1, vertexBytes(kept, s.transparency.data()));
-  if (!s.tangents.empty()) vertex("_TANGENT", 3, vertexBytes(kept, s.tangents.data()));
+  if (!s.transparency.empty()) vertex("_TRANSPARENCY", 1, arrayBytes(s.transparency));
+  if (!s.tangents.empty()) vertex("_TANGENT", 3, arrayBytes(s.tangents));
   // Every vertex has a width, the default where the strands carry none, so an importer that reads
   // _THICKNESS never sees zero; asset.extras.thicknessFromDefault tells hairgen to drop it again.
   if (s.thickness.empty())
-    vertex("_THICKNESS", 1, vertexValues<float>(kept, [&](uint32_t) { return s.defaultThickness; }));
+    vertex("_THICKNESS", 1, vertexValues<float>(points, [&](size_t) { return s.defaultThickness; }));
   else
-    vertex("_THICKNESS", 1, vertexBytes(kept, s.thickness.data()));
+    vertex("_THICKNESS", 1, arrayBytes(s.thickness));
   // Each vertex's strand: the index of its strand's entry in the per-strand accessors.
   vertex("_STRAND", 1, [&](Sink& sink) {
     Chunked<float> strandOf(sink);
-    for (size_t k = 0; k < strands; ++k) {
-      const uint32_t i = kept.strands[k];
-      for (uint32_t p = s.firstPoint[i]; p < s.firstPoint[i + 1]; ++p) strandOf.push(static_cast<float>(k));
-    }
+    for (size_t i = 0; i < strands; ++i)
+      for (uint32_t p = s.firstPoint[i]; p < s.firstPoint[i + 1]; ++p) strandOf.push(static_cast<float>(i));
     strandOf.flush();
   });
   // Per-strand data once per strand: accessors no vertex stage reads, named in the primitive's extras.
   // Not vertex attributes, so ids are UNSIGNED_INT and exact whatever their size.
-  if (!s.strandId.empty()) strand("_STRAND_ID", kUintComponent, 1, strandBytes(kept, s.strandId));
-  if (!s.rootUv.empty()) strand("_ROOT_UV", kFloatComponent, 2, strandBytes(kept, s.rootUv));
-  if (!s.guideIds.empty()) strand("_GUIDE_IDS", kUintComponent, 3, strandBytes(kept, s.guideIds));
-  if (!s.guideWeights.empty())
-    strand("_GUIDE_WEIGHTS", kFloatComponent, 3, strandBytes(kept, s.guideWeights));
-  if (!s.rootTriangle.empty()) strand("_ROOT_TRIANGLE", kUintComponent, 1, strandBytes(kept, s.rootTriangle));
-  if (!s.rootBary.empty()) strand("_ROOT_BARY", kFloatComponent, 3, strandBytes(kept, s.rootBary));
+  if (!s.strandId.empty()) strand("_STRAND_ID", kUintComponent, 1, arrayBytes(s.strandId));
+  if (!s.rootUv.empty()) strand("_ROOT_UV", kFloatComponent, 2, arrayBytes(s.rootUv));
+  if (!s.guideIds.empty()) strand("_GUIDE_IDS", kUintComponent, 3, arrayBytes(s.guideIds));
+  if (!s.guideWeights.empty()) strand("_GUIDE_WEIGHTS", kFloatComponent, 3, arrayBytes(s.guideWeights));
+  if (!s.rootTriangle.empty()) strand("_ROOT_TRIANGLE", kUintComponent, 1, arrayBytes(s.rootTriangle));
+  if (!s.rootBary.empty()) strand("_ROOT_BARY", kFloatComponent, 3, arrayBytes(s.rootBary));
 
   nlohmann::ordered_json accessors = nlohmann::ordered_json::array(), views = nlohmann::ordered_json::array();
   size_t offset = 0;
@@ -549,7 +491,7 @@ void encodeGltf(std::ostream& out, const Strands& s, bool binary, size_t* droppe
   if (!p.source.empty()) extras["source"] = text(p.source);
   if (!p.sourceInfo.empty()) extras["sourceInfo"] = text(p.sourceInfo);
   if (!p.conversion.empty()) extras["conversion"] = text(p.conversion);
-  if (strands < s.strandCount()) extras["onePointStrandsDropped"] = s.strandCount() - strands;
+  if (dropped > 0) extras["onePointStrandsDropped"] = dropped;
 
   nlohmann::ordered_json primitive = {
       {"attributes", attributes}, {"indices", indices}, {"material", 0}, {"mode", TINYGLTF_MODE_LINE}};
@@ -606,6 +548,26 @@ void encodeGltf(std::ostream& out, const Strands& s, bool binary, size_t* droppe
               static_cast<std::streamsize>(json.size() - mark - kMark.size()));
     out.put('\n');
   }
+}
+
+}  // namespace
+
+void encodeGltf(std::ostream& out, const Strands& s, bool binary, size_t* droppedStrands) {
+  s.validate("strands to write");
+  if (s.pointCount() == 0) throw InputError("no points to write; a glTF accessor cannot be empty");
+  if (s.pointCount() > UINT32_MAX - 1) throw InputError("too many points for uint32 glTF indices");
+  const size_t dropped = onePointStrandCount(s), strands = s.strandCount() - dropped;
+  if (strands == 0)
+    throw InputError("no strand has two points; a LINES primitive needs at least one segment");
+  if (strands >= kMaxStrands)
+    throw InputError(
+        std::to_string(strands) +
+        " strands are too many for glTF's float _STRAND attribute (exact below 16777216); use .hair");
+  if (droppedStrands) *droppedStrands = dropped;
+  if (dropped > 0)
+    encodeLines(out, withoutOnePointStrands(s), binary, dropped);
+  else
+    encodeLines(out, s, binary, 0);
 }
 
 std::vector<uint8_t> encodeGltf(const Strands& strands, bool binary, size_t* droppedStrands) {

@@ -24,8 +24,9 @@
 
 namespace hairgen {
 
-// Writes the file to `out` in one pass from `strands` (no array copied whole). `droppedStrands`, when
-// given, gets the number of one-point strands left out. InputError: nothing to write (no strand of two
+// Writes the file to `out` in one pass from `strands` (no array copied whole, unless one-point strands are
+// to be left out: then withoutOnePointStrands copies the rest first). `droppedStrands`, when given, gets
+// the number of one-point strands left out. InputError: nothing to write (no strand of two
 // points), 2^24 strands or more, or a .glb past 4 GiB.
 void encodeGltf(std::ostream& out, const Strands& strands, bool binary, size_t* droppedStrands = nullptr);
 std::vector<uint8_t> encodeGltf(const Strands& strands, bool binary, size_t* droppedStrands = nullptr);

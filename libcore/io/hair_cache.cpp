@@ -15,19 +15,38 @@ struct FormatEntry {
   const char* extension;
   HairFormat format;
   const char* description;
+  bool read;  // readStrands reads it; hairgen writes every format
 };
 constexpr FormatEntry kFormats[] = {
-    {".hair", HairFormat::kHair, "cyHair .hair"},        {".gltf", HairFormat::kGltf, "glTF"},
-    {".glb", HairFormat::kGlb, "binary glTF"},           {".ply", HairFormat::kPly, "PLY"},
-    {".data", HairFormat::kData, "USC-HairSalon .data"}, {".usda", HairFormat::kUsda, "USD (usda)"},
+    {".hair", HairFormat::kHair, "cyHair .hair", true},
+    {".gltf", HairFormat::kGltf, "glTF", true},
+    {".glb", HairFormat::kGlb, "binary glTF", true},
+    {".ply", HairFormat::kPly, "PLY", true},
+    {".data", HairFormat::kData, "USC-HairSalon .data", true},
+    {".usda", HairFormat::kUsda, "USD (usda)", false},
 };
+
+std::string extensionList(bool readOnly) {
+  std::string known;
+  for (const FormatEntry& f : kFormats)
+    if (f.read || !readOnly) known += std::string(known.empty() ? "" : ", ") + f.extension;
+  return known;
+}
 
 }  // namespace
 
 std::string hairExtensionList() {
-  std::string known;
-  for (const FormatEntry& f : kFormats) known += std::string(known.empty() ? "" : ", ") + f.extension;
-  return known;
+  return extensionList(false);
+}
+
+std::string readHairExtensionList() {
+  return extensionList(true);
+}
+
+bool hairgenReads(HairFormat format) {
+  for (const FormatEntry& f : kFormats)
+    if (f.format == format) return f.read;
+  return false;
 }
 
 std::optional<HairFormat> hairFormatFor(const std::filesystem::path& file) {
@@ -57,6 +76,9 @@ void noteSource(Strands& strands, const std::filesystem::path& file) {
 Strands readStrands(const std::filesystem::path& file, const UnitConversion& conversion) {
   Strands strands;
   const HairFormat format = hairFormatOf(file);
+  if (!hairgenReads(format))
+    throw InputError({file.string(), 0}, std::string("hairgen writes ") + describe(format) +
+                                             " but does not read it; it reads " + readHairExtensionList());
   switch (format) {
     case HairFormat::kHair:
       strands = readHair(file);
@@ -71,10 +93,8 @@ Strands readStrands(const std::filesystem::path& file, const UnitConversion& con
     case HairFormat::kData:
       strands = readHairSalon(file);
       break;
-    case HairFormat::kUsda:
-      throw InputError({file.string(), 0},
-                       "hairgen writes USD but does not read it; convert the strands to .hair, .ply or .glb "
-                       "where they were made");
+    case HairFormat::kUsda:  // refused above: hairgenReads is false
+      break;
   }
   noteSource(strands, file);
   const bool statesDefaults =

@@ -22,16 +22,22 @@ enum class HairFormat { kHair, kGltf, kGlb, kPly, kData, kUsda };
 HairFormat hairFormatOf(const std::filesystem::path& file);
 // The same, or nullopt for an extension that names no hair format.
 std::optional<HairFormat> hairFormatFor(const std::filesystem::path& file);
-// The extensions hairFormatOf knows, in its order: ".hair, .gltf, .glb, .ply, .data, .usda".
+// The extensions hairFormatOf knows, in its order: ".hair, .gltf, .glb, .ply, .data, .usda"; writeStrands
+// writes them all.
 std::string hairExtensionList();
+// Those readStrands reads, in the same order: ".hair, .gltf, .glb, .ply, .data" (USD is export only).
+std::string readHairExtensionList();
+// Whether readStrands reads `format`.
+bool hairgenReads(HairFormat format);
 
 // "cyHair .hair", "PLY", ... for messages and `hairgen info`.
 const char* describe(HairFormat format);
 
-// Reads any format hairgen reads, then applies `conversion` (convertToHairgenFrame). A file hairgen did
-// not write (no hairgen provenance) gets its name as Provenance::source, so what is made from it can
-// say where it came from. PLY and .data files state no default width: theirs is hairgen's default, in
-// metres after the conversion (a cyHair header's own default is scaled with the file).
+// Reads any format hairgen reads (hairgenReads; InputError naming them for another), then applies
+// `conversion` (convertToHairgenFrame). A file hairgen did not write (no hairgen provenance) gets its name
+// as Provenance::source, so what is made from it can say where it came from. PLY and .data files state
+// no default width: theirs is hairgen's default, in metres after the conversion (a cyHair header's own
+// default is scaled with the file).
 Strands readStrands(const std::filesystem::path& file, const UnitConversion& conversion = {});
 
 // How formats with a choice are written.

@@ -5,35 +5,30 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdio>
 #include <cstring>
 
 #include <glm/glm.hpp>
 
 #include "libcore/util/error.h"
+#include "libcore/util/fnv.h"
 #include "libcore/util/text.h"
 
 namespace hairgen {
-namespace {
 
-// FNV-1a's step over 64-bit words in four independent lanes (then bytes for the tail), so that a
-// coupe's megabytes of rest points hash at memory speed rather than one dependent multiply a byte: the
-// digest is computed at every simulate call. An identity for equal inputs, not a cryptographic hash.
-void mix(uint64_t& hash, const void* data, size_t bytes) {
-  constexpr uint64_t kPrime = 0x100000001b3ull;
-  const auto* p = static_cast<const unsigned char*>(data);
-  uint64_t lanes[4] = {hash, hash ^ 1, hash ^ 2, hash ^ 3};
-  size_t i = 0;
-  for (; i + sizeof lanes <= bytes; i += sizeof lanes)
-    for (size_t l = 0; l < 4; ++l) {
-      uint64_t word;
-      std::memcpy(&word, p + i + l * sizeof word, sizeof word);
-      lanes[l] = (lanes[l] ^ word) * kPrime;
-    }
-  hash = lanes[0];
-  for (size_t l = 1; l < 4; ++l) hash = (hash ^ lanes[l]) * kPrime;
-  for (; i < bytes; ++i) hash = (hash ^ p[i]) * kPrime;
+std::optional<SpringSegmentFault> springSegmentFault(const glm::dvec3& start, const glm::dvec3& end,
+                                                     const glm::dvec3& velocity, double restLength) {
+  if (!std::isfinite(end.x) || !std::isfinite(end.y) || !std::isfinite(end.z) || !std::isfinite(velocity.x) ||
+      !std::isfinite(velocity.y) || !std::isfinite(velocity.z))
+    return SpringSegmentFault{};
+  const double stretch = glm::length(end - start) / restLength - 1.0;
+  if (!(std::abs(stretch) <= kMaxSpringStretch))
+    return SpringSegmentFault{SpringSegmentFault::kStretch, stretch};
+  const double speed = glm::length(velocity);
+  if (!(speed <= kMaxSpringSpeed)) return SpringSegmentFault{SpringSegmentFault::kSpeed, speed};
+  return std::nullopt;
 }
+
+namespace {
 
 void checkSpringState(const Strands& rest, const std::vector<double>& state, const std::string& source) {
   const size_t segments = rest.pointCount() - rest.strandCount();
@@ -56,18 +51,16 @@ void checkSpringState(const Strands& rest, const std::vector<double>& state, con
                                           std::to_string(j) + " " + what +
                                           "; no simulation writes that: simulate from the first frame");
       };
-      for (int c = 0; c < 6; ++c)
-        if (!std::isfinite(v[c])) refuse("holds a value that is not finite");
       const double restLength =
           glm::length(glm::dvec3(rest.points[p0 + j]) - glm::dvec3(rest.points[p0 + j - 1]));
-      if (!(restLength > 0.0)) refuse("follows a rest segment of no length");
-      const double stretch = glm::length(x - previous) / restLength - 1.0;
-      if (!(std::abs(stretch) <= kMaxSpringStretch))
-        refuse("ends a segment " + formatReal(100.0 * stretch) + "% off its rest length (the bound is " +
+      const std::optional<SpringSegmentFault> fault = springSegmentFault(previous, x, velocity, restLength);
+      if (fault && fault->kind == SpringSegmentFault::kNotFinite) refuse("holds a value that is not finite");
+      if (!(restLength > 0.0)) refuse("follows a rest segment of no length");  // the guides', not the state's
+      if (fault && fault->kind == SpringSegmentFault::kStretch)
+        refuse("ends a segment " + formatReal(100.0 * fault->value) + "% off its rest length (the bound is " +
                formatReal(100.0 * kMaxSpringStretch) + "%)");
-      const double speed = glm::length(velocity);
-      if (!(speed <= kMaxSpringSpeed))
-        refuse("moves at " + formatReal(speed) + " m/s (the bound is " + formatReal(kMaxSpringSpeed) +
+      if (fault)
+        refuse("moves at " + formatReal(fault->value) + " m/s (the bound is " + formatReal(kMaxSpringSpeed) +
                " m/s)");
       previous = x;
     }
@@ -116,15 +109,13 @@ size_t anjyoStateSize(const Strands& rest) {
 }
 
 std::string restGuidesDigest(const Strands& rest) {
-  uint64_t hash = 0xcbf29ce484222325ull;
+  // fnv1aLanes: the digest is computed at every simulate call, over megabytes of points.
   const uint64_t counts[2] = {rest.strandCount(), rest.pointCount()};
-  mix(hash, counts, sizeof counts);
-  mix(hash, rest.firstPoint.data(), rest.firstPoint.size() * sizeof(uint32_t));
-  mix(hash, rest.points.data(), rest.points.size() * sizeof(glm::vec3));
-  mix(hash, rest.tangents.data(), rest.tangents.size() * sizeof(glm::vec3));
-  char hex[17];
-  std::snprintf(hex, sizeof hex, "%016llx", static_cast<unsigned long long>(hash));
-  return hex;
+  uint64_t hash = fnv1aLanes(counts, sizeof counts, kFnvOffsetBasis);
+  hash = fnv1aLanes(rest.firstPoint.data(), rest.firstPoint.size() * sizeof(uint32_t), hash);
+  hash = fnv1aLanes(rest.points.data(), rest.points.size() * sizeof(glm::vec3), hash);
+  hash = fnv1aLanes(rest.tangents.data(), rest.tangents.size() * sizeof(glm::vec3), hash);
+  return formatDigest(hash);
 }
 
 void checkStateValues(const Strands& rest, const std::vector<double>& state, DynamicsModel model,

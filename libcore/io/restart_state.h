@@ -19,8 +19,11 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
+
+#include <glm/glm.hpp>
 
 #include "libcore/config/params.h"
 #include "libcore/model/strands.h"
@@ -35,6 +38,21 @@ namespace hairgen {
 inline constexpr double kMaxSpringStretch = 0.01;
 inline constexpr double kMaxSpringSpeed = 1000.0;  // m/s
 inline constexpr size_t kSpringStateValues = 6;    // per segment: position, velocity
+
+// How a springs segment leaves the bounds above: a position or velocity that is not finite, a stretch
+// `value` = length / rest length − 1 past kMaxSpringStretch, or a speed `value` (m/s) past
+// kMaxSpringSpeed.
+struct SpringSegmentFault {
+  enum Kind { kNotFinite, kStretch, kSpeed };
+  Kind kind = kNotFinite;
+  double value = 0.0;
+};
+// The bounds above on one segment, the one place they are decided (the simulation after each substep,
+// SpringHair::fault(), and a restart state here): the segment from `start` to `end` (metres), whose end
+// point moves at `velocity` (m/s) and whose rest length is `restLength` (> 0, metres). Checks finiteness
+// of `end` and `velocity`, then the stretch, then the speed; returns the first that fails, or nullopt.
+std::optional<SpringSegmentFault> springSegmentFault(const glm::dvec3& start, const glm::dvec3& end,
+                                                     const glm::dvec3& velocity, double restLength);
 
 // Anjyo's layout (anjyo_dynamics.h keeps its state in it) and its bounds: each segment's rotation from
 // its rest direction is at most half a turn, and a turn of more than kMaxAnjyoTurn in a substep is no

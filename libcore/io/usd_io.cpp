@@ -153,41 +153,10 @@ void checkForUsd(const Strands& s) {
 
 // The strands without their one-point strands (linear curves need two points); `dropped` counts them.
 Strands withoutBareFollicles(Strands s, size_t& dropped) {
-  dropped = 0;
-  for (size_t i = 0; i < s.strandCount(); ++i) dropped += s.pointsOf(i) < 2;
+  dropped = onePointStrandCount(s);
   if (dropped == 0) return s;
-  s.validate("strands to write");
-  Strands out;
-  out.firstPoint.assign(1, 0);
-  std::vector<size_t> keptPoints, keptStrands;
-  for (size_t i = 0; i < s.strandCount(); ++i) {
-    if (s.pointsOf(i) < 2) continue;
-    keptStrands.push_back(i);
-    for (uint32_t p = s.firstPoint[i]; p < s.firstPoint[i + 1]; ++p) keptPoints.push_back(p);
-    out.firstPoint.push_back(uint32_t(keptPoints.size()));
-  }
-  auto pick = [](const auto& from, const std::vector<size_t>& at, auto& to) {
-    if (from.empty()) return;
-    to.resize(at.size());
-    for (size_t i = 0; i < at.size(); ++i) to[i] = from[at[i]];
-  };
-  pick(s.points, keptPoints, out.points);
-  pick(s.tangents, keptPoints, out.tangents);
-  pick(s.normals, keptPoints, out.normals);
-  pick(s.colors, keptPoints, out.colors);
-  pick(s.thickness, keptPoints, out.thickness);
-  pick(s.transparency, keptPoints, out.transparency);
-  pick(s.strandId, keptStrands, out.strandId);
-  pick(s.rootTriangle, keptStrands, out.rootTriangle);
-  pick(s.rootBary, keptStrands, out.rootBary);
-  pick(s.rootUv, keptStrands, out.rootUv);
-  pick(s.guideIds, keptStrands, out.guideIds);
-  pick(s.guideWeights, keptStrands, out.guideWeights);
-  out.defaultThickness = s.defaultThickness;
-  out.defaultTransparency = s.defaultTransparency;
-  out.defaultColor = s.defaultColor;
-  out.provenance = std::move(s.provenance);
-  return out;
+  s.validate("strands to write");  // keepStrands' precondition
+  return withoutOnePointStrands(s);
 }
 
 std::vector<uint32_t> curveCounts(const Strands& s) {

@@ -129,6 +129,49 @@ void Strands::validate(const std::string& source) const {
     throw InputError({source, 0}, "header defaults are not finite");
 }
 
+Strands keepStrands(const Strands& s, const std::function<bool(size_t strand)>& keep) {
+  Strands out;
+  std::vector<uint32_t> keptPoints, keptStrands;
+  for (size_t i = 0; i < s.strandCount(); ++i) {
+    if (!keep(i)) continue;
+    keptStrands.push_back(uint32_t(i));
+    for (uint32_t p = s.firstPoint[i]; p < s.firstPoint[i + 1]; ++p) keptPoints.push_back(p);
+    out.firstPoint.push_back(uint32_t(keptPoints.size()));
+  }
+  auto pick = [](const auto& from, const std::vector<uint32_t>& at, auto& to) {
+    if (from.empty()) return;
+    to.resize(at.size());
+    for (size_t i = 0; i < at.size(); ++i) to[i] = from[at[i]];
+  };
+  pick(s.points, keptPoints, out.points);
+  pick(s.tangents, keptPoints, out.tangents);
+  pick(s.normals, keptPoints, out.normals);
+  pick(s.colors, keptPoints, out.colors);
+  pick(s.thickness, keptPoints, out.thickness);
+  pick(s.transparency, keptPoints, out.transparency);
+  pick(s.strandId, keptStrands, out.strandId);
+  pick(s.rootTriangle, keptStrands, out.rootTriangle);
+  pick(s.rootBary, keptStrands, out.rootBary);
+  pick(s.rootUv, keptStrands, out.rootUv);
+  pick(s.guideIds, keptStrands, out.guideIds);
+  pick(s.guideWeights, keptStrands, out.guideWeights);
+  out.defaultThickness = s.defaultThickness;
+  out.defaultTransparency = s.defaultTransparency;
+  out.defaultColor = s.defaultColor;
+  out.provenance = s.provenance;
+  return out;
+}
+
+size_t onePointStrandCount(const Strands& s) {
+  size_t count = 0;
+  for (size_t i = 0; i < s.strandCount(); ++i) count += s.pointsOf(i) < 2;
+  return count;
+}
+
+Strands withoutOnePointStrands(const Strands& s) {
+  return keepStrands(s, [&](size_t i) { return s.pointsOf(i) >= 2; });
+}
+
 PointArray polylineTangents(const Strands& s) {
   PointArray t(s.pointCount(), glm::vec3(0.0f, 1.0f, 0.0f));
   for (size_t i = 0; i < s.strandCount(); ++i) {

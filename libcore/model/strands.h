@@ -2,7 +2,9 @@
 // .hair or glTF cache holds.
 #pragma once
 
+#include <cstddef>
 #include <cstdint>
+#include <functional>
 #include <optional>
 #include <string>
 #include <vector>
@@ -110,6 +112,19 @@ struct Strands {
 
   bool operator==(const Strands&) const = default;
 };
+
+// The strands `keep(i)` holds for, in their order: every per-point array (points, tangents, normals,
+// colors, thickness, transparency) and per-strand array (ids, root triangle, barycentrics and UV, guide
+// ids and weights) that `strands` carries, cut to those strands; the header defaults and the provenance
+// as they were. The simulation state is left out: its layout is a model's, over every strand.
+// Precondition: strands.validate() passes.
+Strands keepStrands(const Strands& strands, const std::function<bool(size_t strand)>& keep);
+
+// How many strands have fewer than two points: bare follicles (USC-HairSalon's one-point strands), which
+// have no segment, so USD's linear curves and glTF's LINES cannot hold them.
+size_t onePointStrandCount(const Strands& strands);
+// keepStrands of the strands of two points or more.
+Strands withoutOnePointStrands(const Strands& strands);
 
 // Unit tangents of every strand's polyline by forward differences (the last point looks back; a
 // repeated point keeps the previous tangent, +y before any), for caches that carry none.

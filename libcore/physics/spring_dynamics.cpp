@@ -13,6 +13,7 @@
 #include "libcore/io/restart_state.h"
 #include "libcore/physics/strand_energy.h"
 #include "libcore/physics/tridiagonal.h"
+#include "libcore/util/atomic_min.h"
 #include "libcore/util/error.h"
 #include "libcore/util/text.h"
 
@@ -458,39 +459,19 @@ std::optional<SpringHair::Fault> SpringHair::checkStrand(size_t s) const {
     within &= length2 >= kLow * rest2 && length2 <= kHigh * rest2 && glm::dot(v_[p], v_[p]) <= kSpeed2;
   }
   if (within) return std::nullopt;
-  // restart_state.h's bounds, in the same arithmetic as checkRestartState's (the rest lengths are the
-  // same doubles), so a state that passes here passes there.
+  // restart_state.h's bounds, by the function checkRestartState uses (the rest lengths are the same
+  // doubles), so a state that passes here passes there.
   for (uint32_t j = 1; j < count; ++j) {
     const uint32_t p = p0 + j;
-    Fault f;
-    f.strand = s;
-    f.point = j;
-    const glm::dvec3 &x = x_[p], &v = v_[p];
-    if (!std::isfinite(x.x) || !std::isfinite(x.y) || !std::isfinite(x.z) || !std::isfinite(v.x) ||
-        !std::isfinite(v.y) || !std::isfinite(v.z))
-      return f;
-    f.value = glm::length(x - x_[p - 1]) / length_[p] - 1.0;
-    if (!(std::abs(f.value) <= kMaxSpringStretch)) {
-      f.kind = Fault::kStretch;
-      return f;
-    }
-    f.value = glm::length(v);
-    if (!(f.value <= kMaxSpringSpeed)) {
-      f.kind = Fault::kSpeed;
-      return f;
-    }
+    if (const std::optional<SpringSegmentFault> f = springSegmentFault(x_[p - 1], x_[p], v_[p], length_[p]))
+      return Fault{*f, s, j};
   }
   return std::nullopt;
 }
 
 void SpringHair::checkStrands(size_t s0, size_t s1, std::atomic<size_t>& first) const {
   for (size_t s = s0; s < s1 && s < first.load(std::memory_order_relaxed); ++s)
-    if (checkStrand(s)) {
-      size_t seen = first.load();
-      while (s < seen && !first.compare_exchange_weak(seen, s)) {
-      }
-      return;
-    }
+    if (checkStrand(s)) return atomicMin(first, s);
 }
 
 void SpringHair::projectStretch(size_t s, double dt, int iterations, std::vector<double>& lambda) {

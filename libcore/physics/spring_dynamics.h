@@ -64,6 +64,7 @@
 #include <glm/glm.hpp>
 
 #include "libcore/config/params.h"
+#include "libcore/io/restart_state.h"
 #include "libcore/model/strands.h"
 #include "libcore/physics/head_motion.h"
 #include "libcore/volume/density_target.h"
@@ -105,15 +106,11 @@ class SpringHair {
   void step(const AccelerationField& field, double dt, bool firstSubstep, bool lastSubstep,
             Kernel kernel = Kernel::kFastest);
 
-  // How a state left its validity: at strand `strand`, point `point` (of the strand, 1 = the end of its
-  // first segment), a value that is not finite, a segment stretched by `value` (length / rest − 1), or
-  // a point moving at `value` m/s.
-  struct Fault {
-    enum Kind { kNotFinite, kStretch, kSpeed };
-    Kind kind = kNotFinite;
+  // How a state left its validity (kind and value: restart_state.h's SpringSegmentFault) at strand
+  // `strand`, point `point` (of the strand, 1 = the end of its first segment).
+  struct Fault : SpringSegmentFault {
     size_t strand = 0;
     uint32_t point = 0;
-    double value = 0.0;
   };
   // The first strand (in strand order, whatever the threads) whose state a step left invalid; none while
   // the hair is valid.

@@ -19,6 +19,7 @@
 
 #include "libcore/util/error.h"
 #include "libcore/util/resources.h"
+#include "libcore/util/text.h"
 
 namespace hairgen {
 namespace fs = std::filesystem;
@@ -445,10 +446,7 @@ std::string contentDigest(const fs::path& path) {
   if (!ok) return "";
   uint64_t hash = size * kP3;
   for (uint64_t lane : lanes) hash = mix(hash ^ round(0, lane)) * kP1;
-  hash = mix(hash);
-  char hex[17];
-  std::snprintf(hex, sizeof hex, "%016llx", static_cast<unsigned long long>(hash));
-  return hex;
+  return formatDigest(mix(hash));
 }
 
 std::string readFileText(const fs::path& path) {

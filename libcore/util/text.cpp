@@ -80,6 +80,12 @@ std::string formatSignificant(double value, int digits) {
   return text;
 }
 
+std::string formatDigest(uint64_t digest) {
+  char hex[17];
+  std::snprintf(hex, sizeof hex, "%016llx", static_cast<unsigned long long>(digest));
+  return hex;
+}
+
 std::string formatFloat(float value) {
   char buffer[32];
   auto [end, ec] = std::to_chars(buffer, buffer + sizeof buffer, value);

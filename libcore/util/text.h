@@ -30,6 +30,8 @@ std::string formatReal(double value);
 std::string formatFloat(float value);  // shortest text that parses back to the same float
 // `value` to `digits` significant digits (printf's %g), for a message: 0.000123, 4.56e+07.
 std::string formatSignificant(double value, int digits = 3);
+// A 64-bit digest as 16 lowercase hex digits, leading zeros kept: "00ff00ff00ff00ff".
+std::string formatDigest(uint64_t digest);
 
 // `text` with every line end replaced by a space: library messages (a compiler's log, a parser's
 // warnings) in hairgen's one-line errors.
