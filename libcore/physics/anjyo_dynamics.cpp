@@ -323,14 +323,18 @@ std::optional<AnjyoHair::Fault> AnjyoHair::fault() const {
   // Every frame checks the whole state, so the common case, a block wholly within bounds, is one
   // branch-free pass over its contiguous rows (padding lanes included: one out of bounds only sends the
   // block to the exact search above, which skips them).
+  // (Counted as integers over fixed-length rows, the angles' and the turns' apart, so that the loops
+  // vectorise: a NaN counts as out of bounds.)
   auto blockWithinBounds = [&](size_t b) {
     const float* values = stateAt(blockFirst_[b]);
     const size_t rows = blockFirst_[b + 1] - blockFirst_[b];
-    bool within = true;
-    for (size_t r = 0; r < rows; ++r, values += kStateValues * kLanes)
-      for (size_t i = 0; i < kStateValues * kLanes; ++i)
-        within &= std::abs(values[i]) <= (i < 2 * kLanes ? float(kMaxAngle) : float(kMaxTurn));
-    return within;
+    constexpr float kAngle = float(kMaxAngle), kTurn = float(kMaxTurn);
+    int outside = 0;
+    for (size_t r = 0; r < rows; ++r, values += kStateValues * kLanes) {
+      for (size_t i = 0; i < 2 * kLanes; ++i) outside += !(std::abs(values[i]) <= kAngle);
+      for (size_t i = 2 * kLanes; i < kStateValues * kLanes; ++i) outside += !(std::abs(values[i]) <= kTurn);
+    }
+    return outside == 0;
   };
   std::atomic<size_t> first{blockCount()};
   tbb::parallel_for(size_t(0), blockCount(), [&](size_t b) {

@@ -127,13 +127,13 @@ class AnjyoHair {
 
  private:
   // Segment j of a block of kLanes consecutive strands, lane by lane (a lane past its strand's last
-  // segment holds zeros): its frame (`rest` its rest direction, `pole` perpendicular to it, `side` =
-  // pole × rest), d_i, c_i u_i m_i (1/m), the rest spring's ω_i² (1/s²), the rest's gravity along pole
-  // and side (m/s²: the styling load, a torque carried with the segment), and the turn allowed at the
-  // node before it (cos −2 where there is no limit).
+  // segment holds zeros): its frame (`rest` its rest direction, `pole` perpendicular to it; the third
+  // axis, side = pole × rest, and the styling load, the rest's gravity along pole and side, are computed
+  // where they are used: the step reads less memory), d_i, c_i u_i m_i (1/m), the rest spring's ω_i²
+  // (1/s²), and the turn allowed at the node before it (cos −2 where there is no limit).
   struct LaneSegment {
-    float rest[3][kLanes], pole[3][kLanes], side[3][kLanes];
-    float length[kLanes], coefficient[kLanes], spring[kLanes], restLoad[2][kLanes];
+    float rest[3][kLanes], pole[3][kLanes];
+    float length[kLanes], coefficient[kLanes], spring[kLanes];
     float cosAllowed[kLanes], sinAllowed[kLanes];
   };
   // Point j of a block's strands, lane by lane (a lane past its strand's last point repeats it): the
