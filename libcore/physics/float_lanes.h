@@ -129,11 +129,14 @@ struct Avx512Isa {
         r[i] = first + int(i) < rows ? _mm512_loadu_ps(tile + (size_t(first) + i) * kWidth)
                                      : _mm512_setzero_ps();
       transpose(r);
+      // Whole columns by plain stores: a masked store to memory costs several times as much on some
+      // processors (AMD Zen 4), and most columns are whole.
       for (size_t l = 0; l < kWidth; ++l) {
         const int count = std::min(rows, valid[l]) - first;
-        if (count <= 0) continue;
-        const __mmask16 mask = count >= int(kWidth) ? __mmask16(0xffff) : __mmask16((1u << count) - 1);
-        _mm512_mask_storeu_ps(to[l] + first, mask, r[l]);
+        if (count >= int(kWidth))
+          _mm512_storeu_ps(to[l] + first, r[l]);
+        else if (count > 0)
+          _mm512_mask_storeu_ps(to[l] + first, __mmask16((1u << count) - 1), r[l]);
       }
     }
   }
