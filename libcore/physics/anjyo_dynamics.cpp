@@ -117,10 +117,10 @@ AnjyoHair::AnjyoHair(const Strands& rest, const Hairstyle& style, const Dynamics
   state_[0] = kStateTag;
   state_[1] = double(kLanes);
   state_[2] = double(kStateValues);
-  resizeLarge(trig_, blockFirst_.back() * kTrigValues * kLanes);
+  resizeLarge(trig_, blockFirst_.back() * kTrigValues);
   resizeLarge(segments_, blockFirst_.back());
   resizeLarge(points_, blockFirst_.back() + blocks);
-  resizeLarge(restDepth_, (blockFirst_.back() + blocks) * laneShapes_.size() * kLanes);
+  resizeLarge(restDepth_, (blockFirst_.back() + blocks) * laneShapes_.size());
   const PointArray tangents = tangentsOf(rest);
   rest_.points = {};  // posing writes the points and tangents; the rest's are kept lane by lane
   rest_.tangents = {};
