@@ -99,7 +99,10 @@ class AnjyoHair {
   static constexpr double kMaxAngle = kMaxAnjyoAngle;  // radians: the most an angle of a state may be
   static constexpr double kMaxTurn = kMaxAnjyoTurn;    // radians: the most its turn in a substep may be
   std::vector<double> state() const { return state_; }
-  void swapState(std::vector<double>& other) { state_.swap(other); }
+  void swapState(std::vector<double>& other) {
+    state_.swap(other);
+    stepChecked_ = false;
+  }
   // Throws InputError naming `source` for a state of another layout or size, or a value past the bounds.
   void restore(const std::vector<double>& state, const std::string& source);
 
@@ -237,6 +240,11 @@ class AnjyoHair {
   Strands rest_;                        // every attribute of the rest guides but their points and tangents
   std::vector<uint32_t> firstSegment_;  // per strand, + 1
   std::vector<double> state_;           // kStateValues per segment (the restart layout): all 0 at rest
+  // Per block, whether the last step left every value of its state within bounds (fault(), padding lanes
+  // included), which the step finds as it stores them; read only while stepChecked_ (the state is the
+  // last step's: no restore, swap or set since).
+  std::vector<char> blockWithin_;
+  bool stepChecked_ = false;
   std::vector<LaneRow, UninitialisedAllocator<LaneRow>> trig_;  // kTrigValues per segment: of state_'s angles
   glm::dvec3 origin_{0.0};                                      // the centre of the rest hair's bounds
   int head_ = -1;  // headShape (the pseudo-force head), an index into shapes; -1 for none
