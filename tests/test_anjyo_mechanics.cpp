@@ -215,5 +215,69 @@ TEST(AnjyoMechanics, AfterANodAHairHangsAsTheElasticaDoes) {
   EXPECT_GT(glm::degrees(expected), 1.0);
 }
 
+// How far a moving tip is from the finest cut's, relative to how far that tip travels.
+struct TipError {
+  double rms = 0.0, max = 0.0;
+};
+
+// A 20 cm hair of `segments` hanging straight down from the origin, with its own stiffness (the auto rest
+// spring) and damping 1/s, after a 30° nod held (the field turned by 30° in the head's frame at t = 0):
+// its tip relative to its root, every 1/96 s for 1.5 s (two swings), stepped at 1/960 s so that the
+// time step's error is small against the segments'.
+std::vector<glm::dvec3> nodTip(int segments) {
+  const Hairstyle style;
+  const double length = 0.2;
+  Dynamics dynamics = bare();
+  dynamics.restFrequencyAuto = true;
+  dynamics.damping = 1.0;
+  AnjyoHair hair(test::chain(glm::dvec3(0.0), std::vector<glm::dvec3>(size_t(segments), {0.0, -1.0, 0.0}),
+                             length / segments),
+                 style, dynamics, Collision{}, 0);
+  HeadState head;
+  head.pose.rotation = eulerRotation({0.0, 0.0, 30.0});
+  const AccelerationField field = headFrameField(head, glm::dvec3(0.0), style.gravity);
+  std::vector<glm::dvec3> tips;
+  for (int frame = 0; frame < 144; ++frame) {
+    for (int n = 0; n < 10; ++n) hair.step(field, 1.0 / 960.0, 1, false);
+    const std::vector<glm::dvec3> nodes = hair.nodes();
+    tips.push_back(nodes.back() - nodes.front());
+  }
+  return tips;
+}
+
+// Anjyo's hair is a chain of rigid segments standing for a continuous hair, so a moving tip converges on
+// the continuous hair's as the segments get shorter, at first order (the error halves with each
+// doubling: against 160 segments 5.4, 2.9, 1.4 and 0.6% RMS of the tip's travel at 5, 10, 20 and 40).
+// Against 40 segments here: the tip's distance from the 40-segment tip, relative to that tip's travel,
+// falls with every doubling of the count, and stays within the first order's figures (4.8/2.3/0.8% RMS,
+// 9.9/4.4/1.5% at most, at 5/10/20 segments).
+TEST(AnjyoMechanics, AMovingTipConvergesWithTheSegmentCount) {
+  const std::vector<glm::dvec3> fine = nodTip(40);
+  double travel = 0.0;
+  for (const glm::dvec3& tip : fine) travel = std::max(travel, glm::length(tip - fine.front()));
+  ASSERT_GT(travel, 0.01);
+  std::vector<TipError> errors;
+  for (int segments : {5, 10, 20}) {
+    const std::vector<glm::dvec3> tips = nodTip(segments);
+    TipError e;
+    for (size_t i = 0; i < tips.size(); ++i) {
+      const double d = glm::length(tips[i] - fine[i]) / travel;
+      e.rms += d * d;
+      e.max = std::max(e.max, d);
+    }
+    e.rms = std::sqrt(e.rms / double(tips.size()));
+    errors.push_back(e);
+  }
+  const double rmsBound[3] = {0.06, 0.03, 0.012}, maxBound[3] = {0.12, 0.06, 0.025};
+  for (size_t i = 0; i < errors.size(); ++i) {
+    const int segments = 5 << i;
+    EXPECT_LT(errors[i].rms, rmsBound[i]) << segments << " segments";
+    EXPECT_LT(errors[i].max, maxBound[i]) << segments << " segments";
+    if (i > 0) {
+      EXPECT_LT(errors[i].rms, 0.6 * errors[i - 1].rms) << segments << " segments against half as many";
+    }
+  }
+}
+
 }  // namespace
 }  // namespace hairgen

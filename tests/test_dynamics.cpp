@@ -430,6 +430,22 @@ TEST(AnjyoDynamics, AStateThatLeftItsBoundsIsAFault) {
   EXPECT_EQ(fault->strand, 17u);
   EXPECT_EQ(fault->segment, 1u);
   EXPECT_TRUE(fault->angle);
+
+  // After a step, the step's own check of the values it stored finds what a search of the whole state
+  // finds (the state lent out and back: the search). A wind of 10,000 m/s² over a second: an overflow.
+  AnjyoHair stepped(rest, config.hairstyle, config.dynamics, config.collision, 1);
+  AccelerationField wind;
+  wind.base = {1e4, -9.81, 0.0};
+  stepped.step(wind, 1.0, 2, false);
+  const std::optional<AnjyoHair::Fault> found = stepped.fault();
+  std::vector<double> lent;
+  stepped.swapState(lent);
+  stepped.swapState(lent);
+  const std::optional<AnjyoHair::Fault> searched = stepped.fault();
+  ASSERT_TRUE(found && searched);
+  EXPECT_EQ(found->strand, searched->strand);
+  EXPECT_EQ(found->segment, searched->segment);
+  EXPECT_EQ(found->angle, searched->angle);
 }
 
 // A still head and no wind: the styling load balances the rest's gravity exactly, bit for bit, and

@@ -117,10 +117,11 @@ AnjyoHair::AnjyoHair(const Strands& rest, const Hairstyle& style, const Dynamics
   state_[0] = kStateTag;
   state_[1] = double(kLanes);
   state_[2] = double(kStateValues);
-  resizeLarge(trig_, blockFirst_.back() * kTrigValues * kLanes);
+  resizeLarge(trig_, blockFirst_.back() * kTrigValues);
+  blockWithin_.assign(blocks, 0);
   resizeLarge(segments_, blockFirst_.back());
   resizeLarge(points_, blockFirst_.back() + blocks);
-  resizeLarge(restDepth_, (blockFirst_.back() + blocks) * laneShapes_.size() * kLanes);
+  resizeLarge(restDepth_, (blockFirst_.back() + blocks) * laneShapes_.size());
   const PointArray tangents = tangentsOf(rest);
   rest_.points = {};  // posing writes the points and tangents; the rest's are kept lane by lane
   rest_.tangents = {};
@@ -240,6 +241,7 @@ void AnjyoHair::step(const AccelerationField& field, double dt, int frame, bool 
   kernel = available(kernel);
   tbb::parallel_for(size_t(0), blockCount(),
                     [&](size_t b) { Kernels::step(*this, b, params, nullptr, nullptr, kernel); });
+  stepChecked_ = true;
 }
 
 void AnjyoHair::stepAndPose(const AccelerationField& field, double dt, int frame, bool firstSubstep,
@@ -250,6 +252,7 @@ void AnjyoHair::stepAndPose(const AccelerationField& field, double dt, int frame
   out.assignRestKeepingBuffers(rest_);  // every attribute but the points and tangents is the rest's
   tbb::parallel_for(size_t(0), blockCount(),
                     [&](size_t b) { Kernels::step(*this, b, params, &pose, &out, kernel); });
+  stepChecked_ = true;
 }
 
 Strands AnjyoHair::posed(const Pose& pose) const {
@@ -293,12 +296,14 @@ void AnjyoHair::setSegmentState(size_t s, uint32_t j, const std::array<double, k
     const float value = float(values[v]);
     std::memcpy(state + v * kLanes, &value, sizeof(float));
   }
+  stepChecked_ = false;
   Kernels::angleTrig(*this, s / kLanes, available(Kernel::kFastest));
 }
 
 void AnjyoHair::restore(const std::vector<double>& state, const std::string& source) {
   checkStateValues(rest_, state, DynamicsModel::kAnjyo, source);  // rest_ keeps the strand layout
   state_ = state;
+  stepChecked_ = false;
   const Kernel kernel = available(Kernel::kFastest);
   tbb::parallel_for(size_t(0), blockCount(), [&](size_t b) { Kernels::angleTrig(*this, b, kernel); });
 }
@@ -320,21 +325,27 @@ std::optional<AnjyoHair::Fault> AnjyoHair::fault() const {
     }
     return std::nullopt;
   };
-  // Every frame checks the whole state, so the common case, a block wholly within bounds, is one
-  // branch-free pass over its contiguous rows (padding lanes included: one out of bounds only sends the
-  // block to the exact search above, which skips them).
+  // Every frame checks the whole state. After a step, the step has found the common case, a block wholly
+  // within bounds, as it stored the values; otherwise it is one branch-free pass over its contiguous rows
+  // (padding lanes included: one out of bounds only sends the block to the exact search above, which skips
+  // them). (Counted as integers over fixed-length rows, the angles' and the turns' apart, so that the loops
+  // vectorise: a NaN counts as out of bounds.)
   auto blockWithinBounds = [&](size_t b) {
     const float* values = stateAt(blockFirst_[b]);
     const size_t rows = blockFirst_[b + 1] - blockFirst_[b];
-    bool within = true;
-    for (size_t r = 0; r < rows; ++r, values += kStateValues * kLanes)
-      for (size_t i = 0; i < kStateValues * kLanes; ++i)
-        within &= std::abs(values[i]) <= (i < 2 * kLanes ? float(kMaxAngle) : float(kMaxTurn));
-    return within;
+    constexpr float kAngle = float(kMaxAngle), kTurn = float(kMaxTurn);
+    int outside = 0;
+    for (size_t r = 0; r < rows; ++r, values += kStateValues * kLanes) {
+      for (size_t i = 0; i < 2 * kLanes; ++i) outside += !(std::abs(values[i]) <= kAngle);
+      for (size_t i = 2 * kLanes; i < kStateValues * kLanes; ++i) outside += !(std::abs(values[i]) <= kTurn);
+    }
+    return outside == 0;
   };
   std::atomic<size_t> first{blockCount()};
   tbb::parallel_for(size_t(0), blockCount(), [&](size_t b) {
-    if (b >= first.load(std::memory_order_relaxed) || blockWithinBounds(b) || !blockFault(b)) return;
+    if (b >= first.load(std::memory_order_relaxed) || (stepChecked_ && blockWithin_[b]) ||
+        blockWithinBounds(b) || !blockFault(b))
+      return;
     size_t seen = first.load();
     while (b < seen && !first.compare_exchange_weak(seen, b)) {
     }

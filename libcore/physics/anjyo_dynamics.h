@@ -99,7 +99,10 @@ class AnjyoHair {
   static constexpr double kMaxAngle = kMaxAnjyoAngle;  // radians: the most an angle of a state may be
   static constexpr double kMaxTurn = kMaxAnjyoTurn;    // radians: the most its turn in a substep may be
   std::vector<double> state() const { return state_; }
-  void swapState(std::vector<double>& other) { state_.swap(other); }
+  void swapState(std::vector<double>& other) {
+    state_.swap(other);
+    stepChecked_ = false;
+  }
   // Throws InputError naming `source` for a state of another layout or size, or a value past the bounds.
   void restore(const std::vector<double>& state, const std::string& source);
 
@@ -127,25 +130,31 @@ class AnjyoHair {
 
  private:
   // Segment j of a block of kLanes consecutive strands, lane by lane (a lane past its strand's last
-  // segment holds zeros): its frame (`rest` its rest direction, `pole` perpendicular to it, `side` =
-  // pole × rest), d_i, c_i u_i m_i (1/m), the rest spring's ω_i² (1/s²), the rest's gravity along pole
-  // and side (m/s²: the styling load, a torque carried with the segment), and the turn allowed at the
-  // node before it (cos −2 where there is no limit).
-  struct LaneSegment {
-    float rest[3][kLanes], pole[3][kLanes], side[3][kLanes];
-    float length[kLanes], coefficient[kLanes], spring[kLanes], restLoad[2][kLanes];
+  // segment holds zeros): its frame (`rest` its rest direction, `pole` perpendicular to it; the third
+  // axis, side = pole × rest, and the styling load, the rest's gravity along pole and side, are computed
+  // where they are used: the step reads less memory), d_i, c_i u_i m_i (1/m), the rest spring's ω_i²
+  // (1/s²), and the turn allowed at the node before it (cos −2 where there is no limit).
+  // (The lane-by-lane arrays are aligned to a cache line, 64 bytes, so each vector the kernel loads or
+  // stores is one line, not two.)
+  struct alignas(64) LaneSegment {
+    float rest[3][kLanes], pole[3][kLanes];
+    float length[kLanes], coefficient[kLanes], spring[kLanes];
     float cosAllowed[kLanes], sinAllowed[kLanes];
   };
   // Point j of a block's strands, lane by lane (a lane past its strand's last point repeats it): the
   // input point and tangent that posing starts from, and the rest node as the step computes it (relative
   // to origin_).
-  struct LanePoint {
+  struct alignas(64) LanePoint {
     float point[3][kLanes], forward[3][kLanes], tangent[3][kLanes];
   };
   // A collision shape as the kernel reads it, relative to origin_: its axes over its semi-axes for an
   // ellipsoid (`scaled`), the squared distance from its centre beyond which no point touches it
   // (`reach2`), and `slack`, how much deeper than at rest a node may sit before it is turned out (a
   // millionth of the shape's size: a few float roundings, not contact).
+  // kLanes floats, a row of the lane-by-lane arrays of floats (trig_, restDepth_).
+  struct alignas(64) LaneRow {
+    float lane[kLanes];
+  };
   struct LaneShape {
     ShapeKind kind = ShapeKind::kSphere;
     bool collides = false;  // a shape without penalty does not collide, as in grow
@@ -213,20 +222,31 @@ class AnjyoHair {
     return reinterpret_cast<const float*>(state_.data() + kStateHeader) + i * kStateValues * kLanes;
   }
 
+  // The first float of trig_ and of restDepth_.
+  float* trigFloats() { return reinterpret_cast<float*>(trig_.data()); }
+  const float* trigFloats() const { return reinterpret_cast<const float*>(trig_.data()); }
+  float* restDepthFloats() { return reinterpret_cast<float*>(restDepth_.data()); }
+  const float* restDepthFloats() const { return reinterpret_cast<const float*>(restDepth_.data()); }
+
   // The kernel's arrays, written whole by the constructor (UninitialisedAllocator: not zeroed first).
   std::vector<LaneSegment, UninitialisedAllocator<LaneSegment>> segments_;  // per block, blockFirst_[b] on
   std::vector<size_t> blockFirst_;  // per block, its first LaneSegment, + 1
   // Per block, blockFirst_[b] + b on (one more point than segments).
   std::vector<LanePoint, UninitialisedAllocator<LanePoint>> points_;
   // Per block point, per shape, kLanes: how deep it sat at rest (≥ 0).
-  std::vector<float, UninitialisedAllocator<float>> restDepth_;
+  std::vector<LaneRow, UninitialisedAllocator<LaneRow>> restDepth_;
   std::vector<LaneShape> laneShapes_;
 
   Strands rest_;                        // every attribute of the rest guides but their points and tangents
   std::vector<uint32_t> firstSegment_;  // per strand, + 1
   std::vector<double> state_;           // kStateValues per segment (the restart layout): all 0 at rest
-  std::vector<float, UninitialisedAllocator<float>> trig_;  // kTrigValues per segment: of state_'s angles
-  glm::dvec3 origin_{0.0};                                  // the centre of the rest hair's bounds
+  // Per block, whether the last step left every value of its state within bounds (fault(), padding lanes
+  // included), which the step finds as it stores them; read only while stepChecked_ (the state is the
+  // last step's: no restore, swap or set since).
+  std::vector<char> blockWithin_;
+  bool stepChecked_ = false;
+  std::vector<LaneRow, UninitialisedAllocator<LaneRow>> trig_;  // kTrigValues per segment: of state_'s angles
+  glm::dvec3 origin_{0.0};                                      // the centre of the rest hair's bounds
   int head_ = -1;  // headShape (the pseudo-force head), an index into shapes; -1 for none
   glm::dvec3 restAcceleration_;
   double damping_ = 0.0;

@@ -13,21 +13,25 @@ namespace hairgen {
 #define HAIRGEN_ANJYO_KERNEL Portable
 #define HAIRGEN_ANJYO_ISA lanes16::PortableIsa
 #define HAIRGEN_ANJYO_FN [[gnu::always_inline]] inline
+#define HAIRGEN_ANJYO_COLD [[gnu::noinline, gnu::cold]]
 #define HAIRGEN_ANJYO_ENTRY
 #include "libcore/physics/anjyo_kernel.inc"
 #undef HAIRGEN_ANJYO_KERNEL
 #undef HAIRGEN_ANJYO_ISA
 #undef HAIRGEN_ANJYO_FN
+#undef HAIRGEN_ANJYO_COLD
 #undef HAIRGEN_ANJYO_ENTRY
 
 #define HAIRGEN_ANJYO_KERNEL Avx512
 #define HAIRGEN_ANJYO_ISA lanes16::Avx512Isa
 #define HAIRGEN_ANJYO_FN [[gnu::always_inline, gnu::target("avx512f,avx512dq")]] inline
+#define HAIRGEN_ANJYO_COLD [[gnu::noinline, gnu::cold, gnu::target("avx512f,avx512dq")]]
 #define HAIRGEN_ANJYO_ENTRY [[gnu::target("avx512f,avx512dq")]]
 #include "libcore/physics/anjyo_kernel.inc"
 #undef HAIRGEN_ANJYO_KERNEL
 #undef HAIRGEN_ANJYO_ISA
 #undef HAIRGEN_ANJYO_FN
+#undef HAIRGEN_ANJYO_COLD
 #undef HAIRGEN_ANJYO_ENTRY
 
 void AnjyoHair::Kernels::measure(AnjyoHair& hair, size_t b, float* totals, std::atomic<size_t>& firstBad,

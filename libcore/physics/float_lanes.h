@@ -87,8 +87,13 @@ HAIRGEN_LANES16 F copySign(F magnitude, F sign) {
                                    (__builtin_bit_cast(I, sign) & int32_t(0x80000000)));
 }
 
-// Any x86-64: comparisons and square roots as the generic vectors build them.
+// Any x86-64: comparisons and square roots as the generic vectors build them; a comparison's result is a
+// vector of masks (I).
 struct PortableIsa {
+  using Mask = I;
+  HAIRGEN_LANES16 static F select(Mask m, F a, F b) { return lanes16::select(m, a, b); }
+  HAIRGEN_LANES16 static F3 select(Mask m, const F3& a, const F3& b) { return lanes16::select(m, a, b); }
+  HAIRGEN_LANES16 static Mask select(Mask m, Mask a, Mask b) { return lanes16::select(m, a, b); }
   HAIRGEN_LANES16 static I less(F a, F b) { return a < b; }
   HAIRGEN_LANES16 static I lessEqual(F a, F b) { return a <= b; }
   HAIRGEN_LANES16 static F sqrt(F v) {
@@ -111,15 +116,33 @@ struct PortableIsa {
 
 // AVX-512 F and DQ: one instruction each. (Callers are built for that instruction set.)
 #define HAIRGEN_AVX512 [[gnu::always_inline, gnu::target("avx512f,avx512dq")]] inline
+// AVX-512's comparison result: a bit a lane, kept in a mask register (as a vector of masks it took a
+// vector register and a conversion each way, and the step spilled vectors for it).
+struct Mask16 {
+  __mmask16 k;
+  HAIRGEN_LANES16 bool operator[](size_t l) const { return (k >> l) & 1u; }
+  HAIRGEN_LANES16 friend Mask16 operator&(Mask16 a, Mask16 b) { return {__mmask16(a.k & b.k)}; }
+  HAIRGEN_LANES16 friend Mask16 operator|(Mask16 a, Mask16 b) { return {__mmask16(a.k | b.k)}; }
+  HAIRGEN_LANES16 friend Mask16 operator~(Mask16 a) { return {__mmask16(~a.k)}; }
+  HAIRGEN_LANES16 Mask16& operator|=(Mask16 b) { return *this = *this | b; }
+};
 struct Avx512Isa {
+  using Mask = Mask16;
   template <int kPredicate>
-  HAIRGEN_AVX512 static I compare(F a, F b) {
-    return I(_mm512_movm_epi32(_mm512_cmp_ps_mask(__m512(a), __m512(b), kPredicate)));
+  HAIRGEN_AVX512 static Mask compare(F a, F b) {
+    return {_mm512_cmp_ps_mask(__m512(a), __m512(b), kPredicate)};
   }
-  HAIRGEN_AVX512 static I less(F a, F b) { return compare<_CMP_LT_OQ>(a, b); }
-  HAIRGEN_AVX512 static I lessEqual(F a, F b) { return compare<_CMP_LE_OQ>(a, b); }
+  HAIRGEN_AVX512 static Mask less(F a, F b) { return compare<_CMP_LT_OQ>(a, b); }
+  HAIRGEN_AVX512 static Mask lessEqual(F a, F b) { return compare<_CMP_LE_OQ>(a, b); }
   HAIRGEN_AVX512 static F sqrt(F v) { return F(_mm512_mask_sqrt_ps(__m512(v), 0xffff, __m512(v))); }
-  HAIRGEN_AVX512 static bool any(I m) { return _mm512_test_epi32_mask(__m512i(m), __m512i(m)) != 0; }
+  HAIRGEN_AVX512 static bool any(Mask m) { return m.k != 0; }
+  HAIRGEN_AVX512 static F select(Mask m, F a, F b) {
+    return F(_mm512_mask_blend_ps(m.k, __m512(b), __m512(a)));
+  }
+  HAIRGEN_AVX512 static F3 select(Mask m, const F3& a, const F3& b) {
+    return {select(m, a.x, b.x), select(m, a.y, b.y), select(m, a.z, b.z)};
+  }
+  HAIRGEN_AVX512 static Mask select(Mask m, Mask a, Mask b) { return (m & a) | (~m & b); }
   // PortableIsa::storeColumns, 16 rows at a time transposed in registers and stored a column at once.
   HAIRGEN_AVX512 static void storeColumns(const float* tile, int rows, float* const (&to)[kWidth],
                                           const int (&valid)[kWidth]) {
@@ -129,11 +152,14 @@ struct Avx512Isa {
         r[i] = first + int(i) < rows ? _mm512_loadu_ps(tile + (size_t(first) + i) * kWidth)
                                      : _mm512_setzero_ps();
       transpose(r);
+      // Whole columns by plain stores: a masked store to memory costs several times as much on some
+      // processors (AMD Zen 4), and most columns are whole.
       for (size_t l = 0; l < kWidth; ++l) {
         const int count = std::min(rows, valid[l]) - first;
-        if (count <= 0) continue;
-        const __mmask16 mask = count >= int(kWidth) ? __mmask16(0xffff) : __mmask16((1u << count) - 1);
-        _mm512_mask_storeu_ps(to[l] + first, mask, r[l]);
+        if (count >= int(kWidth))
+          _mm512_storeu_ps(to[l] + first, r[l]);
+        else if (count > 0)
+          _mm512_mask_storeu_ps(to[l] + first, __mmask16((1u << count) - 1), r[l]);
       }
     }
   }
