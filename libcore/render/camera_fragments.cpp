@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <bit>
 
+#include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
 
 #include "libcore/render/hair_raster.h"
@@ -76,11 +77,21 @@ CameraFragments rasteriseCameraFragments(const Strands& hair, const View& camera
   out.tail.assign(pixels, 0);
   std::vector<uint32_t> counts(pixels, 0);
   std::vector<std::vector<uint32_t>> bandWords(size_t(bands.count));
+  // A band's pixels' slots, one set a thread, reused from band to band (a band's are ~14 MB at 1920
+  // pixels a row: allocated for each band, their pages were cleared again each time).
+  struct BandSlots {
+    std::vector<Slot> slots;
+    std::vector<uint8_t> used;
+  };
+  tbb::enumerable_thread_specific<BandSlots> perThread;
   tbb::parallel_for(0, bands.count, [&](int band) {
     const size_t base = size_t(band) * raster::kBandRows * width;
     const size_t end = std::min(pixels, base + raster::kBandRows * width);
-    std::vector<Slot> slots((end - base) * size_t(kept));
-    std::vector<uint8_t> used(end - base, 0);
+    BandSlots& mine = perThread.local();
+    mine.slots.resize((end - base) * size_t(kept));
+    mine.used.assign(end - base, 0);
+    std::vector<Slot>& slots = mine.slots;
+    std::vector<uint8_t>& used = mine.used;
     bands.eachFragment<raster::Across::kBox>(band, [&](size_t texel, int32_t depth, uint32_t coverage,
                                                        uint32_t point, raster::Piece piece) {
       // Compared as the blend compares them: the fragment's depth as the float it is stored as.
@@ -89,6 +100,9 @@ CameraFragments rasteriseCameraFragments(const Strands& hair, const View& camera
       keep(&slots[local * size_t(kept)], used[local], out.tail[texel], kept, depth, coverage, point, piece);
     });
     std::vector<uint32_t>& words = bandWords[size_t(band)];
+    size_t count = 0;
+    for (const uint8_t n : used) count += n;
+    words.reserve(3 * count);
     for (size_t p = 0; p < end - base; ++p) {
       counts[base + p] = used[p];
       for (int k = 0; k < used[p]; ++k) {

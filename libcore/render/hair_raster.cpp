@@ -48,7 +48,7 @@ Bands projectIntoBands(const Strands& hair, const View& v, double strandWidth) {
                       }
                     });
   // The segments: each pair of consecutive points of a strand, both drawn; by their first point.
-  std::vector<uint32_t>& segments = out.segments;
+  std::vector<uint32_t> segments;
   segments.reserve(hair.points.size());
   for (size_t s = 0; s + 1 < hair.firstPoint.size(); ++s)
     for (uint32_t i = hair.firstPoint[s]; i + 1 < hair.firstPoint[s + 1]; ++i)
@@ -92,7 +92,7 @@ Bands projectIntoBands(const Strands& hair, const View& v, double strandWidth) {
     for (size_t s = c * kBinChunk; s < std::min(segments.size(), (c + 1) * kBinChunk); ++s) {
       int lo, hi;
       bandsOf(s, lo, hi);
-      for (int b = lo; b <= hi; ++b) out.bandSegments[counts[c * bands + b]++] = uint32_t(s);
+      for (int b = lo; b <= hi; ++b) out.bandSegments[counts[c * bands + b]++] = segments[s];
     }
   });
   return out;

@@ -136,7 +136,7 @@ void rasteriseSegment(Vertex a, Vertex b, int64_t rowLo, int64_t rowHi, F&& frag
   if (du == 0) return;  // seen end on: no length, no area
   // The square root of an integer below 2^53 is correctly rounded in double: the same on every machine;
   // rounded to the nearest 1/kSubTexel, so short segments are not all a little short.
-  const uint64_t length = uint64_t(std::llround(std::sqrt(double(du * du + dv * dv))));
+  const uint64_t length = uint64_t(std::sqrt(double(du * du + dv * dv)) + 0.5);
   const uint64_t width = (uint64_t(a.width) + uint64_t(b.width)) / 2;  // 1/kWidthUnit texel
   // The ribbon's extent across the major axis, 1/kWidthUnit texel; half of it in 1/kSubTexel, at least
   // one (a thinner ribbon is shared as a line is).
@@ -208,9 +208,8 @@ void rasteriseSegment(Vertex a, Vertex b, int64_t rowLo, int64_t rowHi, F&& frag
 struct Bands {
   int width = 0, height = 0, count = 0;  // the image's texels; bands of kBandRows rows
   std::vector<Vertex> vertices;          // one per point
-  std::vector<uint32_t> segments;        // each drawn segment's first point, in order
   std::vector<size_t> bandFirst;         // band b's segments: bandSegments[bandFirst[b], bandFirst[b + 1])
-  std::vector<uint32_t> bandSegments;    // indices into `segments`, in order within each band
+  std::vector<uint32_t> bandSegments;    // the segments' first points, in order within each band
 
   // Calls fragment(texel, depth, coverage, segment's first point, piece) for every fragment of every
   // segment of `band` that falls on the image within the band's rows, in the order of the segments;
@@ -219,7 +218,7 @@ struct Bands {
   void eachFragment(int band, F&& fragment) const {
     const int64_t rowLo = int64_t(band) * kBandRows, rowHi = std::min<int64_t>(height, rowLo + kBandRows);
     for (size_t k = bandFirst[size_t(band)]; k < bandFirst[size_t(band) + 1]; ++k) {
-      const uint32_t point = segments[bandSegments[k]];
+      const uint32_t point = bandSegments[k];
       rasteriseSegment<across>(vertices[point], vertices[point + 1], rowLo, rowHi,
                                [&](int64_t i, int64_t j, int32_t depth, uint32_t coverage, Piece piece) {
                                  if (coverage == 0 || j < rowLo || j >= rowHi || i < 0 || i >= width) return;
