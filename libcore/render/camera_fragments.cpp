@@ -68,12 +68,15 @@ void keep(Slot* list, uint8_t& n, uint32_t& tail, int kept, int32_t depth, uint3
 
 CameraFragments rasteriseCameraFragments(const Strands& hair, const View& camera, double strandWidth,
                                          int kept, const float* opaque) {
+  return cameraFragments(raster::projectIntoBands(hair, camera, strandWidth), kept, opaque);
+}
+
+CameraFragments cameraFragments(const raster::Bands& bands, int kept, const float* opaque) {
   kept = std::clamp(kept, 1, 255);  // a pixel counts its fragments in a byte
-  const raster::Bands bands = raster::projectIntoBands(hair, camera, strandWidth);
-  const size_t width = size_t(camera.width), pixels = width * size_t(camera.height);
+  const size_t width = size_t(bands.width), pixels = width * size_t(bands.height);
   CameraFragments out;
-  out.width = camera.width;
-  out.height = camera.height;
+  out.width = bands.width;
+  out.height = bands.height;
   out.tail.assign(pixels, 0);
   std::vector<uint32_t> counts(pixels, 0);
   std::vector<std::vector<uint32_t>> bandWords(size_t(bands.count));

@@ -17,6 +17,7 @@
 #include <vector>
 
 #include "libcore/model/strands.h"
+#include "libcore/render/hair_raster.h"
 #include "libcore/render/views.h"
 
 namespace hairgen {
@@ -47,11 +48,15 @@ struct CameraFragments {
   size_t count() const { return words.size() / 3; }
 };
 
-// `camera`: the view (its width × height pixels, or sub-pixels). `strandWidth`: the strands' diameter,
-// metres. `kept`: fragments per pixel, 1 to 255. `opaque`: null, or per pixel (rows from the bottom)
-// the depth along the camera's axis of what hides the hair behind it (the head), metres: a fragment
-// that deep or deeper is no fragment of the pixel, neither kept nor in its tail. A segment with a point
-// nearer than the near plane is dropped.
+// The fragments of the hair a view's rasteriser has projected and sorted into bands (hair_raster.h:
+// projectIntoBands, its width × height pixels, or sub-pixels). `kept`: fragments per pixel, 1 to 255.
+// `opaque`: null, or per pixel (rows from the bottom) the depth along the camera's axis of what hides
+// the hair behind it (the head), metres: a fragment that deep or deeper is no fragment of the pixel,
+// neither kept nor in its tail.
+CameraFragments cameraFragments(const raster::Bands& bands, int kept, const float* opaque = nullptr);
+
+// projectIntoBands(hair, camera, strandWidth), then its fragments. `strandWidth`: the strands'
+// diameter, metres. A segment with a point nearer than the near plane is dropped.
 CameraFragments rasteriseCameraFragments(const Strands& hair, const View& camera, double strandWidth,
                                          int kept, const float* opaque = nullptr);
 

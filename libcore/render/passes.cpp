@@ -160,10 +160,11 @@ Programs::Programs(bool ribbons, int block, const CustomShaders& custom, bool mo
                         "motion resolve");
 }
 
-// The light's maps (light_maps.h), and where OpenGL draws the camera's hair (a custom HairVert, the
-// motion pass) the strands' drawing order and chords (line_decimation.h), computed on TBB's threads
-// while the main thread, which holds the GL context, uploads the hair and compiles the programs. (The
-// camera's fragments wait for the head's depth: the shading pass.)
+// The light's maps (light_maps.h), the hair as the camera's rasteriser sees it (hair_raster.h: its
+// fragments wait for the head's depth, the shading pass), and where OpenGL draws the camera's hair (a
+// custom HairVert, the motion pass) the strands' drawing order and chords (line_decimation.h),
+// computed on TBB's threads while the main thread, which holds the GL context, uploads the hair and
+// compiles the programs.
 //
 // Order: only without sub-pixels, where the shading stage is tested for depth before it runs (the screen
 // door's discard would defer the test); a different order could only change which of two fragments of
@@ -175,7 +176,8 @@ Programs::Programs(bool ribbons, int block, const CustomShaders& custom, bool mo
 struct Scene::Preparation {
   std::vector<uint32_t> order, camera;
   bool cameraChords = false;
-  std::unique_ptr<HairLightMaps> lightMaps;  // when hairgen's rasteriser draws them
+  std::unique_ptr<HairLightMaps> lightMaps;    // when hairgen's rasteriser draws them
+  std::unique_ptr<raster::Bands> cameraBands;  // when it draws the camera's hair
   tbb::task_group work;
 
   Preparation(const Scene& scene, const RenderInput& in) {
@@ -198,10 +200,17 @@ struct Scene::Preparation {
     const bool lightByRasteriser = !in.shaders.hairVert && in.lightMaps != RenderInput::LightMaps::kGl;
     const View& lightView = scene.light;
     const RenderSettings& r = in.settings;
-    work.run([=, this, &hair, &lightView, &r] {
-      if (!lightByRasteriser) return;
-      lightMaps =
-          std::make_unique<HairLightMaps>(rasteriseLightMaps(hair, lightView, r.strandWidth, r.layerSizes));
+    const View& subpixelView = scene.subpixel;
+    const bool cameraByRasteriser = scene.rasterised;
+    // One after the other, each on every thread: the light's projection is freed before the camera's
+    // is made.
+    work.run([=, this, &hair, &lightView, &subpixelView, &r] {
+      if (lightByRasteriser)
+        lightMaps =
+            std::make_unique<HairLightMaps>(rasteriseLightMaps(hair, lightView, r.strandWidth, r.layerSizes));
+      if (cameraByRasteriser)
+        cameraBands =
+            std::make_unique<raster::Bands>(raster::projectIntoBands(hair, subpixelView, r.strandWidth));
     });
     work.run([=, this, &hair] {
       if (ordered) order = frontToBack(hair, view);
@@ -230,7 +239,6 @@ Scene::Scene(const RenderInput& in)
       motion(in.previous.has_value()),
       rasterised(!in.shaders.hairVert),
       kept(in.keptFragments),
-      strands(in.hair),
       preparing(std::make_unique<Preparation>(*this, in)),
       hair(*in.hair, tangentsFor(*in.hair), motion ? in.previous->hair : nullptr, in.readInPlace),
       head(in.head && !in.head->triangles.empty()
@@ -248,6 +256,7 @@ Scene::Scene(const RenderInput& in)
   preparing->work.wait();
   if (!preparing->order.empty()) hair.drawInOrder(*in.hair, preparing->order);
   lightMaps = std::move(preparing->lightMaps);
+  cameraBands = std::move(preparing->cameraBands);
   if (preparing->cameraChords)
     cameraLines = std::make_unique<LineStrips>(preparing->camera, kCameraChunkVertices);
   preparing.reset();
@@ -260,10 +269,15 @@ void Scene::releaseLightMaps() {
   lightMaps.reset();
 }
 
+void Scene::releaseCameraBands() {
+  cameraBands.reset();
+}
+
 void Scene::releaseGeometry() {
   glBindVertexArray(0);
   hair.release();
   lightMaps.reset();
+  cameraBands.reset();
   cameraLines.reset();
   head.reset();
 }
@@ -451,8 +465,7 @@ ShadedImage shadingPass(const Scene& scene, const LightDepth& depth, const Textu
   glGetTextureImage(image.data.id, 0, GL_RED, GL_FLOAT, GLsizei(headDepth.size() * sizeof(float)),
                     headDepth.data());
   checkGl("reading the head's depth");
-  const CameraFragments f =
-      rasteriseCameraFragments(*scene.strands, scene.subpixel, r.strandWidth, scene.kept, headDepth.data());
+  const CameraFragments f = cameraFragments(*scene.cameraBands, scene.kept, headDepth.data());
   headDepth = {};
   fragments = f.count();
   return blendHair(scene, f, image);

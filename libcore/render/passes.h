@@ -27,6 +27,9 @@
 namespace hairgen {
 
 struct HairLightMaps;  // light_maps.h
+namespace raster {
+struct Bands;  // hair_raster.h
+}
 
 // The programs of one render: hairgen's stages (libcore/render/glsl/), or the Setup's custom ones in
 // their place (HairVert in every program that draws hair, HeadVert in every one that draws the head).
@@ -51,15 +54,14 @@ struct Scene {
 
   const RenderSettings& settings;
   const Visuality& visuality;
-  BoundingSphere sphere;   // around the hair and the head
-  int block;               // k: sub-pixels per pixel side (Samples = k², as far as the device allows)
-  View camera, subpixel;   // the camera on pixels and on sub-pixels
-  View light;              // domResolution texels per side
-  bool ribbons;            // OpenGL draws the camera's hair as ribbons, not lines
-  bool motion;             // the previous frame was given: motion vectors too
-  bool rasterised;         // the camera's hair comes from hairgen's rasteriser (not a custom HairVert)
-  int kept;                // the fragments kept per sub-pixel (RenderInput::keptFragments)
-  const Strands* strands;  // the hair, as RenderInput gives it (the camera's rasteriser reads it)
+  BoundingSphere sphere;  // around the hair and the head
+  int block;              // k: sub-pixels per pixel side (Samples = k², as far as the device allows)
+  View camera, subpixel;  // the camera on pixels and on sub-pixels
+  View light;             // domResolution texels per side
+  bool ribbons;           // OpenGL draws the camera's hair as ribbons, not lines
+  bool motion;            // the previous frame was given: motion vectors too
+  bool rasterised;        // the camera's hair comes from hairgen's rasteriser (not a custom HairVert)
+  int kept;               // the fragments kept per sub-pixel (RenderInput::keptFragments)
   glm::dmat4 viewProj{1.0}, previousViewProj{1.0};  // world to clip: this frame's camera, the previous one's
   // What the CPU prepares for drawing while the GL objects below are made (passes.cpp).
   struct Preparation;
@@ -71,13 +73,17 @@ struct Scene {
   // The light's hair maps from hairgen's rasteriser (light_maps.h); null when OpenGL draws them from
   // every point (a custom HairVert, RenderInput::lightMaps).
   std::unique_ptr<HairLightMaps> lightMaps;
+  // The hair as the camera's rasteriser sees it at the sub-pixels (hair_raster.h), its fragments drawn
+  // in the shading pass, once the head's depth is known; null when OpenGL draws the camera's hair.
+  std::unique_ptr<raster::Bands> cameraBands;
   std::unique_ptr<HeadGeometry> head;  // null when there is no head to draw
   Programs programs;
 
   // Frees the geometry once the passes that draw it are done, so what follows (the readback, the
-  // images' writing) does not run with the coupe still held: the light's maps after their upload, all
-  // of it after the last pass.
+  // images' writing) does not run with the coupe still held: the light's maps after their upload, the
+  // camera's bands after the shading pass, all of it after the last pass.
   void releaseLightMaps();
+  void releaseCameraBands();
   void releaseGeometry();
 };
 

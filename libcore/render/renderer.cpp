@@ -46,11 +46,7 @@ RenderOutput renderHair(GlContext&, const RenderInput& in) {
   out.timings.upload = seconds(clock);
   out.hairReadInPlace = scene.hair.readsStrandsInPlace();
   out.lightMapsOnCpu = scene.lightMaps != nullptr;
-  // The hair is read no more once the device holds a copy, and the camera's rasteriser has drawn it.
-  auto released = [&] {
-    if (in.uploaded && !out.hairReadInPlace) in.uploaded();
-  };
-  if (!scene.rasterised) released();
+  if (in.uploaded && !out.hairReadInPlace) in.uploaded();
   auto passDone = [&] {
     if (in.progress) in.progress->advance();
   };
@@ -64,7 +60,7 @@ RenderOutput renderHair(GlContext&, const RenderInput& in) {
   out.timings.opacity = seconds(clock);
   passDone();
   const ShadedImage image = resolvePass(scene, shadingPass(scene, depth, opacity, out.hairFragments));
-  if (scene.rasterised) released();
+  scene.releaseCameraBands();
   out.timings.shading = seconds(clock);
   passDone();
   std::optional<Texture> motion;

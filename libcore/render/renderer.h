@@ -87,9 +87,8 @@ struct RenderInput {
   enum class LightMaps { kAuto, kCpu, kGl };
   LightMaps lightMaps = LightMaps::kAuto;
   // Called once renderHair reads the hair (and the frame before's) no more, so the caller may free
-  // it: when the device holds a copy, after the upload (a custom HairVert's) or after the shading pass
-  // (whose rasteriser reads the hair); after the last pass that draws it when the device reads it in
-  // place (readInPlace).
+  // it: after the upload when the device holds a copy (the passes then do not run with both held);
+  // after the last pass that draws it when the device reads it in place (readInPlace).
   std::function<void()> uploaded;
   // Let the device read the hair's large arrays where they lie, where it can (GL_AMD_pinned_memory,
   // llvmpipe): no copy, no second coupe held while it is made. The same images either way.
