@@ -11,6 +11,7 @@
 #include <tbb/parallel_for.h>
 
 #include "libcore/physics/strand_energy.h"
+#include "libcore/util/atomic_min.h"
 #include "libcore/util/cpu.h"
 #include "libcore/util/error.h"
 #include "libcore/util/huge_pages.h"
@@ -346,9 +347,7 @@ std::optional<AnjyoHair::Fault> AnjyoHair::fault() const {
     if (b >= first.load(std::memory_order_relaxed) || (stepChecked_ && blockWithin_[b]) ||
         blockWithinBounds(b) || !blockFault(b))
       return;
-    size_t seen = first.load();
-    while (b < seen && !first.compare_exchange_weak(seen, b)) {
-    }
+    atomicMin(first, b);
   });
   if (first == blockCount()) return std::nullopt;
   return blockFault(first);

@@ -6,6 +6,7 @@
 
 #include "libcore/physics/anjyo_dynamics.h"
 #include "libcore/physics/float_lanes.h"
+#include "libcore/util/atomic_min.h"
 #include "libcore/util/random.h"
 
 namespace hairgen {
