@@ -281,6 +281,27 @@ TEST(CameraFragments, AStrandCoversEachColumnByItsWidth) {
       }
 }
 
+// A strand 20 texels wide at 45° has a cross-section 28 texels tall: at its root, 14 texels below its
+// first point, it reaches the band of rows (32 each) below the one that point is in (row 109 in band 3,
+// its cross-section down to row 95 in band 2). Every band its cross-section reaches draws it, so each
+// whole column sums to its width over cos θ, in the camera's view and in the light's maps alike.
+TEST(CameraFragments, AWideDiagonalStrandIsWholeAcrossTheBands) {
+  Strands s;
+  s.addStrand({{40.0f, 109.0f, -1.0f}, {170.0f, 239.0f, -1.0f}});
+  const double expected = 20.0 * std::sqrt(2.0);
+  const CameraFragments f = rasteriseCameraFragments(s, texelView(256), 20.0, kKeptFragments);
+  const HairLightMaps maps = rasteriseLightMaps(s, texelView(256), 20.0, kLayers);
+  for (int x = 40; x < 170; ++x) {
+    double camera = 0.0, light = 0.0;
+    for (int y = 0; y < 256; ++y) {
+      camera += pixelCoverage(f, size_t(y) * 256 + size_t(x));
+      light += double(maps.layers[size_t(y) * 256 + size_t(x)].w) / kCoverageOne;
+    }
+    EXPECT_NEAR(camera, expected, 0.01 * expected) << "the camera's column " << x;
+    EXPECT_NEAR(light, expected, 0.01 * expected) << "the light's column " << x;
+  }
+}
+
 // Twelve strands over the same pixels, 1 cm apart in depth, added in a shuffled order: each pixel keeps
 // the eight nearest, nearest first, and the four behind add their coverage to its tail.
 TEST(CameraFragments, APixelKeepsItsNearestFragmentsInDepthOrderAndTheRestInItsTail) {

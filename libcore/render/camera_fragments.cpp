@@ -37,7 +37,7 @@ void keep(Slot* list, uint8_t& n, uint32_t& tail, int kept, int32_t depth, uint3
   for (int k = 0; k < n; ++k) {
     Slot& s = list[k];
     if (point - s.last > 1) continue;
-    s.coverage += coverage;
+    raster::addSaturating(s.coverage, coverage);
     s.last = point;
     if (coverage > s.largest) {  // shaded where most of it is
       s.largest = coverage;
@@ -53,10 +53,10 @@ void keep(Slot* list, uint8_t& n, uint32_t& tail, int kept, int32_t depth, uint3
   const Slot fresh{depth, point, point, point, coverage, coverage, 0};
   if (n == kept) {
     if (!fresh.nearer(list[n - 1])) {
-      tail += coverage;
+      raster::addSaturating(tail, coverage);
       return;
     }
-    tail += list[--n].coverage;
+    raster::addSaturating(tail, list[--n].coverage);
   }
   int j = n++;
   for (; j > 0 && fresh.nearer(list[j - 1]); --j) list[j] = list[j - 1];

@@ -23,8 +23,8 @@
 namespace hairgen {
 
 // The fragments the shading pass blends per pixel (k-buffer depth): at a real strand's width at 1080p
-// (a fifth to a third of a pixel) the eight nearest strands hide what is behind them to a few per cent,
-// and the tail keeps the rest's coverage.
+// (a fifth to a third of a pixel) the eight nearest strands stop most of the light where hair is thick,
+// and the tail blends the rest's coverage as one layer (render_reference_test.sh measures the error).
 inline constexpr int kKeptFragments = 8;
 // The converged reference's (render --reference, with 8 × 8 sub-pixels): every fragment a sub-pixel of
 // a coupe sees, to the last per cent of its light.

@@ -91,6 +91,11 @@ class MidpointStep {
   int64_t den_, q_, r_, stepQ_, stepR_;
 };
 
+// Coverage sums stop at the largest a word holds, however many strands pile into a texel.
+inline void addSaturating(uint32_t& sum, uint32_t add) {
+  sum = add > UINT32_MAX - sum ? UINT32_MAX : sum + add;
+}
+
 // How a piece's cross-section is shared among the texels across it (above).
 enum class Across { kBox, kTent };
 

@@ -63,8 +63,8 @@ HairLightMaps rasteriseLightMaps(const Strands& hair, const View& light, double 
       const int64_t behind = int64_t(f.depth) - maps.start[f.texel];
       glm::uvec4& sum = maps.layers[f.texel];
       for (int k = 0; k < 3; ++k)
-        if (behind < ends[k]) sum[k] += f.coverage;
-      sum[3] += f.coverage;
+        if (behind < ends[k]) raster::addSaturating(sum[k], f.coverage);
+      raster::addSaturating(sum[3], f.coverage);
     }
   });
   return maps;

@@ -132,7 +132,7 @@ Programs::Programs(bool ribbons, int block, const CustomShaders& custom, bool mo
       resolve(stage(glsl::kFullscreenVertex), stage(glsl::kResolveFragment), "resolve") {
   const std::string defines = custom.hairFrag ? "" : hairShadingDefines(model, colored);
   if (rasterised) {
-    // One point per fragment, each its own sample: no screen door.
+    // One point per fragment, each its own sample: the screen door compiled to nothing (SINGLE_SAMPLE).
     hairAtlas.emplace(
         stage(glsl::kAtlasVertex),
         stage(glsl::kHairFragment, custom.hairFrag, "HairFrag",
@@ -379,7 +379,9 @@ ShadedImage blendHair(const Scene& scene, const CameraFragments& f, const Shaded
   if (rows > size_t(maxSize))
     renderFailure("the camera sees " + std::to_string(f.count()) +
                   " hair fragments, more than this device's largest texture holds; lower Samples");
-  const bool inPlace = scene.hair.readsStrandsInPlace();  // the fragments live as long as the hair
+  // Read in place where the hair is: the fragments outlive these buffers, whose deletion waits for
+  // the draws that read them (Buffer::reset).
+  const bool inPlace = scene.hair.readsStrandsInPlace();
   const Buffer words(f.words.data(), f.words.size() * sizeof(uint32_t), inPlace);
   const Buffer first(f.first.data(), f.first.size() * sizeof(uint32_t), inPlace);
   const Buffer tail(f.tail.data(), f.tail.size() * sizeof(uint32_t), inPlace);
@@ -387,6 +389,10 @@ ShadedImage blendHair(const Scene& scene, const CameraFragments& f, const Shaded
   {
     Framebuffer fb({&atlasColor, &atlasData}, atlasWidth, int(rows), false);
     fb.bind();
+    // A fragment a custom HairFrag discards leaves its texel as cleared: no light stopped.
+    const float nothing[4] = {0.0f, 0.0f, 0.0f, 0.0f};
+    glClearBufferfv(GL_COLOR, 0, nothing);
+    glClearBufferfv(GL_COLOR, 1, nothing);
     glDisable(GL_DEPTH_TEST);
     scene.hair.draw(true, false);  // binds the hair's storage buffers
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 5, words.id);
@@ -460,12 +466,16 @@ ShadedImage shadingPass(const Scene& scene, const LightDepth& depth, const Textu
   }
   if (!scene.rasterised) return image;
   // The hair the head hides is no fragment of the pixel: the rasteriser gets the head's depth.
-  std::vector<float> headDepth(size_t(w) * size_t(h));
-  glBindBuffer(GL_PIXEL_PACK_BUFFER, 0);  // into client memory, not a readback buffer
-  glGetTextureImage(image.data.id, 0, GL_RED, GL_FLOAT, GLsizei(headDepth.size() * sizeof(float)),
-                    headDepth.data());
-  checkGl("reading the head's depth");
-  const CameraFragments f = cameraFragments(*scene.cameraBands, scene.kept, headDepth.data());
+  std::vector<float> headDepth;
+  if (scene.head) {
+    headDepth.resize(size_t(w) * size_t(h));
+    glBindBuffer(GL_PIXEL_PACK_BUFFER, 0);  // into client memory, not a readback buffer
+    glGetTextureImage(image.data.id, 0, GL_RED, GL_FLOAT, GLsizei(headDepth.size() * sizeof(float)),
+                      headDepth.data());
+    checkGl("reading the head's depth");
+  }
+  const CameraFragments f =
+      cameraFragments(*scene.cameraBands, scene.kept, headDepth.empty() ? nullptr : headDepth.data());
   headDepth = {};
   fragments = f.count();
   return blendHair(scene, f, image);
@@ -510,7 +520,8 @@ Texture motionPass(const Scene& scene) {
     p.set("uImageSize", imageSize);
     scene.head->draw();
   }
-  // As the shading pass draws the hair, so each sub-pixel's nearest kept fragment is the same strand's.
+  // OpenGL's lines (or ribbons) at least a pixel wide, with the screen door at sub-pixels: the motion of
+  // what is nearest in each sub-pixel, a footprint wider than the beauty's thin strands.
   const Program& p = *scene.programs.hairMotion;
   useForHairStrips(p, scene, r);
   p.set("uViewProj", glm::mat4(scene.viewProj));

@@ -29,7 +29,7 @@ void main() {
   bool hidden = false;
   for (int j = first; j < end; ++j) {
     float depth = uintBitsToFloat(fragmentData[3 * j + 1]);
-    if (depth >= headZ) {
+    if (depth >= headZ) {  // the rasteriser left none behind the head (the same test); kept as a guard
       hidden = true;
       break;
     }
