@@ -24,6 +24,11 @@ struct Slot {
   bool nearer(const Slot& o) const { return depth != o.depth ? depth < o.depth : origin < o.origin; }
 };
 
+// A depth in kDepthUnit as the metres it is stored and compared as (a float: the blend reads it so).
+float metresOf(int32_t depth) {
+  return float(double(depth) * kDepthUnit);
+}
+
 uint32_t spanOf(raster::Piece piece) {
   return uint32_t(piece.twice * int64_t(kSpanUnit) / (2 * piece.length));
 }
@@ -98,7 +103,7 @@ CameraFragments cameraFragments(const raster::Bands& bands, int kept, const floa
     bands.eachFragment<raster::Across::kBox>(band, [&](size_t texel, int32_t depth, uint32_t coverage,
                                                        uint32_t point, raster::Piece piece) {
       // Compared as the blend compares them: the fragment's depth as the float it is stored as.
-      if (opaque && float(double(depth) * kDepthUnit) >= opaque[texel]) return;
+      if (opaque && metresOf(depth) >= opaque[texel]) return;
       const size_t local = texel - base;
       keep(&slots[local * size_t(kept)], used[local], out.tail[texel], kept, depth, coverage, point, piece);
     });
@@ -110,8 +115,7 @@ CameraFragments cameraFragments(const raster::Bands& bands, int kept, const floa
       counts[base + p] = used[p];
       for (int k = 0; k < used[p]; ++k) {
         const Slot& s = slots[p * size_t(kept) + size_t(k)];
-        const float metres = float(double(s.depth) * kDepthUnit);
-        words.insert(words.end(), {s.point, std::bit_cast<uint32_t>(metres),
+        words.insert(words.end(), {s.point, std::bit_cast<uint32_t>(metresOf(s.depth)),
                                    std::min(s.coverage, kCoverageOne) | (s.span << kCoverageBits)});
       }
     }

@@ -21,10 +21,16 @@ namespace {
 // line still overlaps the curve's).
 constexpr double kChordPixels = 0.375;
 
+// The current context's largest texture, texels a side.
+int maxTextureSize() {
+  GLint size = 4096;
+  glGetIntegerv(GL_MAX_TEXTURE_SIZE, &size);
+  return int(size);
+}
+
 // k for Samples = k² (k ≤ 8), lowered until the sub-pixel image fits the device's largest texture.
 int subpixelBlock(const RenderSettings& r) {
-  GLint maxSize = 4096;
-  glGetIntegerv(GL_MAX_TEXTURE_SIZE, &maxSize);
+  const int maxSize = maxTextureSize();
   int block = std::min(std::max(1, int(std::lround(std::sqrt(double(r.samples))))), 8);
   while (block > 1 && std::max(r.resolution.x, r.resolution.y) * block > maxSize) --block;
   return block;
@@ -36,9 +42,7 @@ int subpixelBlock(const RenderSettings& r) {
 // kMaxDomResolution and the device's largest texture.
 int lightMapSize(const RenderInput& in, const BoundingSphere& sphere, const View& camera) {
   if (in.domResolution > 0) return in.domResolution;
-  GLint maxSize = 4096;
-  glGetIntegerv(GL_MAX_TEXTURE_SIZE, &maxSize);
-  const int largest = std::min(int(maxSize), kMaxDomResolution);
+  const int largest = std::min(maxTextureSize(), kMaxDomResolution);
   const double lightFocalPerTexel = lightView(in.settings, sphere, 1).focalPx;
   const double lightDistance = glm::length(sphere.centre - in.settings.lightPosition);
   const double cameraDistance = glm::length(sphere.centre - in.settings.cameraPosition);
@@ -372,9 +376,8 @@ constexpr int kAtlasWidth = 4096;
 // blended front to back over the head (`head`: what the head's drawing left) into the returned image.
 ShadedImage blendHair(const Scene& scene, const CameraFragments& f, const ShadedImage& head) {
   const int w = scene.subpixel.width, h = scene.subpixel.height;
-  GLint maxSize = 4096;
-  glGetIntegerv(GL_MAX_TEXTURE_SIZE, &maxSize);
-  const int atlasWidth = std::min(kAtlasWidth, int(maxSize));
+  const int maxSize = maxTextureSize();
+  const int atlasWidth = std::min(kAtlasWidth, maxSize);
   const size_t rows = std::max<size_t>(1, (f.count() + size_t(atlasWidth) - 1) / size_t(atlasWidth));
   if (rows > size_t(maxSize))
     renderFailure("the camera sees " + std::to_string(f.count()) +
