@@ -1,6 +1,7 @@
 // hairgen render SETUP --hair FILE -o image.exr: Kajiya-Kay hair with deep opacity map shadows,
 // headless through EGL, to an EXR with AOVs; --dom and --preview write the light's maps and a PNG.
 #include <iostream>
+#include <map>
 
 #include "cli/commands.h"
 #include "cli/common.h"
@@ -62,7 +63,9 @@ RenderOutput renderStage(const CommonOptions& common, const Config& config, GlCo
   stats.counts()["strands"] = strands;
   stats.counts()["points"] = points;
   stats.counts()["samples"] = out.samples;
-  stats.json()["device"]["lightMaps"] = out.lightMapsOnCpu ? "cpu" : "opengl";
+  const char* rasteriser = out.rasterisedOnDevice ? "device" : "cpu";
+  stats.json()["device"]["lightMaps"] = out.lightMapsByRasteriser ? rasteriser : "opengl";
+  stats.json()["device"]["rasteriser"] = rasteriser;
   stats.counts()["hairFragments"] = out.hairFragments;
   stats.json()["device"]["hairReadInPlace"] = out.hairReadInPlace;
   return out;
@@ -141,6 +144,7 @@ struct RenderArgs {
   double scale = 1.0;
   std::vector<double> translate;
   bool frame = false, motion = false, reference = false;
+  RenderInput::Rasteriser rasteriser = RenderInput::Rasteriser::kAuto;
   bool sequence() const { return !frames.empty(); }
   bool fromGuides() const { return !guides.empty(); }
   // A file of the command: with --frames, frame `f`'s file of its pattern.
@@ -181,6 +185,15 @@ void addRenderFlags(CLI::App& cmd, RenderArgs& args) {
   cmd.add_flag("--reference", args.reference,
                "Render the converged reference: 64 samples a pixel, each blending every hair fragment it "
                "sees (slow; what Samples is measured against, docs/rendering.md)");
+  cmd.add_option("--rasteriser", args.rasteriser,
+                 "Where hairgen's hair rasteriser runs: auto (the GPU's compute shaders on a GPU, the CPU's "
+                 "threads under llvmpipe), cpu or device; the same image either way (docs/rendering.md)")
+      ->transform(CLI::CheckedTransformer(
+          std::map<std::string, RenderInput::Rasteriser>{{"auto", RenderInput::Rasteriser::kAuto},
+                                                         {"cpu", RenderInput::Rasteriser::kCpu},
+                                                         {"device", RenderInput::Rasteriser::kDevice}},
+          CLI::ignore_case))
+      ->type_name("WHERE");
   cmd.add_option(
          "--frames", args.frames,
          "Render these frames of a sequence in one process, one device: --hair, -o, --dom and --preview "
@@ -251,6 +264,7 @@ RenderOptions renderOptionsOf(const RenderArgs& args) {
   renderOptions.scale = conversion.metresPerUnit.value_or(args.scale);
   renderOptions.keepDom = !args.dom.empty();
   renderOptions.reference = args.reference;
+  renderOptions.rasteriser = args.rasteriser;
   return renderOptions;
 }
 

@@ -187,6 +187,23 @@ run() {
       say "(b) passes (light depth + opacity + shading, each waited for): $passes s (target 5 ms on a GPU)"
       say "(d) peak memory $(awk -v p="$peak" -v c="$cache" 'BEGIN {printf "%.0f MB = %.2f x the cache'"'"'s %.0f MB", p / 1e6, p / c, c / 1e6}') (target 3 x)"
       say "    device start: $(json "$figures/stats.6.json" "d['device'].get('start', 'not recorded by this build')")"
+      say "    rasteriser: $(json "$figures/stats.6.json" "d['device'].get('rasteriser', 'cpu (this build has only the CPU one)')")"
+      # The same frame with the rasteriser on the CPU's threads: the same EXRs to the byte (issue 34:
+      # one rasteriser, one answer), and what it costs here.
+      local t0 t1
+      t0=$(date +%s.%N)
+      if timeout 120 "$hairgen" render "$setup" --hair "$figures/coupe.hair" -o "$figures/image-cpu.exr" \
+        --dom "$figures/dom-cpu.exr" "${size[@]}" --rasteriser cpu --stats "$figures/stats-cpu.json" &&
+        timeout 120 "$hairgen" render "$setup" --hair "$figures/coupe.hair" -o "$figures/image-auto.exr" \
+          --dom "$figures/dom-auto.exr" "${size[@]}"; then
+        t1=$(date +%s.%N)
+        local same=no
+        cmp -s "$figures/image-cpu.exr" "$figures/image-auto.exr" && cmp -s "$figures/dom-cpu.exr" "$figures/dom-auto.exr" && same=yes
+        say "(e) --rasteriser cpu: $(json "$figures/stats-cpu.json" "' '.join(f'{k} {v:.3f}' for k, v in d['seconds'].items())"); the same EXRs (image and --dom) as the default's: $same"
+        [ "$same" = yes ] || "$hairgen" diff "$figures/image-cpu.exr" "$figures/image-auto.exr" 2>&1 | head -12 | sed 's/^/    /' | tee -a "$summary"
+      else
+        say "(e) the --rasteriser cpu comparison failed"
+      fi
     fi
     # A sequence: the same coupe as every frame (links), so a frame's cost is all that is measured.
     [ "$frames" -gt 0 ] || say "(c) no sequence (DEVICE_CHECK_FRAMES=0)"

@@ -121,6 +121,7 @@ RenderOutput render(GlContext& gl, const Strands& hair, const Mesh* head, const 
   input.domResolution = options.domResolution;
   input.keepDom = options.keepDom;
   input.lightMaps = options.lightMaps;
+  input.rasteriser = options.rasteriser;
   if (options.reference) {
     input.settings.samples = 64;
     input.keptFragments = kReferenceFragments;

@@ -60,7 +60,8 @@ struct RenderOptions {
   double scale = 1.0;     // multiplies the hair's positions and widths, to metres (0.01 for centimetres)
   bool keepDom = false;   // return the light's maps in RenderOutput::dom
   int domResolution = 0;  // texels per side of the light's maps; 0: as the image needs (RenderInput)
-  RenderInput::LightMaps lightMaps = RenderInput::LightMaps::kAuto;  // who draws them (RenderInput)
+  RenderInput::LightMaps lightMaps = RenderInput::LightMaps::kAuto;     // who draws them (RenderInput)
+  RenderInput::Rasteriser rasteriser = RenderInput::Rasteriser::kAuto;  // where it runs (RenderInput)
   bool force = false;  // render work estimated to take absurdly long (never work that cannot fit)
   // The converged reference: Samples 64 (as far as the device allows) and kReferenceFragments per
   // sub-pixel, the ground truth the Setup's Samples are measured against (docs/rendering.md).

@@ -75,8 +75,10 @@ GLuint compileStage(GLenum type, const StageSource& source, const char* program)
   if (source.custom)
     throw InputError({source.custom->file, error.line}, error.text + " (compiling " + origin(source) + ")");
   renderFailure(std::string("compiling the ") + program + " program's " +
-                (type == GL_VERTEX_SHADER ? "vertex" : "fragment") + " stage: line " +
-                std::to_string(error.line) + ": " + error.text);
+                (type == GL_VERTEX_SHADER    ? "vertex"
+                 : type == GL_COMPUTE_SHADER ? "compute"
+                                             : "fragment") +
+                " stage: line " + std::to_string(error.line) + ": " + error.text);
 }
 
 }  // namespace
@@ -103,6 +105,33 @@ Program::Program(const StageSource& vertex, const StageSource& fragment, const c
   id = gl->kept<LinkedProgram>(vertex.text + '\0' + fragment.text, [&] {
            auto linked = std::make_unique<LinkedProgram>();
            linked->id = link(vertex, fragment, name);
+           return linked;
+         }).id;
+}
+
+Program::Program(const StageSource& compute, const char* name) {
+  auto linkCompute = [&] {
+    const GLuint c = compileStage(GL_COMPUTE_SHADER, compute, name);
+    const GLuint linked = glCreateProgram();
+    glAttachShader(linked, c);
+    glLinkProgram(linked);
+    glDeleteShader(c);
+    GLint ok = 0;
+    glGetProgramiv(linked, GL_LINK_STATUS, &ok);
+    if (ok) return linked;
+    const CompilerMessage error = firstCompilerError(infoLog(linked, true));
+    glDeleteProgram(linked);
+    renderFailure(std::string("linking the ") + name + " program: " + error.text);
+  };
+  GlContext* gl = GlContext::current();
+  if (!gl) {
+    id = linkCompute();
+    owned_ = true;
+    return;
+  }
+  id = gl->kept<LinkedProgram>(std::string("compute") + '\0' + compute.text, [&] {
+           auto linked = std::make_unique<LinkedProgram>();
+           linked->id = linkCompute();
            return linked;
          }).id;
 }

@@ -45,6 +45,8 @@ struct StageSource {
 class Program {
  public:
   Program(const StageSource& vertex, const StageSource& fragment, const char* name);
+  // A program of one compute stage, hairgen's own (a failure throws Error), kept by the context alike.
+  Program(const StageSource& compute, const char* name);
   ~Program();
   Program(const Program&) = delete;
   Program& operator=(const Program&) = delete;

@@ -18,8 +18,8 @@ constexpr double kWidest = 4096.0;
 
 }  // namespace
 
-Bands projectIntoBands(const Strands& hair, const View& v, double strandWidth) {
-  Bands out;
+Projection project(const Strands& hair, const View& v, double strandWidth) {
+  Projection out;
   out.width = v.width;
   out.height = v.height;
   // Every point projected as the view places it, then quantised: from here on, integers.
@@ -48,13 +48,27 @@ Bands projectIntoBands(const Strands& hair, const View& v, double strandWidth) {
                       }
                     });
   // The segments: each pair of consecutive points of a strand, both drawn; by their first point.
-  std::vector<uint32_t> segments;
+  std::vector<uint32_t>& segments = out.segments;
   segments.reserve(hair.points.size());
   for (size_t s = 0; s + 1 < hair.firstPoint.size(); ++s)
     for (uint32_t i = hair.firstPoint[s]; i + 1 < hair.firstPoint[s + 1]; ++i)
       if (vertices[i].depth >= 0 && vertices[i + 1].depth >= 0) segments.push_back(i);
+  return out;
+}
+
+Bands projectIntoBands(const Strands& hair, const View& v, double strandWidth) {
+  return intoBands(project(hair, v, strandWidth));
+}
+
+Bands intoBands(Projection&& p) {
+  Bands out;
+  out.width = p.width;
+  out.height = p.height;
+  out.vertices = std::move(p.vertices);
+  const std::vector<Vertex>& vertices = out.vertices;
+  const std::vector<uint32_t> segments = std::move(p.segments);
   // Each segment's bands: the rows its fragments can fall in.
-  const int height = v.height;
+  const int height = p.height;
   const int bands = out.count = (height + kBandRows - 1) / kBandRows;
   auto bandsOf = [&](size_t s, int& lo, int& hi) {
     const Vertex &a = vertices[segments[s]], &b = vertices[segments[s] + 1];

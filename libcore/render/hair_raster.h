@@ -91,6 +91,15 @@ class MidpointStep {
   int64_t den_, q_, r_, stepQ_, stepR_;
 };
 
+// √n rounded to the nearest integer, exactly (never a tie: (r + ½)² is no integer), so every machine
+// and the GLSL twin (glsl/raster_segment.glsl) agree: a floating-point estimate corrected in integers.
+inline uint64_t roundedSqrt(uint64_t n) {
+  uint64_t r = uint64_t(std::sqrt(double(n)));
+  while (r > 0 && r * r > n) --r;
+  while ((r + 1) * (r + 1) <= n) ++r;
+  return n - r * r > r ? r + 1 : r;  // n ≥ r² + r + 1 > (r + ½)²
+}
+
 // Coverage sums stop at the largest a word holds, however many strands pile into a texel.
 inline void addSaturating(uint32_t& sum, uint32_t add) {
   sum = add > UINT32_MAX - sum ? UINT32_MAX : sum + add;
@@ -139,9 +148,8 @@ void rasteriseSegment(Vertex a, Vertex b, int64_t rowLo, int64_t rowHi, F&& frag
   const int64_t u0 = major(a), u1 = major(b), v0 = minor(a);
   const int64_t du = u1 - u0, dv = minor(b) - v0, dz = int64_t(b.depth) - a.depth;
   if (du == 0) return;  // seen end on: no length, no area
-  // The square root of an integer below 2^53 is correctly rounded in double: the same on every machine;
-  // rounded to the nearest 1/kSubTexel, so short segments are not all a little short.
-  const uint64_t length = uint64_t(std::sqrt(double(du * du + dv * dv)) + 0.5);
+  // Rounded to the nearest 1/kSubTexel, so short segments are not all a little short.
+  const uint64_t length = roundedSqrt(uint64_t(du * du + dv * dv));
   const uint64_t width = (uint64_t(a.width) + uint64_t(b.width)) / 2;  // 1/kWidthUnit texel
   // The ribbon's extent across the major axis, 1/kWidthUnit texel; half of it in 1/kSubTexel, at least
   // one (a thinner ribbon is shared as a line is).
@@ -209,6 +217,13 @@ void rasteriseSegment(Vertex a, Vertex b, int64_t rowLo, int64_t rowHi, F&& frag
   }
 }
 
+// The hair as a view sees it, quantised: every point, and the segments drawn.
+struct Projection {
+  int width = 0, height = 0;       // the image's texels
+  std::vector<Vertex> vertices;    // one per point
+  std::vector<uint32_t> segments;  // each segment's first point, in order: both its points drawn
+};
+
 // The hair as a view sees it, quantised, and its segments sorted into bands of rows.
 struct Bands {
   int width = 0, height = 0, count = 0;  // the image's texels; bands of kBandRows rows
@@ -234,9 +249,14 @@ struct Bands {
   }
 };
 
-// Projects the hair with `v` (its width × height texels) and sorts its segments into bands.
-// `strandWidth`: the strands' diameter, metres. A segment with a point nearer than the near plane, or
-// far off the image, is dropped.
+// Projects the hair with `v` (its width × height texels). `strandWidth`: the strands' diameter, metres.
+// A segment with a point nearer than the near plane, or far off the image, is dropped.
+Projection project(const Strands& hair, const View& v, double strandWidth);
+
+// The projection's segments sorted into bands (its vertices move into them).
+Bands intoBands(Projection&& p);
+
+// project(), then intoBands().
 Bands projectIntoBands(const Strands& hair, const View& v, double strandWidth);
 
 }  // namespace raster

@@ -7,6 +7,7 @@
 
 #include "glsl/embedded_glsl.h"
 #include "libcore/render/camera_fragments.h"
+#include "libcore/render/compute_raster.h"
 #include "libcore/render/light_maps.h"
 #include "libcore/render/line_decimation.h"
 #include "libcore/render/readback.h"
@@ -49,6 +50,22 @@ int lightMapSize(const RenderInput& in, const BoundingSphere& sphere, const View
   const double pixel = std::max(cameraDistance, 1e-6) / camera.focalPx;
   const double texels = std::ceil(std::max(lightDistance, 1e-6) / (lightFocalPerTexel * pixel));
   return int(std::clamp(texels, double(kMinDomResolution), double(largest)));
+}
+
+// Whether hairgen's rasteriser runs on the device (RenderInput::rasteriser).
+bool rasteriseOnDevice(const RenderInput& in) {
+  switch (in.rasteriser) {
+    case RenderInput::Rasteriser::kCpu:
+      return false;
+    case RenderInput::Rasteriser::kDevice:
+      if (!computeRasterAvailable())
+        renderFailure(
+            "this device cannot run hairgen's rasteriser (no GL_ARB_gpu_shader_int64); use the CPU's");
+      return true;
+    case RenderInput::Rasteriser::kAuto:
+      break;
+  }
+  return !softwareRasteriser() && computeRasterAvailable();
 }
 
 // Lines where every strand is at most a pixel and a half wide (at the scene's nearest point) and
@@ -182,6 +199,8 @@ struct Scene::Preparation {
   bool cameraChords = false;
   std::unique_ptr<HairLightMaps> lightMaps;    // when hairgen's rasteriser draws them
   std::unique_ptr<raster::Bands> cameraBands;  // when it draws the camera's hair
+  // The same projected for the device, when the rasteriser runs there (Scene::onDevice).
+  std::unique_ptr<raster::Projection> lightProjection, cameraProjection;
   tbb::task_group work;
 
   Preparation(const Scene& scene, const RenderInput& in) {
@@ -206,13 +225,20 @@ struct Scene::Preparation {
     const RenderSettings& r = in.settings;
     const View& subpixelView = scene.subpixel;
     const bool cameraByRasteriser = scene.rasterised;
+    const bool onDevice = scene.onDevice;
     // One after the other, each on every thread: the light's projection is freed before the camera's
     // is made.
     work.run([=, this, &hair, &lightView, &subpixelView, &r] {
-      if (lightByRasteriser)
+      if (lightByRasteriser && onDevice)
+        lightProjection =
+            std::make_unique<raster::Projection>(raster::project(hair, lightView, r.strandWidth));
+      else if (lightByRasteriser)
         lightMaps =
             std::make_unique<HairLightMaps>(rasteriseLightMaps(hair, lightView, r.strandWidth, r.layerSizes));
-      if (cameraByRasteriser)
+      if (cameraByRasteriser && onDevice)
+        cameraProjection =
+            std::make_unique<raster::Projection>(raster::project(hair, subpixelView, r.strandWidth));
+      else if (cameraByRasteriser)
         cameraBands =
             std::make_unique<raster::Bands>(raster::projectIntoBands(hair, subpixelView, r.strandWidth));
     });
@@ -243,6 +269,7 @@ Scene::Scene(const RenderInput& in)
       motion(in.previous.has_value()),
       rasterised(!in.shaders.hairVert),
       kept(in.keptFragments),
+      onDevice(rasteriseOnDevice(in)),
       preparing(std::make_unique<Preparation>(*this, in)),
       hair(*in.hair, tangentsFor(*in.hair), motion ? in.previous->hair : nullptr, in.readInPlace),
       head(in.head && !in.head->triangles.empty()
@@ -261,6 +288,10 @@ Scene::Scene(const RenderInput& in)
   if (!preparing->order.empty()) hair.drawInOrder(*in.hair, preparing->order);
   lightMaps = std::move(preparing->lightMaps);
   cameraBands = std::move(preparing->cameraBands);
+  if (preparing->lightProjection)
+    lightOnDevice = std::make_unique<DeviceProjection>(*preparing->lightProjection);
+  if (preparing->cameraProjection)
+    cameraOnDevice = std::make_unique<DeviceProjection>(*preparing->cameraProjection);
   if (preparing->cameraChords)
     cameraLines = std::make_unique<LineStrips>(preparing->camera, kCameraChunkVertices);
   preparing.reset();
@@ -271,10 +302,12 @@ Scene::~Scene() = default;
 
 void Scene::releaseLightMaps() {
   lightMaps.reset();
+  lightOnDevice.reset();
 }
 
 void Scene::releaseCameraBands() {
   cameraBands.reset();
+  cameraOnDevice.reset();
 }
 
 void Scene::releaseGeometry() {
@@ -282,6 +315,8 @@ void Scene::releaseGeometry() {
   hair.release();
   lightMaps.reset();
   cameraBands.reset();
+  lightOnDevice.reset();
+  cameraOnDevice.reset();
   cameraLines.reset();
   head.reset();
 }
@@ -290,7 +325,7 @@ LightDepth lightDepthPass(const Scene& scene) {
   const int n = scene.light.width;
   const float far[4] = {kBackgroundZ, kBackgroundZ, kBackgroundZ, kBackgroundZ};
   const float one = 1.0f;
-  LightDepth depth{Texture(GL_R32F, n, n), Texture(GL_R32F, n, n)};
+  LightDepth depth{Texture(GL_R32F, n, n), Texture(GL_R32F, n, n), std::nullopt};
   glEnable(GL_DEPTH_TEST);
   glDepthFunc(GL_LESS);
   glDisable(GL_CULL_FACE);
@@ -305,7 +340,12 @@ LightDepth lightDepthPass(const Scene& scene) {
       scene.head->draw();
     }
   }
-  if (scene.lightMaps) {
+  if (scene.lightOnDevice) {
+    depth.opacity.emplace(GL_RGBA32F, n, n);
+    const RenderSettings& r = scene.settings;
+    computeLightMaps(*scene.lightOnDevice, r.layerSizes, r.strandOpacity, kBackgroundZ, depth.hairStart,
+                     *depth.opacity);
+  } else if (scene.lightMaps) {
     const std::vector<float> start = scene.lightMaps->startMetres(kBackgroundZ);
     glTextureSubImage2D(depth.hairStart.id, 0, 0, 0, n, n, GL_RED, GL_FLOAT, start.data());
   } else {
@@ -323,7 +363,12 @@ LightDepth lightDepthPass(const Scene& scene) {
   return depth;
 }
 
-Texture deepOpacityPass(const Scene& scene, const LightDepth& depth) {
+Texture deepOpacityPass(const Scene& scene, LightDepth& depth) {
+  if (depth.opacity) {
+    Texture drawn = std::move(*depth.opacity);
+    depth.opacity.reset();
+    return drawn;
+  }
   const int n = scene.light.width;
   Texture opacity(GL_RGBA32F, n, n);
   if (scene.lightMaps) {
@@ -372,22 +417,23 @@ void setHairShading(const Program& p, const Scene& scene) {
 // Texels per row of the atlas the kept fragments are shaded in.
 constexpr int kAtlasWidth = 4096;
 
+// The camera's kept fragments in the device's buffers, laid out as CameraFragments' (words, first,
+// tail), `count` of them.
+struct FragmentBuffers {
+  GLuint words, first, tail;
+  size_t count;
+};
+
 // The rasteriser's kept fragments shaded one texel each in an atlas by the hair's shading stage, then
 // blended front to back over the head (`head`: what the head's drawing left) into the returned image.
-ShadedImage blendHair(const Scene& scene, const CameraFragments& f, const ShadedImage& head) {
+ShadedImage blendHair(const Scene& scene, const FragmentBuffers& f, const ShadedImage& head) {
   const int w = scene.subpixel.width, h = scene.subpixel.height;
   const int maxSize = maxTextureSize();
   const int atlasWidth = std::min(kAtlasWidth, maxSize);
-  const size_t rows = std::max<size_t>(1, (f.count() + size_t(atlasWidth) - 1) / size_t(atlasWidth));
+  const size_t rows = std::max<size_t>(1, (f.count + size_t(atlasWidth) - 1) / size_t(atlasWidth));
   if (rows > size_t(maxSize))
-    renderFailure("the camera sees " + std::to_string(f.count()) +
+    renderFailure("the camera sees " + std::to_string(f.count) +
                   " hair fragments, more than this device's largest texture holds; lower Samples");
-  // Read in place where the hair is: the fragments outlive these buffers, whose deletion waits for
-  // the draws that read them (Buffer::reset).
-  const bool inPlace = scene.hair.readsStrandsInPlace();
-  const Buffer words(f.words.data(), f.words.size() * sizeof(uint32_t), inPlace);
-  const Buffer first(f.first.data(), f.first.size() * sizeof(uint32_t), inPlace);
-  const Buffer tail(f.tail.data(), f.tail.size() * sizeof(uint32_t), inPlace);
   Texture atlasColor(GL_RGBA16F, atlasWidth, int(rows)), atlasData(GL_RGBA16F, atlasWidth, int(rows));
   {
     Framebuffer fb({&atlasColor, &atlasData}, atlasWidth, int(rows), false);
@@ -398,21 +444,21 @@ ShadedImage blendHair(const Scene& scene, const CameraFragments& f, const Shaded
     glClearBufferfv(GL_COLOR, 1, nothing);
     glDisable(GL_DEPTH_TEST);
     scene.hair.draw(true, false);  // binds the hair's storage buffers
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 5, words.id);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 5, f.words);
     const Program& p = *scene.programs.hairAtlas;
     p.use();
     setHairShading(p, scene);
     p.set("uOpacity", float(scene.settings.strandOpacity));
     p.set("uAtlasWidth", atlasWidth);
     p.set("uAtlasSize", glm::vec2(atlasWidth, float(rows)));
-    drawPoints(f.count());
+    drawPoints(f.count);
     checkGl("the hair's shading");
   }
   ShadedImage image{Texture(GL_RGBA16F, w, h), Texture(GL_RGBA32F, w, h), true};
   Framebuffer fb({&image.color, &image.data}, w, h, false);
   fb.bind();
-  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 6, first.id);
-  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 7, tail.id);
+  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 6, f.first);
+  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 7, f.tail);
   glBindTextureUnit(kUnitSubpixelColor, head.color.id);
   glBindTextureUnit(kUnitSubpixelData, head.data.id);
   glBindTextureUnit(kUnitAtlasColor, atlasColor.id);
@@ -468,6 +514,13 @@ ShadedImage shadingPass(const Scene& scene, const LightDepth& depth, const Textu
     checkGl("the shading pass");
   }
   if (!scene.rasterised) return image;
+  if (scene.cameraOnDevice) {
+    // The head's depth is the data's R, read where it lies.
+    const DeviceFragments f =
+        computeCameraFragments(*scene.cameraOnDevice, scene.kept, scene.head ? &image.data : nullptr);
+    fragments = f.count;
+    return blendHair(scene, {f.words->id, f.first->id, f.tail->id, f.count}, image);
+  }
   // The hair the head hides is no fragment of the pixel: the rasteriser gets the head's depth.
   std::vector<float> headDepth;
   if (scene.head) {
@@ -481,7 +534,13 @@ ShadedImage shadingPass(const Scene& scene, const LightDepth& depth, const Textu
       cameraFragments(*scene.cameraBands, scene.kept, headDepth.empty() ? nullptr : headDepth.data());
   headDepth = {};
   fragments = f.count();
-  return blendHair(scene, f, image);
+  // Read in place where the hair is: the fragments outlive these buffers, whose deletion waits for
+  // the draws that read them (Buffer::reset).
+  const bool inPlace = scene.hair.readsStrandsInPlace();
+  const Buffer words(f.words.data(), f.words.size() * sizeof(uint32_t), inPlace);
+  const Buffer first(f.first.data(), f.first.size() * sizeof(uint32_t), inPlace);
+  const Buffer tail(f.tail.data(), f.tail.size() * sizeof(uint32_t), inPlace);
+  return blendHair(scene, {words.id, first.id, tail.id, f.count()}, image);
 }
 
 ShadedImage resolvePass(const Scene& scene, const ShadedImage& subpixels) {

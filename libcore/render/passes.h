@@ -26,7 +26,8 @@
 
 namespace hairgen {
 
-struct HairLightMaps;  // light_maps.h
+struct HairLightMaps;     // light_maps.h
+struct DeviceProjection;  // compute_raster.h
 namespace raster {
 struct Bands;  // hair_raster.h
 }
@@ -62,6 +63,7 @@ struct Scene {
   bool motion;            // the previous frame was given: motion vectors too
   bool rasterised;        // the camera's hair comes from hairgen's rasteriser (not a custom HairVert)
   int kept;               // the fragments kept per sub-pixel (RenderInput::keptFragments)
+  bool onDevice;          // hairgen's rasteriser runs on the device (RenderInput::rasteriser)
   glm::dmat4 viewProj{1.0}, previousViewProj{1.0};  // world to clip: this frame's camera, the previous one's
   // What the CPU prepares for drawing while the GL objects below are made (passes.cpp).
   struct Preparation;
@@ -76,6 +78,9 @@ struct Scene {
   // The hair as the camera's rasteriser sees it at the sub-pixels (hair_raster.h), its fragments drawn
   // in the shading pass, once the head's depth is known; null when OpenGL draws the camera's hair.
   std::unique_ptr<raster::Bands> cameraBands;
+  // The same on the device, where the rasteriser runs there (onDevice): the light's projection and the
+  // camera's, uploaded.
+  std::unique_ptr<DeviceProjection> lightOnDevice, cameraOnDevice;
   std::unique_ptr<HeadGeometry> head;  // null when there is no head to draw
   Programs programs;
 
@@ -91,6 +96,8 @@ struct Scene {
 struct LightDepth {
   Texture head;       // R32F: to the head
   Texture hairStart;  // R32F: to where the hair begins
+  // The deep opacity map, when the device's rasteriser drew it with the depth (deepOpacityPass takes it).
+  std::optional<Texture> opacity;
 };
 
 // An image the shading pass draws and the resolve averages.
@@ -102,7 +109,7 @@ struct ShadedImage {
 
 LightDepth lightDepthPass(const Scene& scene);
 // RGBA32F, one layer per channel, the light's map size.
-Texture deepOpacityPass(const Scene& scene, const LightDepth& depth);
+Texture deepOpacityPass(const Scene& scene, LightDepth& depth);
 // At sub-pixel resolution; `fragments`: how many hair fragments the rasteriser kept (0 when OpenGL drew
 // the hair).
 ShadedImage shadingPass(const Scene& scene, const LightDepth& depth, const Texture& opacity,

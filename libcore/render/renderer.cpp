@@ -45,7 +45,8 @@ RenderOutput renderHair(GlContext&, const RenderInput& in) {
   out.lightWorldToNdc = openExrWorldToNdc(scene.light);
   out.timings.upload = seconds(clock);
   out.hairReadInPlace = scene.hair.readsStrandsInPlace();
-  out.lightMapsOnCpu = scene.lightMaps != nullptr;
+  out.lightMapsByRasteriser = scene.lightMaps || scene.lightOnDevice;
+  out.rasterisedOnDevice = scene.onDevice;
   if (in.uploaded && !out.hairReadInPlace) in.uploaded();
   auto passDone = [&] {
     if (in.progress) in.progress->advance();

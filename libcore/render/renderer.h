@@ -54,10 +54,14 @@ struct RenderOutput {
   RenderTimings timings;
   int samples = 1;               // the samples used (Samples, clamped to what the device offers)
   bool hairReadInPlace = false;  // whether the device read the hair where it lay (RenderInput::readInPlace)
-  bool lightMapsOnCpu = false;   // whether the CPU drew the light's hair maps (RenderInput::lightMaps)
-  size_t hairFragments = 0;      // the camera's kept hair fragments (camera_fragments.h), at the sub-pixels
-  RenderSettings settings;       // what was rendered: the input's, with the camera and light the render stage
-                                 // aimed when asked to frame the hair
+  // Who drew the light's hair maps (RenderInput::lightMaps): hairgen's rasteriser (on the device when
+  // rasterisedOnDevice), or OpenGL's lines.
+  bool lightMapsByRasteriser = false;
+  bool rasterisedOnDevice =
+      false;                 // whether hairgen's rasteriser ran on the device (RenderInput::rasteriser)
+  size_t hairFragments = 0;  // the camera's kept hair fragments (camera_fragments.h), at the sub-pixels
+  RenderSettings settings;   // what was rendered: the input's, with the camera and light the render stage
+                             // aimed when asked to frame the hair
 };
 
 // The frame before this one, for motion vectors: the same strands (as many points) and head (as many
@@ -86,6 +90,13 @@ struct RenderInput {
   // whose vertices only OpenGL can place.
   enum class LightMaps { kAuto, kCpu, kGl };
   LightMaps lightMaps = LightMaps::kAuto;
+  // Where hairgen's rasteriser runs, for the light's maps and the camera's fragments alike: on the CPU's
+  // threads (hair_raster.h), or as compute passes on the device (compute_raster.h), the same bits
+  // either way. kAuto: on the device when it is a GPU that can (GL_ARB_gpu_shader_int64), on the CPU
+  // under a software rasteriser (llvmpipe runs compute passes on the same cores, slower than the
+  // CPU's code). kDevice where the device cannot throws renderFailure.
+  enum class Rasteriser { kAuto, kCpu, kDevice };
+  Rasteriser rasteriser = Rasteriser::kAuto;
   // Called once renderHair reads the hair (and the frame before's) no more, so the caller may free
   // it: after the upload when the device holds a copy (the passes then do not run with both held);
   // after the last pass that draws it when the device reads it in place (readInPlace).
