@@ -114,8 +114,10 @@ TEST(ComputeRaster, TheCamerasFragmentsAreTheCpusBits) {
           const CameraFragments cpu = cameraFragments(raster::projectIntoBands(hair, camera, width), kept,
                                                       withHead ? head.data() : nullptr);
           const DeviceProjection device(raster::project(hair, camera, width));
-          const CameraFragments gpu =
-              computeCameraFragments(device, kept, withHead ? &headData : nullptr, slab).read(200, 150);
+          const std::optional<DeviceFragments> drawn =
+              computeCameraFragments(device, kept, withHead ? &headData : nullptr, slab);
+          ASSERT_TRUE(drawn);
+          const CameraFragments gpu = drawn->read(200, 150);
           SCOPED_TRACE(testing::Message()
                        << width << " m wide, " << kept << " kept, head " << withHead << ", slab " << slab);
           EXPECT_GT(cpu.count(), 10000u);
@@ -123,6 +125,9 @@ TEST(ComputeRaster, TheCamerasFragmentsAreTheCpusBits) {
           EXPECT_TRUE(gpu.tail == cpu.tail);
           EXPECT_TRUE(gpu.words == cpu.words);
         }
+  // A row's fragments that do not fit the slab's buffer: nothing, and the renderer draws them on the CPU.
+  const DeviceProjection device(raster::project(hair, camera, 0.001));
+  EXPECT_FALSE(computeCameraFragments(device, 8, nullptr, 64));
 }
 
 // A whole render, coupe 3 at a fifth of its density on its head at 320×240 with 4 samples, the light's

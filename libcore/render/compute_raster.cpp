@@ -60,6 +60,10 @@ void drawSegments(const DeviceProjection& hair) {
 
 }  // namespace
 
+bool fitsDevice(size_t bytes) {
+  return bytes <= size_t(maxStorageBlock());
+}
+
 bool computeRasterAvailable() {
   GLint n = 0;
   glGetIntegerv(GL_NUM_EXTENSIONS, &n);
@@ -88,6 +92,15 @@ std::vector<T> DeviceBuffer::read(size_t count) const {
   std::vector<T> out(count);
   if (count) glGetNamedBufferSubData(id, 0, GLsizeiptr(count * sizeof(T)), out.data());
   return out;
+}
+
+raster::Projection DeviceProjection::read() const {
+  raster::Projection p;
+  p.width = width;
+  p.height = height;
+  p.vertices = vertices.read<raster::Vertex>(vertices.bytes / sizeof(raster::Vertex));
+  p.segments = segmentList.read<uint32_t>(segments);
+  return p;
 }
 
 DeviceProjection::DeviceProjection(const raster::Projection& p)
@@ -170,10 +183,11 @@ CameraFragments DeviceFragments::read(int width, int height) const {
   return out;
 }
 
-DeviceFragments computeCameraFragments(const DeviceProjection& hair, int kept, const Texture* opaque,
-                                       size_t slabBytes) {
+std::optional<DeviceFragments> computeCameraFragments(const DeviceProjection& hair, int kept,
+                                                      const Texture* opaque, size_t slabBytes) {
   kept = std::clamp(kept, 1, 255);
   const size_t width = size_t(hair.width), pixels = width * size_t(hair.height);
+  if (!fitsDevice(pixels * sizeof(uint32_t))) return std::nullopt;
   const std::string keptDefine = "#define KEPT " + std::to_string(kept) + "\n";
   auto useOpaque = [&](const Program& p) {
     glUniform1i(p.loc("uHasOpaque"), opaque ? 1 : 0);
@@ -204,10 +218,7 @@ DeviceFragments computeCameraFragments(const DeviceProjection& hair, int kept, c
   for (int row = 0; row < hair.height; ++row) {
     uint64_t rowFragments = 0;
     for (size_t p = size_t(row) * width; p < size_t(row + 1) * width; ++p) rowFragments += count[p];
-    if (rowFragments > slabFragments)
-      renderFailure(
-          "a row of the image has " + std::to_string(rowFragments) +
-          " hair fragments, more than this device's storage buffers hold; lower Samples or StrandWidth");
+    if (rowFragments > slabFragments) return std::nullopt;
     if (inSlab + rowFragments > slabFragments) {
       slabRows.push_back(row);
       inSlab = 0;
@@ -219,9 +230,7 @@ DeviceFragments computeCameraFragments(const DeviceProjection& hair, int kept, c
       keptBound += std::min<uint32_t>(count[p], uint32_t(kept));
     }
     slabLargest = std::max(slabLargest, inSlab);
-    if (keptBound * 3 * sizeof(uint32_t) > size_t(maxStorageBlock()))
-      renderFailure(
-          "the camera sees more hair fragments than this device's storage buffers hold; lower Samples");
+    if (!fitsDevice(keptBound * 3 * sizeof(uint32_t))) return std::nullopt;
   }
   slabRows.push_back(hair.height);
   const DeviceBuffer offsetBuffer(pixels * sizeof(uint32_t), offsets.data()),

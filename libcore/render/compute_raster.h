@@ -14,6 +14,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <vector>
 
 #include <glm/glm.hpp>
@@ -27,6 +28,10 @@ namespace hairgen {
 
 // Whether the current context can run the compute passes (GL_ARB_gpu_shader_int64).
 bool computeRasterAvailable();
+
+// Whether an array of `bytes` fits one of the device's storage buffers (GL_MAX_SHADER_STORAGE_BLOCK_SIZE:
+// 128 MiB on llvmpipe, 2 GiB on NVIDIA's drivers).
+bool fitsDevice(size_t bytes);
 
 // A buffer on the device, `bytes` long (at least 4), uninitialised unless `data` is given.
 struct DeviceBuffer {
@@ -43,9 +48,11 @@ struct DeviceBuffer {
   size_t bytes = 0;
 };
 
-// A projection (hair_raster.h: project()) uploaded: its points and segments.
+// A projection (hair_raster.h: project()) uploaded: its points and segments. Each must fit a storage
+// buffer (fitsDevice: 16 bytes a point, 4 a segment).
 struct DeviceProjection {
   explicit DeviceProjection(const raster::Projection& p);
+  raster::Projection read() const;  // back from the device, for the CPU's rasteriser
   int width, height;
   size_t segments;
   DeviceBuffer vertices, segmentList;
@@ -70,9 +77,9 @@ struct DeviceFragments {
 // cameraFragments() on the device. `opaque`: null, or a texture whose R channel is, per pixel, the depth
 // along the camera's axis of what hides the hair behind it (the shading pass's data, after the head).
 // The rows are drawn in slabs whose lists fit `slabBytes` (0: 1 GiB, or the device's largest storage
-// buffer if smaller; 16 bytes a fragment). Throws renderFailure when a row's fragments, or the kept ones,
-// do not fit the device's buffers.
-DeviceFragments computeCameraFragments(const DeviceProjection& hair, int kept, const Texture* opaque,
-                                       size_t slabBytes = 0);
+// buffer if smaller; 16 bytes a fragment). Nothing when the image's pixels, a row's fragments or the kept
+// ones (12 bytes each) do not fit the device's buffers: the caller draws them on the CPU.
+std::optional<DeviceFragments> computeCameraFragments(const DeviceProjection& hair, int kept,
+                                                      const Texture* opaque, size_t slabBytes = 0);
 
 }  // namespace hairgen

@@ -52,20 +52,19 @@ int lightMapSize(const RenderInput& in, const BoundingSphere& sphere, const View
   return int(std::clamp(texels, double(kMinDomResolution), double(largest)));
 }
 
-// Whether hairgen's rasteriser runs on the device (RenderInput::rasteriser).
-bool rasteriseOnDevice(const RenderInput& in) {
-  switch (in.rasteriser) {
-    case RenderInput::Rasteriser::kCpu:
-      return false;
-    case RenderInput::Rasteriser::kDevice:
-      if (!computeRasterAvailable())
-        renderFailure(
-            "this device cannot run hairgen's rasteriser (no GL_ARB_gpu_shader_int64); use the CPU's");
-      return true;
-    case RenderInput::Rasteriser::kAuto:
-      break;
-  }
-  return !softwareRasteriser() && computeRasterAvailable();
+// Whether hairgen's rasteriser runs on the device (RenderInput::rasteriser): where it can, and the hair's
+// projected points (16 bytes each) and the light's integer maps (16 bytes a texel) fit its storage
+// buffers (the camera's fragments, which cannot be known before, fall back to the CPU themselves).
+bool rasteriseOnDevice(const RenderInput& in, int lightSize) {
+  if (in.rasteriser == RenderInput::Rasteriser::kCpu) return false;
+  const bool can = computeRasterAvailable();
+  const bool fits = fitsDevice(in.hair->points.size() * sizeof(raster::Vertex)) &&
+                    fitsDevice(size_t(lightSize) * size_t(lightSize) * sizeof(glm::uvec4));
+  if (in.rasteriser == RenderInput::Rasteriser::kDevice && !(can && fits))
+    renderFailure(can ? "the hair is too large for this device's storage buffers; use --rasteriser cpu"
+                      : "this device cannot run hairgen's rasteriser (no GL_ARB_gpu_shader_int64); use "
+                        "--rasteriser cpu");
+  return can && fits && (in.rasteriser == RenderInput::Rasteriser::kDevice || !softwareRasteriser());
 }
 
 // Lines where every strand is at most a pixel and a half wide (at the scene's nearest point) and
@@ -269,7 +268,7 @@ Scene::Scene(const RenderInput& in)
       motion(in.previous.has_value()),
       rasterised(!in.shaders.hairVert),
       kept(in.keptFragments),
-      onDevice(rasteriseOnDevice(in)),
+      onDevice(rasteriseOnDevice(in, light.width)),
       preparing(std::make_unique<Preparation>(*this, in)),
       hair(*in.hair, tangentsFor(*in.hair), motion ? in.previous->hair : nullptr, in.readInPlace),
       head(in.head && !in.head->triangles.empty()
@@ -516,10 +515,12 @@ ShadedImage shadingPass(const Scene& scene, const LightDepth& depth, const Textu
   if (!scene.rasterised) return image;
   if (scene.cameraOnDevice) {
     // The head's depth is the data's R, read where it lies.
-    const DeviceFragments f =
+    const std::optional<DeviceFragments> f =
         computeCameraFragments(*scene.cameraOnDevice, scene.kept, scene.head ? &image.data : nullptr);
-    fragments = f.count;
-    return blendHair(scene, {f.words->id, f.first->id, f.tail->id, f.count}, image);
+    if (f) {
+      fragments = f->count;
+      return blendHair(scene, {f->words->id, f->first->id, f->tail->id, f->count}, image);
+    }
   }
   // The hair the head hides is no fragment of the pixel: the rasteriser gets the head's depth.
   std::vector<float> headDepth;
@@ -530,8 +531,13 @@ ShadedImage shadingPass(const Scene& scene, const LightDepth& depth, const Textu
                       headDepth.data());
     checkGl("reading the head's depth");
   }
+  // On the CPU: where the rasteriser runs there, or its fragments did not fit the device's buffers (the
+  // projection read back from the device: the hair itself may be gone).
+  std::optional<raster::Bands> readBack;
+  if (!scene.cameraBands) readBack.emplace(raster::intoBands(scene.cameraOnDevice->read()));
+  const raster::Bands& bands = scene.cameraBands ? *scene.cameraBands : *readBack;
   const CameraFragments f =
-      cameraFragments(*scene.cameraBands, scene.kept, headDepth.empty() ? nullptr : headDepth.data());
+      cameraFragments(bands, scene.kept, headDepth.empty() ? nullptr : headDepth.data());
   headDepth = {};
   fragments = f.count();
   // Read in place where the hair is: the fragments outlive these buffers, whose deletion waits for

@@ -1,0 +1,46 @@
+#!/usr/bin/env bash
+# Where hairgen's rasteriser runs (issue 34: one rasteriser, one answer): `render --rasteriser device`
+# (GLSL compute passes, compute_raster.h) and `--rasteriser cpu` (hair_raster.h on TBB's threads) write
+# the same EXRs to the byte, image and --dom, a sequence's frames too; --stats says which ran; a word
+# other than auto, cpu or device is refused.
+source "$(dirname "$0")/cli_lib.sh" "$@"
+
+setup="$src/configs/thesis/coupe2/setup.txt"
+size=(--quiet --set "Render.Resolution=160 120" --set Render.Samples=4)
+
+case "$case" in
+  same_bytes)
+    expect_rc 0 "$hairgen" interpolate "$setup" --guides "$src/golden/fixtures/guides-coupe2.hair" \
+      -o "$tmp/coupe.hair" --quiet --set Hairstyle.HairDensity=10
+    for where in cpu device; do
+      "$hairgen" render "$setup" --hair "$tmp/coupe.hair" -o "$tmp/$where.exr" --dom "$tmp/dom-$where.exr" \
+        "${size[@]}" --rasteriser "$where" --stats "$tmp/$where.json"
+      rc=$?
+      [ "$rc" -eq 3 ] && skip "no rendering device here"
+      [ "$rc" -eq 0 ] || fail "render --rasteriser $where exited $rc"
+      grep -q "\"rasteriser\": *\"$where\"" "$tmp/$where.json" || fail "--stats does not say $where: $(cat "$tmp/$where.json")"
+    done
+    cmp "$tmp/cpu.exr" "$tmp/device.exr" || fail "the image differs between the CPU's and the device's rasteriser"
+    cmp "$tmp/dom-cpu.exr" "$tmp/dom-device.exr" || fail "the light's maps differ"
+    ;;
+  sequence_same_bytes)
+    expect_rc 0 "$hairgen" interpolate "$setup" --guides "$src/golden/fixtures/guides-coupe2.hair" \
+      -o "$tmp/coupe.0001.hair" --quiet --set Hairstyle.HairDensity=5
+    cp "$tmp/coupe.0001.hair" "$tmp/coupe.0002.hair"
+    for where in cpu device; do
+      "$hairgen" render "$setup" --hair "$tmp/coupe.####.hair" --frames 1-2 -o "$tmp/$where.####.exr" "${size[@]}" \
+        --rasteriser "$where"
+      rc=$?
+      [ "$rc" -eq 3 ] && skip "no rendering device here"
+      [ "$rc" -eq 0 ] || fail "render --frames --rasteriser $where exited $rc"
+    done
+    for f in 0001 0002; do cmp "$tmp/cpu.$f.exr" "$tmp/device.$f.exr" || fail "frame $f differs"; done
+    ;;
+  unknown_word)
+    expect_rc 2 "$hairgen" render "$setup" -o "$tmp/x.exr" --rasteriser gpu
+    expect_err "--rasteriser"
+    [ ! -e "$tmp/x.exr" ] || fail "an image was written"
+    ;;
+  *) fail "unknown case" ;;
+esac
+echo "ok ($case)"
