@@ -67,6 +67,7 @@ RenderOutput renderStage(const CommonOptions& common, const Config& config, GlCo
   stats.json()["device"]["lightMaps"] = out.lightMapsByRasteriser ? rasteriser : "opengl";
   stats.json()["device"]["rasteriser"] = rasteriser;
   stats.counts()["hairFragments"] = out.hairFragments;
+  stats.json()["device"]["hairFragmentSeconds"] = out.timings.fragments;
   stats.json()["device"]["hairReadInPlace"] = out.hairReadInPlace;
   return out;
 }

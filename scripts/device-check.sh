@@ -187,7 +187,7 @@ run() {
       say "(b) passes (light depth + opacity + shading, each waited for): $passes s (target 5 ms on a GPU)"
       say "(d) peak memory $(awk -v p="$peak" -v c="$cache" 'BEGIN {printf "%.0f MB = %.2f x the cache'"'"'s %.0f MB", p / 1e6, p / c, c / 1e6}') (target 3 x)"
       say "    device start: $(json "$figures/stats.6.json" "d['device'].get('start', 'not recorded by this build')")"
-      say "    rasteriser: $(json "$figures/stats.6.json" "d['device'].get('rasteriser', 'cpu (this build has only the CPU one)')")"
+      say "    rasteriser: $(json "$figures/stats.6.json" "d['device'].get('rasteriser', 'cpu (this build has only the CPU one)')"), the camera's fragments $(for i in 2 3 4 5 6; do json "$figures/stats.$i.json" "d['device'].get('hairFragmentSeconds', float('nan'))"; done | median) s of the shading (median)"
       # The same frame with the rasteriser on the CPU's threads: the same EXRs to the byte (issue 34:
       # one rasteriser, one answer), and what it costs here.
       local t0 t1

@@ -1,9 +1,11 @@
 // hairgen's rasteriser as GLSL compute passes (compute_raster.h) against the CPU's (light_maps.h,
 // camera_fragments.h) on this machine's OpenGL (llvmpipe in CI): the same integer maps and the same kept
 // fragments, to the bit, for hair crossing every way, strands thinner and wider than a pixel, segments
-// seen end on, strands running off the image, behind a head's depth, and the camera's rows in slabs.
+// seen end on, strands running off the image, behind a head's depth, the camera's rows in slabs, sums
+// past a word, and segments handed to the device in a shuffled order.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <random>
 
@@ -25,6 +27,21 @@ namespace {
 GlContext& gl() {
   static GlContext context;
   return context;
+}
+
+// A device with no int64 in its shaders, or whose floating point rounds otherwise, has no compute
+// rasteriser to compare: the renderer uses the CPU's there.
+#define SKIP_WITHOUT_COMPUTE_RASTER()                                                                 \
+  do {                                                                                                \
+    ASSERT_TRUE(gl().current());                                                                      \
+    if (!computeRasterAvailable()) GTEST_SKIP() << "this device cannot run hairgen's compute passes"; \
+  } while (false)
+
+// The projection with its segments in a shuffled order: the device must not depend on the order its
+// invocations run in, which this stands in for (llvmpipe runs them almost in order).
+DeviceProjection shuffled(raster::Projection p, unsigned seed) {
+  std::shuffle(p.segments.begin(), p.segments.end(), std::mt19937(seed));
+  return DeviceProjection(p);
 }
 
 // A pinhole view from (0, 0, 0.5) toward the origin, `width` × `height` pixels, 30° vertically.
@@ -67,13 +84,12 @@ constexpr glm::dvec4 kLayers{0.002, 0.006, 0.015, 0.04};
 
 // The light's maps: the integers and the textures the shadow lookup reads.
 TEST(ComputeRaster, TheLightsMapsAreTheCpusBits) {
-  ASSERT_TRUE(gl().current());
-  ASSERT_TRUE(computeRasterAvailable());
+  SKIP_WITHOUT_COMPUTE_RASTER();
   const Strands hair = tangle(600, 7);
   for (const double width : {0.00008, 0.0015}) {
     const View light = perspective(256, 256);
     const HairLightMaps cpu = rasteriseLightMaps(hair, light, width, kLayers);
-    const DeviceProjection device(raster::project(hair, light, width));
+    const DeviceProjection device = shuffled(raster::project(hair, light, width), 3);
     const Texture start(GL_R32F, 256, 256), opacity(GL_RGBA32F, 256, 256);
     HairLightMaps gpu;
     computeLightMaps(device, kLayers, 0.4, 1.0e10f, start, opacity, &gpu);
@@ -94,7 +110,7 @@ TEST(ComputeRaster, TheLightsMapsAreTheCpusBits) {
 // The camera's kept fragments, with and without a head's depth in front of some of the hair, at 8 and
 // at 2 fragments a pixel (more in the tails), in one slab and in slabs of a few rows.
 TEST(ComputeRaster, TheCamerasFragmentsAreTheCpusBits) {
-  ASSERT_TRUE(gl().current());
+  SKIP_WITHOUT_COMPUTE_RASTER();
   const Strands hair = tangle(900, 11);
   const View camera = perspective(200, 150);
   const size_t pixels = 200 * 150;
@@ -113,7 +129,7 @@ TEST(ComputeRaster, TheCamerasFragmentsAreTheCpusBits) {
         for (const size_t slab : {size_t(0), size_t(16) << 10}) {
           const CameraFragments cpu = cameraFragments(raster::projectIntoBands(hair, camera, width), kept,
                                                       withHead ? head.data() : nullptr);
-          const DeviceProjection device(raster::project(hair, camera, width));
+          const DeviceProjection device = shuffled(raster::project(hair, camera, width), kept);
           const std::optional<DeviceFragments> drawn =
               computeCameraFragments(device, kept, withHead ? &headData : nullptr, slab);
           ASSERT_TRUE(drawn);
@@ -133,7 +149,44 @@ TEST(ComputeRaster, TheCamerasFragmentsAreTheCpusBits) {
 // A whole render, coupe 3 at a fifth of its density on its head at 320×240 with 4 samples, the light's
 // maps kept: the rasteriser on the device gives the image and maps the CPU's does, every channel to the
 // bit (on llvmpipe the shading around them is the same code too).
+// 70,000 strands 4 texels wide over the same few rows: each texel's sums pass 2^32 (65,536 whole
+// texels), which the CPU's sums saturate at and the device flags; the camera's tails saturate alike. A
+// software rasteriser cannot sort 70,000 fragments of a pixel within its loop budget (compute_raster.h:
+// withinLoopBudget): there the camera's fragments are the CPU's, and the device must say so.
+TEST(ComputeRaster, SumsPastAWordSaturateAsTheCpusDo) {
+  SKIP_WITHOUT_COMPUTE_RASTER();
+  Strands pile;
+  for (int i = 0; i < 70000; ++i) {
+    const float y = 4.0f + 0.00001f * float(i % 100), z = -1.0f - 0.000001f * float(i);
+    pile.addStrand({{0.5f, y, z}, {7.5f, y + 0.5f, z}});  // rows 2.25 to 6.25 at 4 texels wide
+  }
+  View v;
+  v.width = v.height = 8;
+  v.proj = glm::ortho(0.0, 8.0, 0.0, 8.0, -100.0, 100.0);
+  const HairLightMaps cpu = rasteriseLightMaps(pile, v, 4.0, kLayers);
+  EXPECT_EQ(cpu.layers[4 * 8 + 3].w, UINT32_MAX) << "the pile passes a word";
+  const DeviceProjection device(raster::project(pile, v, 4.0));
+  const Texture start(GL_R32F, 8, 8), opacity(GL_RGBA32F, 8, 8);
+  HairLightMaps gpu;
+  computeLightMaps(device, kLayers, 1.0, 1.0e10f, start, opacity, &gpu);
+  EXPECT_TRUE(gpu.start == cpu.start);
+  EXPECT_TRUE(gpu.layers == cpu.layers);
+  const CameraFragments cpuFragments = cameraFragments(raster::projectIntoBands(pile, v, 4.0), 8);
+  EXPECT_EQ(cpuFragments.tail[4 * 8 + 3], UINT32_MAX) << "the tail passes a word";
+  const std::optional<DeviceFragments> drawn = computeCameraFragments(device, 8, nullptr);
+  if (softwareRasteriser()) {
+    EXPECT_FALSE(drawn) << "past llvmpipe's loop budget";
+    return;
+  }
+  ASSERT_TRUE(drawn);
+  const CameraFragments gpuFragments = drawn->read(8, 8);
+  EXPECT_TRUE(gpuFragments.first == cpuFragments.first);
+  EXPECT_TRUE(gpuFragments.tail == cpuFragments.tail);
+  EXPECT_TRUE(gpuFragments.words == cpuFragments.words);
+}
+
 TEST(ComputeRaster, ARenderIsTheSameBitsWhereverTheRasteriserRuns) {
+  SKIP_WITHOUT_COMPUTE_RASTER();
   test::Job job = test::loadJob("thesis/coupe3/setup.txt", SetupUse::kRender);
   Hairstyle h = job.config.hairstyle;
   h.hairDensity = 20;

@@ -1,17 +1,25 @@
 #include "libcore/render/compute_raster.h"
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
 #include <cstring>
 #include <limits>
 #include <string>
 
 #include "glsl/embedded_glsl.h"
+#include "libcore/render/gl_context.h"
 #include "libcore/render/shader_interface.h"
 
 namespace hairgen {
 
 namespace {
+
+// llvmpipe (Mesa 22.3's gallivm) ends every loop of a shader invocation once the invocation has run
+// 65,535 loop iterations in all, silently: on a software rasteriser the passes are used only where each
+// invocation stays well inside that (withinLoopBudget; the keeping pass's sort of a pixel's n fragments,
+// about 2 n log2 n steps, and its n × (KEPT + 1)), the CPU's rasteriser elsewhere.
+constexpr uint64_t kSoftwareLoopBudget = 40000;
 
 // A slab's lists at most (16 bytes a fragment), whatever larger buffer the device allows: the camera's
 // fragments of a 1080p image of 150,000 strands take ~0.5 GB in one slab.
@@ -40,9 +48,9 @@ void dispatch(size_t invocations, size_t size) {
   glDispatchCompute(GLuint(x), GLuint(y), 1);
 }
 
-GLint maxStorageBlock() {
-  GLint size = 0;
-  glGetIntegerv(GL_MAX_SHADER_STORAGE_BLOCK_SIZE, &size);
+GLint64 maxStorageBlock() {
+  GLint64 size = 0;
+  glGetInteger64v(GL_MAX_SHADER_STORAGE_BLOCK_SIZE, &size);
   return size;
 }
 
@@ -64,7 +72,9 @@ bool fitsDevice(size_t bytes) {
   return bytes <= size_t(maxStorageBlock());
 }
 
-bool computeRasterAvailable() {
+namespace {
+
+bool hasInt64() {
   GLint n = 0;
   glGetIntegerv(GL_NUM_EXTENSIONS, &n);
   for (GLint i = 0; i < n; ++i)
@@ -72,6 +82,80 @@ bool computeRasterAvailable() {
                     "GL_ARB_gpu_shader_int64") == 0)
       return true;
   return false;
+}
+
+// Whether the device's floating point gives the CPU's bits where the passes use it (glsl/raster_probe.glsl):
+// GLSL leaves double arithmetic's rounding and a double sqrt's precision to the device, so they are
+// tried on depths and squares chosen to catch a device that rounds otherwise, before any pass relies
+// on them.
+bool floatingPointAgrees() {
+  std::vector<int32_t> depths = {0, 1, 2, 3, 999999, 1000000, 1000001, 123456789, 2000000000, INT32_MAX};
+  std::vector<uint64_t> squares;
+  uint64_t state = 0x9E3779B97F4A7C15ull;  // a fixed sequence (splitmix64), the same every run
+  auto next = [&] {
+    uint64_t z = (state += 0x9E3779B97F4A7C15ull);
+    z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
+    z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
+    return z ^ (z >> 31);
+  };
+  while (depths.size() < 4096) depths.push_back(int32_t(next() >> 33));
+  for (uint64_t k : {uint64_t(1), uint64_t(255), uint64_t(65535), uint64_t(94906265), uint64_t(1) << 26})
+    for (uint64_t n : {k * k - 1, k * k, k * k + k, k * k + k + 1}) squares.push_back(n);
+  while (squares.size() < 4096) squares.push_back(next() >> (12 + next() % 40));
+  const DeviceBuffer depthIn(depths.size() * sizeof(int32_t), depths.data()),
+      squareIn(squares.size() * sizeof(uint64_t), squares.data()), depthOut(depths.size() * sizeof(uint32_t)),
+      squareOut(squares.size() * sizeof(uint64_t));
+  const Program p(computeStage(glsl::kRasterProbe, true), "raster probe");
+  p.use();
+  glUniform1d(p.loc("uDepthUnit"), kDepthUnit);
+  glUniform1ui(p.loc("uCount"), GLuint(depths.size()));
+  depthIn.bind(2);
+  squareIn.bind(3);
+  depthOut.bind(4);
+  squareOut.bind(5);
+  dispatch(depths.size(), 256);
+  glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
+  const std::vector<uint32_t> metres = depthOut.read<uint32_t>(depths.size());
+  const std::vector<uint64_t> roots = squareOut.read<uint64_t>(squares.size());
+  for (size_t i = 0; i < depths.size(); ++i)
+    if (metres[i] != std::bit_cast<uint32_t>(float(double(depths[i]) * kDepthUnit))) return false;
+  for (size_t i = 0; i < squares.size(); ++i)
+    if (roots[i] != raster::roundedSqrt(squares[i])) return false;
+  return true;
+}
+
+// The answer kept by the context, so a sequence probes once.
+struct ProbeResult {
+  bool agrees = false;
+};
+
+}  // namespace
+
+bool withinLoopBudget(const raster::Projection& p) {
+  for (const uint32_t first : p.segments) {
+    const raster::Vertex &a = p.vertices[first], &b = p.vertices[size_t(first) + 1];
+    const int64_t du = std::max(std::abs(int64_t(b.x) - a.x), std::abs(int64_t(b.y) - a.y));
+    // The columns along the major axis, and per column the texels across a piece's cross-section (at
+    // most its width over cos 45°, a tent's texel more either side).
+    const uint64_t along = uint64_t(du / kSubTexel + 2);
+    const uint64_t across = uint64_t(std::max(a.width, b.width)) * 3 / (2 * uint64_t(kWidthUnit)) + 4;
+    if (along * (across + 1) > kSoftwareLoopBudget) return false;
+  }
+  return true;
+}
+
+bool computeRasterAvailable() {
+  if (!hasInt64()) return false;
+  GlContext* gl = GlContext::current();
+  if (!gl) return floatingPointAgrees();
+  return gl
+      ->kept<ProbeResult>("compute raster probe",
+                          [] {
+                            auto result = std::make_unique<ProbeResult>();
+                            result->agrees = floatingPointAgrees();
+                            return result;
+                          })
+      .agrees;
 }
 
 DeviceBuffer::DeviceBuffer(size_t size, const void* data) : bytes(std::max<size_t>(size, 4)) {
@@ -205,39 +289,49 @@ std::optional<DeviceFragments> computeCameraFragments(const DeviceProjection& ha
     counts.bind(2);
     drawSegments(hair);
   }
-  const std::vector<uint32_t> count = counts.read<uint32_t>(pixels);
   // The rows in slabs whose lists fit a buffer; each pixel's list's place within its slab, and its kept
-  // fragments' place among every pixel's (at most min(count, kept) of them).
+  // fragments' place among every pixel's (at most min(count, kept) of them), uploaded and let go.
   const size_t slabFragments =
       std::min<size_t>(slabBytes ? slabBytes : kSlabBytes, size_t(maxStorageBlock())) /
       (4 * sizeof(uint32_t));
-  std::vector<uint32_t> offsets(pixels), keepAt(pixels);
   std::vector<int> slabRows{0};
-  size_t slabLargest = 0, inSlab = 0;
+  size_t slabLargest = 0;
   uint64_t keptBound = 0;
-  for (int row = 0; row < hair.height; ++row) {
-    uint64_t rowFragments = 0;
-    for (size_t p = size_t(row) * width; p < size_t(row + 1) * width; ++p) rowFragments += count[p];
-    if (rowFragments > slabFragments) return std::nullopt;
-    if (inSlab + rowFragments > slabFragments) {
-      slabRows.push_back(row);
-      inSlab = 0;
+  std::unique_ptr<DeviceBuffer> offsetBuffer, keepAtBuffer;
+  {
+    const std::vector<uint32_t> count = counts.read<uint32_t>(pixels);
+    const uint64_t deepest = *std::max_element(count.begin(), count.end());
+    if (softwareRasteriser() &&
+        deepest * (uint64_t(kept) + 1 + 2 * uint64_t(std::bit_width(deepest))) > kSoftwareLoopBudget)
+      return std::nullopt;
+    std::vector<uint32_t> offsets(pixels), keepAt(pixels);
+    size_t inSlab = 0;
+    for (int row = 0; row < hair.height; ++row) {
+      uint64_t rowFragments = 0;
+      for (size_t p = size_t(row) * width; p < size_t(row + 1) * width; ++p) rowFragments += count[p];
+      if (rowFragments > slabFragments) return std::nullopt;
+      if (inSlab + rowFragments > slabFragments) {
+        slabRows.push_back(row);
+        inSlab = 0;
+      }
+      for (size_t p = size_t(row) * width; p < size_t(row + 1) * width; ++p) {
+        offsets[p] = uint32_t(inSlab);
+        inSlab += count[p];
+        keepAt[p] = uint32_t(keptBound);
+        keptBound += std::min<uint32_t>(count[p], uint32_t(kept));
+      }
+      slabLargest = std::max(slabLargest, inSlab);
+      if (keptBound > UINT32_MAX || !fitsDevice(keptBound * 3 * sizeof(uint32_t))) return std::nullopt;
     }
-    for (size_t p = size_t(row) * width; p < size_t(row + 1) * width; ++p) {
-      offsets[p] = uint32_t(inSlab);
-      inSlab += count[p];
-      keepAt[p] = uint32_t(keptBound);
-      keptBound += std::min<uint32_t>(count[p], uint32_t(kept));
-    }
-    slabLargest = std::max(slabLargest, inSlab);
-    if (!fitsDevice(keptBound * 3 * sizeof(uint32_t))) return std::nullopt;
+    offsetBuffer = std::make_unique<DeviceBuffer>(pixels * sizeof(uint32_t), offsets.data());
+    keepAtBuffer = std::make_unique<DeviceBuffer>(pixels * sizeof(uint32_t), keepAt.data());
   }
   slabRows.push_back(hair.height);
-  const DeviceBuffer offsetBuffer(pixels * sizeof(uint32_t), offsets.data()),
-      keepAtBuffer(pixels * sizeof(uint32_t), keepAt.data());
+  // Kept: each pixel's kept count, and after them the keeping pass's fault word.
   DeviceBuffer cursors(pixels * sizeof(uint32_t)), lists(slabLargest * 4 * sizeof(uint32_t)),
-      keptCounts(pixels * sizeof(uint32_t)), staging(size_t(keptBound) * 3 * sizeof(uint32_t));
+      keptCounts((pixels + 1) * sizeof(uint32_t)), staging(size_t(keptBound) * 3 * sizeof(uint32_t));
   cursors.clear(0);
+  keptCounts.clear(0);
   auto tails = std::make_unique<DeviceBuffer>(pixels * sizeof(uint32_t));
   const Program fill(computeStage(glsl::kCameraFill, true), "camera fill");
   const Program keep(computeStage(glsl::kCameraKeep, false, keptDefine), "camera keep");
@@ -248,47 +342,52 @@ std::optional<DeviceFragments> computeCameraFragments(const DeviceProjection& ha
     useOpaque(fill);
     glUniform1i(fill.loc("uRowLo"), slabRows[s]);
     glUniform1i(fill.loc("uRowHi"), slabRows[s + 1]);
-    offsetBuffer.bind(2);
+    offsetBuffer->bind(2);
     cursors.bind(3);
     lists.bind(4);
+    counts.bind(5);
     drawSegments(hair);
     keep.use();
     const size_t lo = size_t(slabRows[s]) * width, hi = size_t(slabRows[s + 1]) * width;
     glUniform1ui(keep.loc("uPixelLo"), GLuint(lo));
     glUniform1ui(keep.loc("uPixelHi"), GLuint(hi));
+    glUniform1ui(keep.loc("uFault"), GLuint(pixels));
     glUniform1d(keep.loc("uDepthUnit"), kDepthUnit);
-    offsetBuffer.bind(2);
-    counts.bind(3);
-    lists.bind(4);
-    keptCounts.bind(5);
-    tails->bind(6);
-    keepAtBuffer.bind(7);
-    staging.bind(8);
+    offsetBuffer->bind(0);
+    counts.bind(1);
+    lists.bind(2);
+    keptCounts.bind(3);
+    tails->bind(4);
+    keepAtBuffer->bind(5);
+    staging.bind(6);
+    cursors.bind(7);
     dispatch(hi - lo, 64);
     glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT);
   }
-  // Each pixel's first kept fragment: the kept counts summed.
-  const std::vector<uint32_t> keptCount = keptCounts.read<uint32_t>(pixels);
-  std::vector<uint32_t> first(pixels + 1);
+  // Each pixel's first kept fragment: the kept counts summed, in their own array.
+  std::vector<uint32_t> first = keptCounts.read<uint32_t>(pixels + 1);
+  if (first[pixels] != 0) return std::nullopt;  // the count and fill passes disagreed
   uint32_t total = 0;
   for (size_t p = 0; p < pixels; ++p) {
+    const uint32_t n = first[p];
     first[p] = total;
-    total += keptCount[p];
+    total += n;
   }
   first[pixels] = total;
   DeviceFragments out;
   out.count = total;
   out.first = std::make_unique<DeviceBuffer>(first.size() * sizeof(uint32_t), first.data());
+  first = {};
   out.words = std::make_unique<DeviceBuffer>(size_t(total) * 3 * sizeof(uint32_t));
   out.tail = std::move(tails);
   {
     const Program p(computeStage(glsl::kCameraPack, false), "camera pack");
     p.use();
     glUniform1ui(p.loc("uPixels"), GLuint(pixels));
-    out.first->bind(5);
-    out.words->bind(6);
-    keepAtBuffer.bind(7);
-    staging.bind(8);
+    out.first->bind(0);
+    out.words->bind(1);
+    keepAtBuffer->bind(2);
+    staging.bind(3);
     dispatch(pixels, 256);
   }
   glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT);

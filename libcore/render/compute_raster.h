@@ -48,6 +48,12 @@ struct DeviceBuffer {
   size_t bytes = 0;
 };
 
+// Whether every segment of the projection is drawn within a software rasteriser's loop budget: llvmpipe
+// ends a shader invocation's loops after 65,535 iterations in all (compute_raster.cpp), so there the
+// passes take only projections within it, and the keeping pass pixels of a few hundred fragments at most
+// (deeper, computeCameraFragments gives nothing and the CPU draws them).
+bool withinLoopBudget(const raster::Projection& p);
+
 // A projection (hair_raster.h: project()) uploaded: its points and segments. Each must fit a storage
 // buffer (fitsDevice: 16 bytes a point, 4 a segment).
 struct DeviceProjection {

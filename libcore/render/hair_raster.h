@@ -94,7 +94,7 @@ class MidpointStep {
 // √n rounded to the nearest integer, exactly (never a tie: (r + ½)² is no integer), so every machine
 // and the GLSL twin (glsl/raster_segment.glsl) agree: a floating-point estimate corrected in integers.
 inline uint64_t roundedSqrt(uint64_t n) {
-  uint64_t r = uint64_t(std::sqrt(double(n)));
+  uint64_t r = std::min<uint64_t>(uint64_t(std::sqrt(double(n))), uint64_t(1) << 27);  // n < 2^54
   while (r > 0 && r * r > n) --r;
   while ((r + 1) * (r + 1) <= n) ++r;
   return n - r * r > r ? r + 1 : r;  // n ≥ r² + r + 1 > (r + ½)²

@@ -12,6 +12,7 @@
 #include "libcore/render/line_decimation.h"
 #include "libcore/render/readback.h"
 #include "libcore/render/shader_interface.h"
+#include "libcore/util/stopwatch.h"
 
 namespace hairgen {
 
@@ -224,20 +225,23 @@ struct Scene::Preparation {
     const RenderSettings& r = in.settings;
     const View& subpixelView = scene.subpixel;
     const bool cameraByRasteriser = scene.rasterised;
-    const bool onDevice = scene.onDevice;
-    // One after the other, each on every thread: the light's projection is freed before the camera's
-    // is made.
+    const bool onDevice = scene.onDevice, software = onDevice && softwareRasteriser();
+    // On a software rasteriser a projection the device cannot draw within its loop budget
+    // (compute_raster.h: withinLoopBudget) is drawn on the CPU.
+    auto forDevice = [software](raster::Projection&& p) {
+      return software && !withinLoopBudget(p) ? nullptr : std::make_unique<raster::Projection>(std::move(p));
+    };
+    // One after the other, each on every thread. For the CPU the light's projection is freed (into its
+    // maps) before the camera's is made; for the device both are held until the Scene uploads them.
     work.run([=, this, &hair, &lightView, &subpixelView, &r] {
       if (lightByRasteriser && onDevice)
-        lightProjection =
-            std::make_unique<raster::Projection>(raster::project(hair, lightView, r.strandWidth));
-      else if (lightByRasteriser)
+        lightProjection = forDevice(raster::project(hair, lightView, r.strandWidth));
+      if (lightByRasteriser && !lightProjection)
         lightMaps =
             std::make_unique<HairLightMaps>(rasteriseLightMaps(hair, lightView, r.strandWidth, r.layerSizes));
       if (cameraByRasteriser && onDevice)
-        cameraProjection =
-            std::make_unique<raster::Projection>(raster::project(hair, subpixelView, r.strandWidth));
-      else if (cameraByRasteriser)
+        cameraProjection = forDevice(raster::project(hair, subpixelView, r.strandWidth));
+      if (cameraByRasteriser && !cameraProjection)
         cameraBands =
             std::make_unique<raster::Bands>(raster::projectIntoBands(hair, subpixelView, r.strandWidth));
     });
@@ -475,7 +479,7 @@ ShadedImage blendHair(const Scene& scene, const FragmentBuffers& f, const Shaded
 }  // namespace
 
 ShadedImage shadingPass(const Scene& scene, const LightDepth& depth, const Texture& opacity,
-                        size_t& fragments) {
+                        size_t& fragments, double& fragmentSeconds) {
   const RenderSettings& r = scene.settings;
   const int w = scene.subpixel.width, h = scene.subpixel.height;
   ShadedImage image{Texture(GL_RGBA16F, w, h), Texture(GL_RGBA32F, w, h), false};
@@ -513,10 +517,14 @@ ShadedImage shadingPass(const Scene& scene, const LightDepth& depth, const Textu
     checkGl("the shading pass");
   }
   if (!scene.rasterised) return image;
+  glFinish();
+  Stopwatch clock;
   if (scene.cameraOnDevice) {
     // The head's depth is the data's R, read where it lies.
     const std::optional<DeviceFragments> f =
         computeCameraFragments(*scene.cameraOnDevice, scene.kept, scene.head ? &image.data : nullptr);
+    glFinish();
+    fragmentSeconds = clock.lap();
     if (f) {
       fragments = f->count;
       return blendHair(scene, {f->words->id, f->first->id, f->tail->id, f->count}, image);
@@ -540,6 +548,7 @@ ShadedImage shadingPass(const Scene& scene, const LightDepth& depth, const Textu
       cameraFragments(bands, scene.kept, headDepth.empty() ? nullptr : headDepth.data());
   headDepth = {};
   fragments = f.count();
+  fragmentSeconds += clock.lap();
   // Read in place where the hair is: the fragments outlive these buffers, whose deletion waits for
   // the draws that read them (Buffer::reset).
   const bool inPlace = scene.hair.readsStrandsInPlace();

@@ -111,9 +111,9 @@ LightDepth lightDepthPass(const Scene& scene);
 // RGBA32F, one layer per channel, the light's map size.
 Texture deepOpacityPass(const Scene& scene, LightDepth& depth);
 // At sub-pixel resolution; `fragments`: how many hair fragments the rasteriser kept (0 when OpenGL drew
-// the hair).
+// the hair), `fragmentSeconds` the time it took to find them (the device's work waited for).
 ShadedImage shadingPass(const Scene& scene, const LightDepth& depth, const Texture& opacity,
-                        size_t& fragments);
+                        size_t& fragments, double& fragmentSeconds);
 // At the image's resolution.
 ShadedImage resolvePass(const Scene& scene, const ShadedImage& subpixels);
 // At sub-pixel resolution, RGBA32F: motion u, v (pixels of the image), 1 where something was drawn.

@@ -46,7 +46,7 @@ RenderOutput renderHair(GlContext&, const RenderInput& in) {
   out.timings.upload = seconds(clock);
   out.hairReadInPlace = scene.hair.readsStrandsInPlace();
   out.lightMapsByRasteriser = scene.lightMaps || scene.lightOnDevice;
-  out.rasterisedOnDevice = scene.onDevice;
+  out.rasterisedOnDevice = scene.lightOnDevice || scene.cameraOnDevice;
   if (in.uploaded && !out.hairReadInPlace) in.uploaded();
   auto passDone = [&] {
     if (in.progress) in.progress->advance();
@@ -60,7 +60,8 @@ RenderOutput renderHair(GlContext&, const RenderInput& in) {
   scene.releaseLightMaps();
   out.timings.opacity = seconds(clock);
   passDone();
-  const ShadedImage image = resolvePass(scene, shadingPass(scene, depth, opacity, out.hairFragments));
+  const ShadedImage image =
+      resolvePass(scene, shadingPass(scene, depth, opacity, out.hairFragments, out.timings.fragments));
   scene.releaseCameraBands();
   out.timings.shading = seconds(clock);
   passDone();

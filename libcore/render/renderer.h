@@ -42,6 +42,7 @@ inline constexpr const char* kChannelDomLayers[4] = {"dom.layer1", "dom.layer2",
 
 struct RenderTimings {
   double upload = 0.0, lightDepth = 0.0, opacity = 0.0, shading = 0.0, motion = 0.0, readback = 0.0;  // s
+  double fragments = 0.0;  // of shading: the camera's hair fragments found by hairgen's rasteriser, s
 };
 
 struct RenderOutput {

@@ -10,14 +10,18 @@ layout(std430, binding = 3) buffer Cursors { uint cursorData[]; };
 // Per fragment: its segment's first point, its depth (kDepthUnit), its coverage, where along its segment
 // (1/kSpanUnit).
 layout(std430, binding = 4) writeonly buffer Lists { uvec4 listData[]; };
+layout(std430, binding = 5) readonly buffer Counts { uint countData[]; };
 uint gPoint;  // the segment being drawn
 void emit(int column, int row, int depth, uint coverage, int64_t twice, int64_t length) {
   if (row < uRowLo || row >= uRowHi) return;
   if (uHasOpaque != 0 && float(double(depth) * uDepthUnit) >= texelFetch(uOpaque, ivec2(column, row), 0).r)
     return;
   int pixel = row * uRasterSize.x + column;
-  uint at = offsetData[pixel] + atomicAdd(cursorData[pixel], 1u);
-  listData[at] = uvec4(gPoint, uint(depth), coverage, uint(twice * int64_t(kSpanUnit) / (2l * length)));
+  // More than the count pass found would spill into the next pixel's list: dropped, and the keeping
+  // pass reports the pixel (its cursor is not its count).
+  uint k = atomicAdd(cursorData[pixel], 1u);
+  if (k >= countData[pixel]) return;
+  listData[offsetData[pixel] + k] = uvec4(gPoint, uint(depth), coverage, uint(twice * int64_t(kSpanUnit) / (2l * length)));
 }
 void main() {
   uint s = segmentOfInvocation();

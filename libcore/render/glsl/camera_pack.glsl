@@ -2,10 +2,10 @@
 // into CameraFragments' layout, three words each from the pixel's first (the host's sums of the kept
 // counts).
 layout(local_size_x = 256) in;
-layout(std430, binding = 5) readonly buffer First { uint firstData[]; };
-layout(std430, binding = 6) writeonly buffer Words { uint wordData[]; };
-layout(std430, binding = 7) readonly buffer KeepAt { uint keepAtData[]; };
-layout(std430, binding = 8) readonly buffer Staging { uint stagingData[]; };
+layout(std430, binding = 0) readonly buffer First { uint firstData[]; };
+layout(std430, binding = 1) writeonly buffer Words { uint wordData[]; };
+layout(std430, binding = 2) readonly buffer KeepAt { uint keepAtData[]; };
+layout(std430, binding = 3) readonly buffer Staging { uint stagingData[]; };
 uniform uint uPixels;
 void main() {
   uint p = (gl_WorkGroupID.y * gl_NumWorkGroups.x + gl_WorkGroupID.x) * gl_WorkGroupSize.x +

@@ -18,9 +18,10 @@ int64_t floorDiv(int64_t a, int64_t b) {
   return a >= 0l ? a / b : -((-a + b - 1l) / b);
 }
 
-// hair_raster.h's roundedSqrt.
+// hair_raster.h's roundedSqrt: the estimate only starts the integer search (GLSL leaves a double sqrt's
+// precision to the device), kept below 2^27 (n < 2^54) so the squares cannot overflow.
 uint64_t roundedSqrt(uint64_t n) {
-  uint64_t r = uint64_t(sqrt(double(n)));
+  uint64_t r = min(uint64_t(sqrt(double(n))), 1ul << 27);
   while (r > 0ul && r * r > n) --r;
   while ((r + 1ul) * (r + 1ul) <= n) ++r;
   return n - r * r > r ? r + 1ul : r;
@@ -111,7 +112,9 @@ void rasteriseSegment(uint first) {
   const int64_t first0 = max(u0 >> 8, 0l), last = min((u1 - 1l) >> 8, along - 1l);
   const int64_t acrossSize = alongX ? int64_t(uRasterSize.y) : int64_t(uRasterSize.x);
   const int64_t reach = int64_t(extent / (2ul * perSub)) + 2l * kSubTexel;
-  if (dv == 0l && (v0 + reach < 0l || v0 - reach >= acrossSize * kSubTexel)) return;
+  // A segment whose cross-section cannot reach the image across (the piece's middles lie between its
+  // ends) has no fragment on it.
+  if (max(v0, v0 + dv) + reach < 0l || min(v0, v0 + dv) - reach >= acrossSize * kSubTexel) return;
   const uint64_t perArea = uint64_t(du) * uint64_t(kWidthUnit * kSubTexel / int64_t(kCoverageOne));
   const uint64_t wholeArea = (width * uint64_t(kSubTexel) * length + perArea / 2ul) / perArea;
   const int64_t twiceFirst = 2l * first0 * kSubTexel + kSubTexel - 2l * u0;
