@@ -29,14 +29,6 @@ int maxTextureSize() {
   return int(size);
 }
 
-// k for Samples = k² (k ≤ 8), lowered until the sub-pixel image fits the device's largest texture.
-int subpixelBlock(const RenderSettings& r) {
-  const int maxSize = maxTextureSize();
-  int block = std::min(std::max(1, int(std::lround(std::sqrt(double(r.samples))))), 8);
-  while (block > 1 && std::max(r.resolution.x, r.resolution.y) * block > maxSize) --block;
-  return block;
-}
-
 // The light's maps' size when the input leaves it to the renderer: a texel no larger than a pixel at the
 // scene's centre (a texel there is its distance from the light over the light's focal length in
 // texels, which grows with the map's size), between kMinDomResolution and the smaller of
@@ -260,7 +252,7 @@ Scene::Scene(const RenderInput& in)
     : settings(in.settings),
       visuality(in.visuality),
       sphere(boundingSphere(*in.hair, in.head)),
-      block(subpixelBlock(in.settings)),
+      block(subpixelBlock(in.settings, maxTextureSize())),
       camera(cameraView(in.settings, sphere)),
       subpixel(subpixelView(camera, block)),
       light(lightView(in.settings, sphere, lightMapSize(in, sphere, camera))),

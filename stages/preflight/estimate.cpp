@@ -164,14 +164,6 @@ WorkEstimate estimateShade(const RenderSettings& render, size_t strands, size_t 
 
 namespace {
 
-// k for Samples = k² (k ≤ 8), lowered until the sub-pixel image fits the device's largest texture, as
-// the renderer chooses it.
-int subpixelBlock(const RenderSettings& r, int maxTextureSize) {
-  int block = std::clamp(int(std::lround(std::sqrt(double(r.samples)))), 1, 8);
-  while (block > 1 && std::max(r.resolution.x, r.resolution.y) * block > maxTextureSize) --block;
-  return block;
-}
-
 // A strand drawn wider than this share of the image's smaller side is a sheet, not a hair: 759 guides
 // 0.5 m wide filled a 640x640 coupe image 400 times over (40 s of llvmpipe for a grey wall).
 constexpr double kSheetShare = 0.25;
