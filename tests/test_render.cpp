@@ -332,6 +332,32 @@ TEST(CameraFragments, TheFragmentsAreTheSameBitsOnOneThreadAsOnAll) {
   EXPECT_TRUE(all.first == single.first && all.tail == single.tail && all.tail == again.tail);
 }
 
+// The fragments a caller can use bound what is kept: as many as it can use give the same fragments,
+// one fewer is an InputError before the words are gathered (so `first` never wraps past 2^32).
+TEST(CameraFragments, MoreFragmentsThanTheCallerCanUseAreRefused) {
+  const Strands s = crossingEveryWay();
+  const raster::Bands bands = raster::projectIntoBands(s, texelView(256), 0.7);
+  const CameraFragments all = cameraFragments(bands, kKeptFragments);
+  const CameraFragments enough = cameraFragments(bands, kKeptFragments, nullptr, all.count());
+  EXPECT_TRUE(enough.words == all.words && enough.first == all.first);
+  EXPECT_THROW(cameraFragments(bands, kKeptFragments, nullptr, all.count() - 1), InputError);
+}
+
+// Samples k² draws k × k sub-pixels a pixel (k the rounded root, at most 8), fewer when the sub-pixel
+// image would pass the device's largest texture: the one rule the renderer and preflight share.
+TEST(CameraFragments, TheSubpixelBlockIsTheRootOfSamplesWithinTheLargestTexture) {
+  RenderSettings r;
+  r.resolution = {1920, 1080};
+  const std::pair<int, int> samplesBlock[] = {{1, 1}, {2, 1}, {3, 2}, {4, 2}, {16, 4}, {64, 8}, {1000, 8}};
+  for (const auto& [samples, block] : samplesBlock) {
+    r.samples = samples;
+    EXPECT_EQ(subpixelBlock(r, 16384), block) << samples;
+  }
+  r.samples = 64;
+  EXPECT_EQ(subpixelBlock(r, 8192), 4);
+  EXPECT_EQ(subpixelBlock(r, 1024), 1);
+}
+
 // A pixel the hair covers whole: its pieces' coverages are integers rounded down (hair_raster.h), so a
 // strand's inside sums to within a few 1/65536 of a pixel.
 constexpr float kCovered = 0.999f;

@@ -52,8 +52,11 @@ struct CameraFragments {
 // projectIntoBands, its width × height pixels, or sub-pixels). `kept`: fragments per pixel, 1 to 255.
 // `opaque`: null, or per pixel (rows from the bottom) the depth along the camera's axis of what hides
 // the hair behind it (the head), metres: a fragment that deep or deeper is no fragment of the pixel,
-// neither kept nor in its tail.
-CameraFragments cameraFragments(const raster::Bands& bands, int kept, const float* opaque = nullptr);
+// neither kept nor in its tail. `limit`: the most fragments the caller can use (the shading pass's
+// atlas); more is refused (InputError naming Render.Samples and Render.Resolution) as soon as the
+// bands drawn so far keep more, so `first` (32 bits) never wraps and their words are never all held.
+CameraFragments cameraFragments(const raster::Bands& bands, int kept, const float* opaque = nullptr,
+                                uint64_t limit = UINT32_MAX);
 
 // projectIntoBands(hair, camera, strandWidth), then its fragments. `strandWidth`: the strands'
 // diameter, metres. A segment with a point nearer than the near plane is dropped.

@@ -528,8 +528,11 @@ ShadedImage shadingPass(const Scene& scene, const LightDepth& depth, const Textu
   std::optional<raster::Bands> readBack;
   if (!scene.cameraBands) readBack.emplace(raster::intoBands(scene.cameraOnDevice->read()));
   const raster::Bands& bands = scene.cameraBands ? *scene.cameraBands : *readBack;
+  // No more than blendHair's atlas holds (rows of atlasWidth texels, at most the largest texture's).
+  const int maxSize = maxTextureSize();
+  const uint64_t atlasTexels = uint64_t(std::min(kAtlasWidth, maxSize)) * uint64_t(maxSize);
   const CameraFragments f =
-      cameraFragments(bands, scene.kept, headDepth.empty() ? nullptr : headDepth.data());
+      cameraFragments(bands, scene.kept, headDepth.empty() ? nullptr : headDepth.data(), atlasTexels);
   headDepth = {};
   fragments = f.count();
   // Read in place where the hair is: the fragments outlive these buffers, whose deletion waits for
