@@ -26,6 +26,7 @@ struct Slot {
   uint32_t span;      // where its largest piece lies along its segment, 1/kSpanUnit
   bool nearer(const Slot& o) const { return depth != o.depth ? depth < o.depth : origin < o.origin; }
 };
+static_assert(sizeof(Slot) == kSlotBytes);
 
 // A depth in kDepthUnit as the metres it is stored and compared as (a float: the blend reads it so).
 float metresOf(int32_t depth) {

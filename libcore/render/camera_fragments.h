@@ -13,6 +13,7 @@
 // back (order-independent transparency over the nearest fragments, as a k-buffer does), passes.h.
 #pragma once
 
+#include <cstddef>
 #include <cstdint>
 #include <vector>
 
@@ -29,6 +30,9 @@ inline constexpr int kKeptFragments = 8;
 // The converged reference's (render --reference, with 8 × 8 sub-pixels): every fragment a sub-pixel of
 // a coupe sees, to the last per cent of its light.
 inline constexpr int kReferenceFragments = 64;
+// The bytes a pixel's kept slot takes while its band is drawn (camera_fragments.cpp's Slot), for
+// preflight's estimate of what the rasteriser holds.
+inline constexpr size_t kSlotBytes = 28;
 // Where a fragment lies along its segment, in 1/kSpanUnit of it (15 bits).
 inline constexpr uint32_t kSpanUnit = (1u << 15) - 1;
 // A fragment's third word: its coverage in kCoverageOne per pixel (hair_raster.h) in the low 17 bits,
