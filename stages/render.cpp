@@ -132,7 +132,8 @@ RenderOutput render(GlContext& gl, const Strands& hair, const Mesh* head, const 
     copyFraming.reset();
     if (options.uploaded) options.uploaded();
   };
-  requireFits(estimateRender(input.settings, *input.hair, head, gl.maxTextureSize()), options.force);
+  requireFits(estimateRender(input.settings, *input.hair, head, gl.maxTextureSize(), input.keptFragments),
+              options.force);
   RenderOutput out = renderHair(gl, input);
   requireFinite(out.beauty);
   return out;

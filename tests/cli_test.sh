@@ -679,7 +679,7 @@ check_shot_time)
   # check on a shot estimates its time as well as its memory: each stage's, the frames' render (the
   # most of it), and the total.
   expect_rc 0 "$hairgen" check "$src/configs/shots/headturn/setup.txt"
-  grep -Eq "^  render, 72 frames: about [0-9]+ MB, [0-9]+ (s|min [0-9]+ s|h [0-9]+ min) \([0-9]+ s a frame\)" "$tmp/out" ||
+  grep -Eq "^  render, 72 frames: about [0-9.]+ (MB|GB), [0-9]+ (s|min [0-9]+ s|h [0-9]+ min) \([0-9]+ s a frame\)" "$tmp/out" ||
     fail "check names no time for the render of the shot's frames: $(cat "$tmp/out")"
   grep -Eq "^  simulate, 72 frames: " "$tmp/out" || fail "check names no simulation: $(cat "$tmp/out")"
   grep -Eq "^  in all about [0-9]+ (s|min|h)" "$tmp/out" || fail "check names no total time: $(cat "$tmp/out")"
@@ -693,7 +693,7 @@ assert abs(sum(w["seconds"] for w in r["work"]) - r["workSeconds"]) < 1e-6 * r["
 PY
   # A still: one render, no frames.
   expect_rc 0 "$hairgen" check "$src/configs/default/setup.txt"
-  grep -Eq "^  render: about [0-9]+ MB, ([0-9]+ s|under a second)" "$tmp/out" || fail "check names no render time: $(cat "$tmp/out")"
+  grep -Eq "^  render: about [0-9.]+ (MB|GB), ([0-9]+ s|under a second)" "$tmp/out" || fail "check names no render time: $(cat "$tmp/out")"
   ;;
 shot_headturn)
   # The bundled head turn, small: the shot runs end to end, the head has turned by its last frame (the

@@ -133,6 +133,44 @@ TEST(RenderEstimate, CoverageCountsOnlyWhatIsOnScreen) {
   EXPECT_LE(hairCoverage(view, hair, 1.0, 1.0), double(hair.pointCount() - hair.strandCount()) * 640 * 640);
 }
 
+// The fragments hairgen's rasteriser keeps: a lone strand's are its length times its true width and
+// one (0.2 pixel wide here: 1.2 pixels a pixel of length); a thousand strands over the same pixels are
+// at most the kept count a pixel of the tiles they cross, not a thousand times one.
+TEST(RenderEstimate, KeptFragmentsAreALengthTimesAWidthAtMostKeptAPixel) {
+  RenderSettings r;
+  r.resolution = {640, 640};
+  r.cameraPosition = {0.0, 0.15, 1.0};
+  r.cameraTarget = {0.0, 0.15, 0.0};
+  Strands one;
+  one.addStrand({{0.0f, 0.0f, 0.0f}, {0.0f, 0.3f, 0.0f}});
+  const View view = cameraView(r, boundingSphere(one, nullptr));
+  const double widthPx = 0.2, lengthPx = 0.3 * view.focalPx;
+  KeptFragments lone{8};
+  hairCoverage(view, one, widthPx / view.focalPx, 1.0, &lone);
+  EXPECT_NEAR(lone.fragments, lengthPx * (widthPx + 1.0), 0.01 * lone.fragments);
+  Strands pile;
+  for (int i = 0; i < 1000; ++i) pile.addStrand({{0.0f, 0.0f, 0.0f}, {0.0f, 0.3f, 0.0f}});
+  KeptFragments piled{8};
+  hairCoverage(view, pile, widthPx / view.focalPx, 1.0, &piled);
+  const double tiles = std::ceil(lengthPx / kFootprintTile) + 1.0;
+  EXPECT_LE(piled.fragments, 8.0 * kFootprintTile * kFootprintTile * tiles);
+  EXPECT_GT(piled.fragments, 8.0 * lone.fragments);
+}
+
+// render --reference keeps kReferenceFragments a sub-pixel: each thread's slots for a band of its 8 x 8
+// sub-pixels (28 bytes a slot) are counted, 880 MB a thread at 1080p.
+TEST(RenderEstimate, TheReferencesSlotsAreCounted) {
+  RenderSettings r;
+  r.resolution = {1920, 1080};
+  r.samples = 64;
+  const Strands hair = brush(100, 16);
+  frameScene(r, hair, nullptr);
+  const WorkEstimate fast = estimateRender(r, hair, nullptr, 16384);
+  const WorkEstimate reference = estimateRender(r, hair, nullptr, 16384, kReferenceFragments);
+  const double slotsPerThread = 32.0 * 1920 * 8 * (kReferenceFragments - kKeptFragments) * 28.0;
+  EXPECT_GE(double(reference.bytes - fast.bytes), slotsPerThread);
+}
+
 TEST(RenderEstimate, SheetWideStrandsAreRefusedNamingStrandWidth) {
   // Coupe 3's 759 guides at Render.StrandWidth 0.5 (legal, (0, 1]) drew for 40 s with exit 0.
   RenderSettings r;

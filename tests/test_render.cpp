@@ -161,6 +161,54 @@ TEST(HairLightMaps, ASegmentCoversItsWidthTimesItsLength) {
     }
 }
 
+// A strand thousands of texels wide drawn for one band of rows: the fragments in those rows are the
+// same bits as when every row is wanted (the rows passed over still count toward the last texel's
+// remainder), with either filter, and the band costs its rows, not the strand's width.
+template <raster::Across across>
+void expectABandsRowsAsAllRows(raster::Vertex a, raster::Vertex b) {
+  struct Fragment {
+    int64_t i, j;
+    int32_t depth;
+    uint32_t coverage;
+    int64_t twice;
+    bool operator==(const Fragment&) const = default;
+  };
+  auto draw = [&](int64_t rowLo, int64_t rowHi, size_t& calls) {
+    std::vector<Fragment> in;
+    calls = 0;
+    raster::rasteriseSegment<across>(a, b, rowLo, rowHi,
+                                     [&](int64_t i, int64_t j, int32_t depth, uint32_t c, raster::Piece p) {
+                                       ++calls;
+                                       if (j >= rowLo && j < rowHi) in.push_back({i, j, depth, c, p.twice});
+                                     });
+    return in;
+  };
+  size_t allCalls = 0, bandCalls = 0;
+  const std::vector<Fragment> all = draw(-100000, 100000, allCalls);
+  const int64_t columns = std::abs(int64_t(b.x) - a.x) / kSubTexel + 2;
+  for (const int64_t rowLo : {int64_t(0), int64_t(1984), int64_t(2016), int64_t(3520), int64_t(5000)}) {
+    const int64_t rowHi = rowLo + raster::kBandRows;
+    std::vector<Fragment> want;
+    for (const Fragment& f : all)
+      if (f.j >= rowLo && f.j < rowHi) want.push_back(f);
+    EXPECT_TRUE(draw(rowLo, rowHi, bandCalls) == want) << "rows from " << rowLo;
+    EXPECT_LE(bandCalls, size_t(columns) * (raster::kBandRows + 6)) << "rows from " << rowLo;
+  }
+  EXPECT_GT(allCalls, size_t(columns) * 2000);
+}
+
+TEST(HairRaster, ABandOfAWideStrandIsTheSameBitsAndCostsItsRows) {
+  // 3000 and 4096 texels wide (the widest drawn), slanting up and down, along x.
+  for (const int32_t width : {3000, 4096})
+    for (const int32_t rise : {25470, -31337, 0}) {
+      const raster::Vertex a{2637, 2000 * kSubTexel + 179, 1000000, width * kWidthUnit};
+      const raster::Vertex b{300 * kSubTexel + 150, 2000 * kSubTexel + 179 + rise, 1003000,
+                             width * kWidthUnit};
+      expectABandsRowsAsAllRows<raster::Across::kBox>(a, b);
+      expectABandsRowsAsAllRows<raster::Across::kTent>(a, b);
+    }
+}
+
 // Two strands over the same texels, the second 4 mm behind the first: with layers of 2, 6, 15 and 40 mm
 // it adds to the second layer and those behind, not the first; where the hair begins is the first's
 // depth. (A strand's width in texels is its width over its depth: 0.5 texel at 1 m, 0.498 at 1.004 m.)
@@ -330,6 +378,32 @@ TEST(CameraFragments, TheFragmentsAreTheSameBitsOnOneThreadAsOnAll) {
   EXPECT_GT(all.count(), 100000u);
   EXPECT_TRUE(all.words == single.words && all.words == again.words);
   EXPECT_TRUE(all.first == single.first && all.tail == single.tail && all.tail == again.tail);
+}
+
+// The fragments a caller can use bound what is kept: as many as it can use give the same fragments,
+// one fewer is an InputError before the words are gathered (so `first` never wraps past 2^32).
+TEST(CameraFragments, MoreFragmentsThanTheCallerCanUseAreRefused) {
+  const Strands s = crossingEveryWay();
+  const raster::Bands bands = raster::projectIntoBands(s, texelView(256), 0.7);
+  const CameraFragments all = cameraFragments(bands, kKeptFragments);
+  const CameraFragments enough = cameraFragments(bands, kKeptFragments, nullptr, all.count());
+  EXPECT_TRUE(enough.words == all.words && enough.first == all.first);
+  EXPECT_THROW(cameraFragments(bands, kKeptFragments, nullptr, all.count() - 1), InputError);
+}
+
+// Samples k² draws k × k sub-pixels a pixel (k the rounded root, at most 8), fewer when the sub-pixel
+// image would pass the device's largest texture: the one rule the renderer and preflight share.
+TEST(CameraFragments, TheSubpixelBlockIsTheRootOfSamplesWithinTheLargestTexture) {
+  RenderSettings r;
+  r.resolution = {1920, 1080};
+  const std::pair<int, int> samplesBlock[] = {{1, 1}, {2, 1}, {3, 2}, {4, 2}, {16, 4}, {64, 8}, {1000, 8}};
+  for (const auto& [samples, block] : samplesBlock) {
+    r.samples = samples;
+    EXPECT_EQ(subpixelBlock(r, 16384), block) << samples;
+  }
+  r.samples = 64;
+  EXPECT_EQ(subpixelBlock(r, 8192), 4);
+  EXPECT_EQ(subpixelBlock(r, 1024), 1);
 }
 
 // A pixel the hair covers whole: its pieces' coverages are integers rounded down (hair_raster.h), so a

@@ -1,12 +1,15 @@
 #include "libcore/render/camera_fragments.h"
 
 #include <algorithm>
+#include <atomic>
 #include <bit>
+#include <string>
 
 #include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
 
 #include "libcore/render/hair_raster.h"
+#include "libcore/util/error.h"
 
 namespace hairgen {
 
@@ -23,6 +26,7 @@ struct Slot {
   uint32_t span;      // where its largest piece lies along its segment, 1/kSpanUnit
   bool nearer(const Slot& o) const { return depth != o.depth ? depth < o.depth : origin < o.origin; }
 };
+static_assert(sizeof(Slot) == kSlotBytes);
 
 // A depth in kDepthUnit as the metres it is stored and compared as (a float: the blend reads it so).
 float metresOf(int32_t depth) {
@@ -76,8 +80,10 @@ CameraFragments rasteriseCameraFragments(const Strands& hair, const View& camera
   return cameraFragments(raster::projectIntoBands(hair, camera, strandWidth), kept, opaque);
 }
 
-CameraFragments cameraFragments(const raster::Bands& bands, int kept, const float* opaque) {
-  kept = std::clamp(kept, 1, 255);  // a pixel counts its fragments in a byte
+CameraFragments cameraFragments(const raster::Bands& bands, int kept, const float* opaque, uint64_t limit) {
+  kept = std::clamp(kept, 1, 255);                // a pixel counts its fragments in a byte
+  limit = std::min<uint64_t>(limit, UINT32_MAX);  // what `first` indexes
+  std::atomic<uint64_t> keptSoFar{0};             // the fragments of the bands drawn so far
   const size_t width = size_t(bands.width), pixels = width * size_t(bands.height);
   CameraFragments out;
   out.width = bands.width;
@@ -110,6 +116,10 @@ CameraFragments cameraFragments(const raster::Bands& bands, int kept, const floa
     std::vector<uint32_t>& words = bandWords[size_t(band)];
     size_t count = 0;
     for (const uint8_t n : used) count += n;
+    if (keptSoFar.fetch_add(count) + count > limit)
+      throw InputError("the camera sees more than " + std::to_string(limit) +
+                       " hair fragments, more than the renderer can shade at once; lower Render.Samples or "
+                       "Render.Resolution");
     words.reserve(3 * count);
     for (size_t p = 0; p < end - base; ++p) {
       counts[base + p] = used[p];
@@ -121,7 +131,7 @@ CameraFragments cameraFragments(const raster::Bands& bands, int kept, const floa
     }
   });
   out.first.resize(pixels + 1);
-  uint32_t total = 0;
+  uint32_t total = 0;  // at most `limit`
   for (size_t p = 0; p < pixels; ++p) {
     out.first[p] = total;
     total += counts[p];

@@ -13,6 +13,7 @@
 // back (order-independent transparency over the nearest fragments, as a k-buffer does), passes.h.
 #pragma once
 
+#include <cstddef>
 #include <cstdint>
 #include <vector>
 
@@ -29,6 +30,9 @@ inline constexpr int kKeptFragments = 8;
 // The converged reference's (render --reference, with 8 × 8 sub-pixels): every fragment a sub-pixel of
 // a coupe sees, to the last per cent of its light.
 inline constexpr int kReferenceFragments = 64;
+// The bytes a pixel's kept slot takes while its band is drawn (camera_fragments.cpp's Slot), for
+// preflight's estimate of what the rasteriser holds.
+inline constexpr size_t kSlotBytes = 28;
 // Where a fragment lies along its segment, in 1/kSpanUnit of it (15 bits).
 inline constexpr uint32_t kSpanUnit = (1u << 15) - 1;
 // A fragment's third word: its coverage in kCoverageOne per pixel (hair_raster.h) in the low 17 bits,
@@ -52,8 +56,11 @@ struct CameraFragments {
 // projectIntoBands, its width × height pixels, or sub-pixels). `kept`: fragments per pixel, 1 to 255.
 // `opaque`: null, or per pixel (rows from the bottom) the depth along the camera's axis of what hides
 // the hair behind it (the head), metres: a fragment that deep or deeper is no fragment of the pixel,
-// neither kept nor in its tail.
-CameraFragments cameraFragments(const raster::Bands& bands, int kept, const float* opaque = nullptr);
+// neither kept nor in its tail. `limit`: the most fragments the caller can use (the shading pass's
+// atlas); more is refused (InputError naming Render.Samples and Render.Resolution) as soon as the
+// bands drawn so far keep more, so `first` (32 bits) never wraps and their words are never all held.
+CameraFragments cameraFragments(const raster::Bands& bands, int kept, const float* opaque = nullptr,
+                                uint64_t limit = UINT32_MAX);
 
 // projectIntoBands(hair, camera, strandWidth), then its fragments. `strandWidth`: the strands'
 // diameter, metres. A segment with a point nearer than the near plane is dropped.

@@ -204,7 +204,22 @@ void rasteriseSegment(Vertex a, Vertex b, int64_t rowLo, int64_t rowHi, F&& frag
     const int64_t mFirst = floorDiv(below - reachOut, kSubTexel);
     const int64_t mLast = floorDiv(above + reachOut - 1, kSubTexel);
     uint64_t given = 0;
+    // Along x the texels across are rows, and those outside [rowLo, rowHi) are not wanted. Every texel
+    // whose filter lies inside the cross-section, [insideFirst, insideLast], holds the same share, so a
+    // run of unwanted ones is passed over with their shares' sum: `given` as adding them one by one
+    // leaves it, so the wanted texels' shares are the same bits, and a strand thousands of texels wide
+    // costs a band its rows, not its width.
+    const int64_t insideFirst = -floorDiv(-(below + reachOut), kSubTexel);
+    const int64_t insideLast = floorDiv(above - reachOut, kSubTexel) - 1;
+    const uint64_t insideShare =
+        uint64_t(Uint128(area * uint64_t(acrossTotal<across>(kSubTexel))) * perExtent >> 40);
     for (int64_t m = mFirst; m <= mLast; ++m) {
+      if (alongX && (m < rowLo || m >= rowHi) && m >= insideFirst && m <= insideLast && m < mLast) {
+        const int64_t next = std::min({m < rowLo ? rowLo : mLast, insideLast + 1, mLast});  // not passed over
+        given += uint64_t(next - m) * insideShare;
+        m = next - 1;
+        continue;
+      }
       uint64_t share = area - given;
       if (m < mLast)
         share = uint64_t(Uint128(area * uint64_t(acrossShare<across>(m, below, above))) * perExtent >> 40);

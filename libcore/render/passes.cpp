@@ -30,14 +30,6 @@ int maxTextureSize() {
   return int(size);
 }
 
-// k for Samples = k² (k ≤ 8), lowered until the sub-pixel image fits the device's largest texture.
-int subpixelBlock(const RenderSettings& r) {
-  const int maxSize = maxTextureSize();
-  int block = std::min(std::max(1, int(std::lround(std::sqrt(double(r.samples))))), 8);
-  while (block > 1 && std::max(r.resolution.x, r.resolution.y) * block > maxSize) --block;
-  return block;
-}
-
 // The light's maps' size when the input leaves it to the renderer: a texel no larger than a pixel at the
 // scene's centre (a texel there is its distance from the light over the light's focal length in
 // texels, which grows with the map's size), between kMinDomResolution and the smaller of
@@ -264,7 +256,7 @@ Scene::Scene(const RenderInput& in)
     : settings(in.settings),
       visuality(in.visuality),
       sphere(boundingSphere(*in.hair, in.head)),
-      block(subpixelBlock(in.settings)),
+      block(subpixelBlock(in.settings, maxTextureSize())),
       camera(cameraView(in.settings, sphere)),
       subpixel(subpixelView(camera, block)),
       light(lightView(in.settings, sphere, lightMapSize(in, sphere, camera))),
@@ -544,8 +536,11 @@ ShadedImage shadingPass(const Scene& scene, const LightDepth& depth, const Textu
   std::optional<raster::Bands> readBack;
   if (!scene.cameraBands) readBack.emplace(raster::intoBands(scene.cameraOnDevice->read()));
   const raster::Bands& bands = scene.cameraBands ? *scene.cameraBands : *readBack;
+  // No more than blendHair's atlas holds (rows of atlasWidth texels, at most the largest texture's).
+  const int maxSize = maxTextureSize();
+  const uint64_t atlasTexels = uint64_t(std::min(kAtlasWidth, maxSize)) * uint64_t(maxSize);
   const CameraFragments f =
-      cameraFragments(bands, scene.kept, headDepth.empty() ? nullptr : headDepth.data());
+      cameraFragments(bands, scene.kept, headDepth.empty() ? nullptr : headDepth.data(), atlasTexels);
   headDepth = {};
   fragments = f.count();
   fragmentSeconds += clock.lap();

@@ -86,4 +86,10 @@ View subpixelView(const View& camera, int block) {
   return fine;
 }
 
+int subpixelBlock(const RenderSettings& render, int maxTextureSize) {
+  int block = std::clamp(int(std::lround(std::sqrt(double(render.samples)))), 1, 8);
+  while (block > 1 && std::max(render.resolution.x, render.resolution.y) * block > maxTextureSize) --block;
+  return block;
+}
+
 }  // namespace hairgen

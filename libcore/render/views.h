@@ -47,4 +47,9 @@ glm::dmat4 openExrWorldToNdc(const View& view);
 // The same camera on a grid of block × block sub-pixels per pixel.
 View subpixelView(const View& camera, int block);
 
+// The sub-pixel block the renderer draws `render` with: k for Samples = k², k = round(√Samples) capped
+// at 8, lowered until the sub-pixel image (the larger side of Resolution × k) fits `maxTextureSize`, the
+// device's largest texture in texels a side. The one rule the renderer and its preflight estimate share.
+int subpixelBlock(const RenderSettings& render, int maxTextureSize);
+
 }  // namespace hairgen

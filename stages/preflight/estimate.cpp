@@ -7,6 +7,9 @@
 #include <cmath>
 #include <thread>
 
+#include <tbb/global_control.h>
+#include <tbb/task_arena.h>
+
 #include "libcore/render/views.h"
 #include "libcore/util/error.h"
 #include "libcore/util/resources.h"
@@ -164,40 +167,67 @@ WorkEstimate estimateShade(const RenderSettings& render, size_t strands, size_t 
 
 namespace {
 
-// k for Samples = k² (k ≤ 8), lowered until the sub-pixel image fits the device's largest texture, as
-// the renderer chooses it.
-int subpixelBlock(const RenderSettings& r, int maxTextureSize) {
-  int block = std::clamp(int(std::lround(std::sqrt(double(r.samples)))), 1, 8);
-  while (block > 1 && std::max(r.resolution.x, r.resolution.y) * block > maxTextureSize) --block;
-  return block;
-}
-
 // A strand drawn wider than this share of the image's smaller side is a sheet, not a hair: 759 guides
 // 0.5 m wide filled a 640x640 coupe image 400 times over (40 s of llvmpipe for a grey wall).
 constexpr double kSheetShare = 0.25;
 
-// The render's memory and time, from `fragments`: the sub-pixel fragments the hair's ribbons cover.
-// `distance`: from the camera to the scene's centre, metres, where a strand's width is judged.
+// What hairgen's rasteriser holds while it draws the camera's view at `block` × `block` sub-pixels,
+// keeping `kept` fragments a sub-pixel, F of them in all (hairCoverage's KeptFragments), on `threads`
+// threads, bytes; `points`, `segments`: the hair's. Each term is a buffer of camera_fragments.cpp
+// or hair_raster.h:
+//   slots       threads × kBandRows × W × (kept × kSlotBytes + 1): each thread's slots for a band's
+//               sub-pixels and their counts (W the sub-pixel image's width), alive until the end;
+//   words       2 × 12 × F: three words a fragment, gathered per band and then copied into one array
+//               while the bands' are alive;
+//   atlas       16 × F: the shading pass's two RGBA16F texels per kept fragment (host memory on
+//               llvmpipe, the device's on a GPU);
+//   per pixel   sub-pixels × 16: first, the counts, the tail and the head's depth read back;
+//   bands       16 × points + 4 × segments: the quantised points and each segment listed in its band.
+// The light's maps (their integers) are counted with the other light maps in renderCost. Against peak
+// RSS on coupe 3 (150k strands of 65 points, 2 threads): 2.3 GB in all for 1.5 GB at 1920x1080 Samples 4,
+// 5.7 GB for 3.1 GB with --reference at 480x270 (F 1.5-1.6 times the fragments kept).
+double rasteriserBytes(const RenderSettings& r, int block, int kept, double fragments, size_t points,
+                       size_t segments, size_t threads) {
+  const double width = double(r.resolution.x) * block;
+  const double fine = width * double(r.resolution.y) * block;
+  const double slots = double(threads) * raster::kBandRows * width * (double(kept) * kSlotBytes + 1.0);
+  return slots + fragments * (2.0 * 12.0 + 16.0) + fine * 16.0 + double(points) * 16.0 +
+         double(segments) * 4.0;
+}
+
+// The render's memory and time, from `fragments`: the sub-pixel fragments the hair's ribbons cover, and
+// `keptSeen`: those hairgen's rasteriser keeps, `kept` a sub-pixel (rasteriserBytes). `distance`: from
+// the camera to the scene's centre, metres, where a strand's width is judged.
 WorkEstimate renderCost(const RenderSettings& r, size_t strands, size_t points, size_t headTriangles,
-                        double fragments, double distance, int block) {
+                        double fragments, double keptSeen, int kept, double distance, int block) {
   WorkEstimate e;
   e.stage = "render";
   const double pixels = double(r.resolution.x) * double(r.resolution.y);
   const double fine = pixels * double(block) * double(block);
+  const double keptAll = std::min(keptSeen, fine * kept);
   const int dom = std::clamp(std::max(r.resolution.x, r.resolution.y) / 2, 1024, 4096);
   // The shading targets (RGBA16F colour, RGBA32F data, 24-bit depth) at the sub-pixel resolution, the
-  // resolved pair and the planes read back, the light's maps, and the hair and head on the device.
+  // resolved pair and the planes read back, the light's maps (textures, and the rasteriser's start
+  // depth and four layer sums, 20 bytes a texel), and the hair and head on the device.
   const double framebuffers =
-      fine * (8.0 + 16.0 + 4.0) + pixels * (32.0 + 7 * 4.0) + double(dom) * dom * 28.0;
+      fine * (8.0 + 16.0 + 4.0) + pixels * (32.0 + 7 * 4.0) + double(dom) * dom * (28.0 + 20.0);
   const double geometry = double(points) * 48.0 * 2.0 + double(strands) * 16.0 + double(headTriangles) * 36.0;
-  e.bytes = bytesOf(framebuffers + geometry);
-  e.memoryKey = framebuffers >= geometry ? "Render.Resolution or Render.Samples" : "the coupe's size";
+  // The threads the rasteriser draws bands on: this arena's, at most what --threads allows.
+  const size_t threads = std::max<size_t>(
+      1, std::min(size_t(tbb::this_task_arena::max_concurrency()),
+                  tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism)));
+  const double raster =
+      rasteriserBytes(r, block, kept, keptAll, points, points - std::min(points, strands), threads);
+  e.bytes = bytesOf(framebuffers + geometry + raster);
+  e.memoryKey =
+      framebuffers + raster >= geometry ? "Render.Resolution or Render.Samples" : "the coupe's size";
   e.seconds = 3.0 * double(points) * kSecondsPerVertex + (fragments + fine) * kSecondsPerFragment;
   const double focal = 0.5 * r.resolution.y / std::tan(0.5 * r.fieldOfView * M_PI / 180.0);
   const double widthPx = r.strandWidth * focal / std::max(distance, 1e-6);
   e.timeKey = widthPx > 4.0 ? "Render.StrandWidth" : "Render.Resolution or Render.Samples";
   e.detail = std::to_string(r.resolution.x) + "x" + std::to_string(r.resolution.y) + " pixels at " +
-             std::to_string(block * block) + " samples, " + std::to_string(strands) + " strands";
+             std::to_string(block * block) + " samples, " + std::to_string(strands) + " strands, about " +
+             formatReal(std::round(keptAll / 1e6)) + " million hair fragments kept";
   const double side = double(std::min(r.resolution.x, r.resolution.y));
   if (widthPx > kSheetShare * side)
     e.refusal = "Render.StrandWidth " + formatReal(r.strandWidth) + " m draws each strand about " +
@@ -240,9 +270,14 @@ bool clipToBox(const glm::dvec2& a, const glm::dvec2& b, const glm::dvec2& lo, c
 
 }  // namespace
 
-double hairCoverage(const View& view, const Strands& hair, double strandWidth, double minWidthPx) {
+double hairCoverage(const View& view, const Strands& hair, double strandWidth, double minWidthPx,
+                    KeptFragments* kept) {
   const glm::dvec2 size(view.width, view.height);
   const double screen = size.x * size.y;
+  // The fragments given in each tile of kFootprintTile² pixels.
+  const int tilesX = (view.width + kFootprintTile - 1) / kFootprintTile;
+  const int tilesY = (view.height + kFootprintTile - 1) / kFootprintTile;
+  std::vector<double> given(kept ? size_t(tilesX) * size_t(tilesY) : 0, 0.0);
   // The near plane (glm::perspective's), before which the device clips.
   const double nearDepth = std::max(view.proj[3][2] / (view.proj[2][2] - 1.0), 1e-9);
   double fragments = 0.0;
@@ -260,8 +295,8 @@ double hairCoverage(const View& view, const Strands& hair, double strandWidth, d
         b += (a - b) * ((nearDepth - db) / (da - db));
         db = nearDepth;
       }
-      const double wa = std::max(strandWidth * view.focalPx / da, minWidthPx),
-                   wb = std::max(strandWidth * view.focalPx / db, minWidthPx);
+      const double trueA = strandWidth * view.focalPx / da, trueB = strandWidth * view.focalPx / db;
+      const double wa = std::max(trueA, minWidthPx), wb = std::max(trueB, minWidthPx);
       const glm::dvec2 pa = 0.5 * size + view.focalPx * glm::dvec2(a.x, a.y) / da,
                        pb = 0.5 * size + view.focalPx * glm::dvec2(b.x, b.y) / db;
       // The ribbon reaches half its width beyond its centre line.
@@ -272,19 +307,35 @@ double hairCoverage(const View& view, const Strands& hair, double strandWidth, d
       const double width = wa + (wb - wa) * 0.5 * (t0 + t1);
       // A quad at least its width long (the joins), and never more than the image.
       fragments += std::min(std::max(length, width) * width, screen);
+      if (kept) {  // in the tile of the clipped segment's middle
+        const glm::dvec2 middle = glm::clamp(pa + (pb - pa) * (0.5 * (t0 + t1)), glm::dvec2(0.0), size - 1.0);
+        given[size_t(middle.y / kFootprintTile) * size_t(tilesX) + size_t(middle.x / kFootprintTile)] +=
+            std::min(length * (trueA + (trueB - trueA) * 0.5 * (t0 + t1) + 1.0), screen);
+      }
     }
+  }
+  if (kept) {
+    kept->fragments = 0.0;
+    for (int ty = 0; ty < tilesY; ++ty)
+      for (int tx = 0; tx < tilesX; ++tx) {
+        const double pixels = double(std::min(kFootprintTile, view.width - tx * kFootprintTile)) *
+                              double(std::min(kFootprintTile, view.height - ty * kFootprintTile));
+        kept->fragments += std::min(given[size_t(ty) * size_t(tilesX) + size_t(tx)], pixels * kept->perPixel);
+      }
   }
   return fragments;
 }
 
 WorkEstimate estimateRender(const RenderSettings& r, const Strands& hair, const Mesh* head,
-                            int maxTextureSize) {
+                            int maxTextureSize, int keptFragments) {
   const int block = subpixelBlock(r, maxTextureSize);
   const BoundingSphere sphere = boundingSphere(hair, head);
   const View fine = subpixelView(cameraView(r, sphere), block);
-  const double fragments = hairCoverage(fine, hair, r.strandWidth, double(block));
-  WorkEstimate e = renderCost(r, hair.strandCount(), hair.pointCount(), head ? head->triangleCount() : 0,
-                              fragments, glm::length(sphere.centre - r.cameraPosition), block);
+  KeptFragments kept{keptFragments};
+  const double fragments = hairCoverage(fine, hair, r.strandWidth, double(block), &kept);
+  WorkEstimate e =
+      renderCost(r, hair.strandCount(), hair.pointCount(), head ? head->triangleCount() : 0, fragments,
+                 kept.fragments, keptFragments, glm::length(sphere.centre - r.cameraPosition), block);
   double longest = 0.0;
   for (size_t s = 0; s < hair.strandCount(); ++s) {
     double length = 0.0;
@@ -297,7 +348,8 @@ WorkEstimate estimateRender(const RenderSettings& r, const Strands& hair, const 
 }
 
 WorkEstimate estimateRender(const RenderSettings& r, size_t strands, size_t points, size_t headTriangles,
-                            double distance, double radius, double hairLength, int maxTextureSize) {
+                            double distance, double radius, double hairLength, int maxTextureSize,
+                            int keptFragments) {
   const int block = subpixelBlock(r, maxTextureSize);
   const double fine = double(r.resolution.x) * r.resolution.y * block * block;
   // Each strand a ribbon at least a sub-pixel wide and as long as it looks from the scene's nearest
@@ -307,7 +359,12 @@ WorkEstimate estimateRender(const RenderSettings& r, size_t strands, size_t poin
   const double scale = focal / nearest;
   const double widthPx = std::max(r.strandWidth * scale, double(block)), lengthPx = hairLength * scale;
   const double fragments = double(strands) * std::min(std::max(lengthPx, widthPx) * widthPx, fine);
-  WorkEstimate e = renderCost(r, strands, points, headTriangles, fragments, distance, block);
+  // Each strand's fragments: its length times its true width and one (KeptFragments), at most
+  // keptFragments a sub-pixel (renderCost): for a coupe filling the image, the cap (default: 13 million
+  // at 640x640 for 2.6 million kept, 1.1 GB in all for a 650 MB peak of `hairgen run`).
+  const double keptSeen = double(strands) * lengthPx * (r.strandWidth * scale + 1.0);
+  WorkEstimate e =
+      renderCost(r, strands, points, headTriangles, fragments, keptSeen, keptFragments, distance, block);
   blameUnits(e, hairLength);
   return e;
 }

@@ -13,6 +13,7 @@
 #include "libcore/config/params.h"
 #include "libcore/model/mesh.h"
 #include "libcore/model/strands.h"
+#include "libcore/render/camera_fragments.h"
 #include "libcore/render/views.h"
 #include "libcore/util/frames.h"
 
@@ -49,17 +50,29 @@ WorkEstimate estimateShade(const RenderSettings& render, size_t strands, size_t 
 // The sub-pixel fragments `hair`'s ribbons cover in `view` (the camera at its sub-pixels), what the
 // render's time grows with: each segment clipped to the near plane and to the image (widened by half the
 // ribbon), its length in pixels times its width (`strandWidth` metres, at least `minWidthPx`), at most
-// the image's pixels a segment. Off-screen hair costs nothing.
-double hairCoverage(const View& view, const Strands& hair, double strandWidth, double minWidthPx);
+// the image's pixels a segment. Off-screen hair costs nothing. `kept`, when given, gets the fragments
+// hairgen's rasteriser keeps (what its memory grows with): in each tile of kFootprintTile² pixels, those
+// its segments give (a segment's clipped length times its true width plus one, the box filter's reach,
+// counted in the tile of its middle), at most kept->perPixel a pixel.
+struct KeptFragments {
+  int perPixel = kKeptFragments;  // in
+  double fragments = 0.0;         // out
+};
+inline constexpr int kFootprintTile = 32;  // pixels a side: a band's rows (hair_raster.h's kBandRows)
+double hairCoverage(const View& view, const Strands& hair, double strandWidth, double minWidthPx,
+                    KeptFragments* kept = nullptr);
 
 // The render of `hair` (and `head`, may be null) with `render`'s camera as framed, its time from
-// hairCoverage. A strand drawn wider than a quarter of the image is a refusal naming Render.StrandWidth.
+// hairCoverage, its memory with what the rasteriser holds for `keptFragments` a sub-pixel (render
+// --reference keeps kReferenceFragments) on this process's threads. A strand drawn wider than a quarter
+// of the image is a refusal naming Render.StrandWidth.
 WorkEstimate estimateRender(const RenderSettings& render, const Strands& hair, const Mesh* head,
-                            int maxTextureSize);
+                            int maxTextureSize, int keptFragments = kKeptFragments);
 // The same predicted before there is hair: `distance` from the camera to the scene's centre, `radius`
 // the scene's, `hairLength` the longest strand, metres; each strand covers at most the image.
 WorkEstimate estimateRender(const RenderSettings& render, size_t strands, size_t points, size_t headTriangles,
-                            double distance, double radius, double hairLength, int maxTextureSize);
+                            double distance, double radius, double hairLength, int maxTextureSize,
+                            int keptFragments = kKeptFragments);
 
 // `segments`: the guides' segments (points − strands); `frames`: the frames to simulate; `span`: the
 // size of the box that holds the rest guides and Model springs' DensityTarget (metres), which sizes
