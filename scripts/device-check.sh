@@ -15,6 +15,7 @@
 #       There, from the repository's root (golden/, configs/, tests/golden_test.sh): unpacks DIR's
 #       archive into a temporary folder, then
 #         1. hairgen render --list-devices                                   -> OUT/devices.txt
+#        1b. the unit tests that compare the device's rasteriser with the CPU's -> OUT/unit_tests.txt
 #         2. every golden case (tests/golden_test.sh with the packed hairgen); the failures' sheets
 #            (reference | rendered | 10 x difference) and diff reports       -> OUT/golden.tar
 #         3. issue 34's render figures through the command line (any hairgen build): 150,000 strands of
@@ -48,8 +49,10 @@ pack() {
   else
     echo "device-check: no $build/tests/hairgen_bench; the benchmarks will be skipped there" >&2
   fi
-  # The stage goldens' invariant checker (tests/stage_invariants.cpp), where this build has it.
+  # The stage goldens' invariant checker (tests/stage_invariants.cpp), and the unit tests (for the
+  # rasteriser's device-against-CPU comparisons), where this build has them.
   [ -x "$build/tests/stage_invariants" ] && binaries+=("$build/tests/stage_invariants")
+  [ -x "$build/tests/unit_tests" ] && binaries+=("$build/tests/unit_tests")
   for b in "${binaries[@]}"; do
     [ -e "$b" ] || die "$b is missing"
     cp "$b" "$stage/bin/" && strip --strip-unneeded "$stage/bin/$(basename "$b")"
@@ -58,7 +61,7 @@ pack() {
   # library's and OpenGL's.
   local skip='/(libc|libm|libdl|libpthread|librt|libresolv)\.so|/ld-linux|/libGL|/libEGL|/libOpenGL|/libGLX|/libGLdispatch'
   local lib
-  for b in "$stage/bin/hairgen" "$stage/bin/hairgen_bench" "$stage/bin/stage_invariants"; do
+  for b in "$stage/bin/hairgen" "$stage/bin/hairgen_bench" "$stage/bin/stage_invariants" "$stage/bin/unit_tests"; do
     [ -e "$b" ] || continue
     ldd "$b" | awk '$2 == "=>" && $3 ~ /^\// {print $3}'
   done | sort -u | grep -vE "$skip" | while read -r lib; do
@@ -127,6 +130,16 @@ run() {
   say "== 1. hairgen render --list-devices"
   timeout 60 "$hairgen" render --list-devices >"$out/devices.txt" 2>&1
   say "$(cat "$out/devices.txt")"
+
+  say "== 1b. the rasteriser on the device against the CPU's (unit tests)"
+  if [ -x "$bin/unit_tests" ]; then
+    HAIRGEN_SOURCE_DIR="$src" timeout 300 "$bin/unit_tests" --gtest_filter='ComputeRaster.*:CameraFragments.*:HairLightMaps.*' \
+      >"$out/unit_tests.txt" 2>&1
+    say "unit tests (exit $?): $(grep -E '^\[  (PASSED|FAILED|SKIPPED) ' "$out/unit_tests.txt" | tr '\n' ' ')"
+    grep -E '^\[  FAILED  \]|^\[  SKIPPED \]' "$out/unit_tests.txt" | sed 's/^/    /' | tee -a "$summary"
+  else
+    say "no unit_tests in the pack"
+  fi
 
   say "== 2. golden cases"
   local golden="$work/golden" failed=0 passed=0 case

@@ -3,6 +3,7 @@
 
 #include <gtest/gtest.h>
 
+#include <cstdlib>
 #include <filesystem>
 #include <random>
 #include <string>
@@ -16,8 +17,11 @@
 
 namespace hairgen::test {
 
+// The repository: where the build was configured, or $HAIRGEN_SOURCE_DIR where the tests run from a
+// copy elsewhere (scripts/device-check.sh on a GPU machine).
 inline std::filesystem::path sourceDir() {
-  return HAIRGEN_SOURCE_DIR;
+  const char* moved = std::getenv("HAIRGEN_SOURCE_DIR");
+  return moved && *moved ? moved : HAIRGEN_SOURCE_DIR;
 }
 // A bundled Setup (a path under configs/) read as a stage would, with its wick.
 struct Job {

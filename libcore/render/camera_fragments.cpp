@@ -80,6 +80,13 @@ CameraFragments rasteriseCameraFragments(const Strands& hair, const View& camera
   return cameraFragments(raster::projectIntoBands(hair, camera, strandWidth), kept, opaque);
 }
 
+void requireShadable(uint64_t fragments, uint64_t limit) {
+  if (fragments > limit)
+    throw InputError("the camera sees more than " + std::to_string(limit) +
+                     " hair fragments, more than the renderer can shade at once; lower Render.Samples or "
+                     "Render.Resolution");
+}
+
 CameraFragments cameraFragments(const raster::Bands& bands, int kept, const float* opaque, uint64_t limit) {
   kept = std::clamp(kept, 1, 255);                // a pixel counts its fragments in a byte
   limit = std::min<uint64_t>(limit, UINT32_MAX);  // what `first` indexes
@@ -116,10 +123,7 @@ CameraFragments cameraFragments(const raster::Bands& bands, int kept, const floa
     std::vector<uint32_t>& words = bandWords[size_t(band)];
     size_t count = 0;
     for (const uint8_t n : used) count += n;
-    if (keptSoFar.fetch_add(count) + count > limit)
-      throw InputError("the camera sees more than " + std::to_string(limit) +
-                       " hair fragments, more than the renderer can shade at once; lower Render.Samples or "
-                       "Render.Resolution");
+    requireShadable(keptSoFar.fetch_add(count) + count, limit);
     words.reserve(3 * count);
     for (size_t p = 0; p < end - base; ++p) {
       counts[base + p] = used[p];

@@ -62,6 +62,10 @@ struct CameraFragments {
 CameraFragments cameraFragments(const raster::Bands& bands, int kept, const float* opaque = nullptr,
                                 uint64_t limit = UINT32_MAX);
 
+// Throws InputError (exit 2) when `fragments` kept fragments are more than `limit`, the most the
+// shading pass can use.
+void requireShadable(uint64_t fragments, uint64_t limit);
+
 // projectIntoBands(hair, camera, strandWidth), then its fragments. `strandWidth`: the strands'
 // diameter, metres. A segment with a point nearer than the near plane is dropped.
 CameraFragments rasteriseCameraFragments(const Strands& hair, const View& camera, double strandWidth,

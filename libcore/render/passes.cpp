@@ -511,6 +511,9 @@ ShadedImage shadingPass(const Scene& scene, const LightDepth& depth, const Textu
   if (!scene.rasterised) return image;
   glFinish();
   Stopwatch clock;
+  // No more than blendHair's atlas holds (rows of atlasWidth texels, at most the largest texture's).
+  const int maxSize = maxTextureSize();
+  const uint64_t atlasTexels = uint64_t(std::min(kAtlasWidth, maxSize)) * uint64_t(maxSize);
   if (scene.cameraOnDevice) {
     // The head's depth is the data's R, read where it lies.
     const std::optional<DeviceFragments> f =
@@ -518,6 +521,7 @@ ShadedImage shadingPass(const Scene& scene, const LightDepth& depth, const Textu
     glFinish();
     fragmentSeconds = clock.lap();
     if (f) {
+      requireShadable(f->count, atlasTexels);
       fragments = f->count;
       return blendHair(scene, {f->words->id, f->first->id, f->tail->id, f->count}, image);
     }
@@ -536,9 +540,6 @@ ShadedImage shadingPass(const Scene& scene, const LightDepth& depth, const Textu
   std::optional<raster::Bands> readBack;
   if (!scene.cameraBands) readBack.emplace(raster::intoBands(scene.cameraOnDevice->read()));
   const raster::Bands& bands = scene.cameraBands ? *scene.cameraBands : *readBack;
-  // No more than blendHair's atlas holds (rows of atlasWidth texels, at most the largest texture's).
-  const int maxSize = maxTextureSize();
-  const uint64_t atlasTexels = uint64_t(std::min(kAtlasWidth, maxSize)) * uint64_t(maxSize);
   const CameraFragments f =
       cameraFragments(bands, scene.kept, headDepth.empty() ? nullptr : headDepth.data(), atlasTexels);
   headDepth = {};
