@@ -16,8 +16,6 @@
 #include "libcore/render/compute_raster.h"
 #include "libcore/render/gl_context.h"
 #include "libcore/render/light_maps.h"
-#include "stages/grow.h"
-#include "stages/interpolate.h"
 #include "stages/render.h"
 #include "tests/test_util.h"
 
@@ -188,10 +186,7 @@ TEST(ComputeRaster, SumsPastAWordSaturateAsTheCpusDo) {
 TEST(ComputeRaster, ARenderIsTheSameBitsWhereverTheRasteriserRuns) {
   SKIP_WITHOUT_COMPUTE_RASTER();
   test::Job job = test::loadJob("thesis/coupe3/setup.txt", SetupUse::kRender);
-  Hairstyle h = job.config.hairstyle;
-  h.hairDensity = 20;
-  const Strands coupe =
-      interpolate(job.wick, grow(job.wick, h, job.config.collision, {}).guides, h, job.config.collision, {});
+  const Strands coupe = test::coupeOf(job, 20);
   const Mesh head = readObj(job.config.setup.headModel.path);
   RenderSettings r = job.config.render;
   r.resolution = {320, 240};

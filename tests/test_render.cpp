@@ -1020,10 +1020,7 @@ TEST(Render, HairReadInPlaceGivesTheImageOfACopy) {
 // shadows' edges: under a tenth of the hair's pixels differ by more than 0.1.
 TEST(Render, TheRasterisersLightMapsAreOpenGlsLines) {
   test::Job job = test::loadJob("thesis/coupe3/setup.txt", SetupUse::kRender);
-  Hairstyle h = job.config.hairstyle;
-  h.hairDensity = 20;
-  const Strands coupe =
-      interpolate(job.wick, grow(job.wick, h, job.config.collision, {}).guides, h, job.config.collision, {});
+  const Strands coupe = test::coupeOf(job, 20);
   const Mesh head = readObj(job.config.setup.headModel.path);
   RenderSettings r = job.config.render;
   r.resolution = {320, 240};

@@ -14,6 +14,8 @@
 #include "libcore/io/obj_io.h"
 #include "libcore/model/strands.h"
 #include "libcore/physics/head_motion.h"
+#include "stages/grow.h"
+#include "stages/interpolate.h"
 
 namespace hairgen::test {
 
@@ -32,6 +34,14 @@ inline Job loadJob(const std::string& setup, SetupUse use = SetupUse::kGrow) {
   Job job{loadConfig(sourceDir() / "configs" / setup, {}, use), {}};
   job.wick = readObj(job.config.setup.wickModel.path);
   return job;
+}
+
+// The job's coupe grown from its wick and interpolated at `density` strands a cm².
+inline Strands coupeOf(const Job& job, int density) {
+  Hairstyle h = job.config.hairstyle;
+  h.hairDensity = density;
+  return interpolate(job.wick, grow(job.wick, h, job.config.collision, {}).guides, h, job.config.collision,
+                     {});
 }
 
 inline std::filesystem::path realData() {

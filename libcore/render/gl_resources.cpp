@@ -93,47 +93,53 @@ struct LinkedProgram {
 
 }  // namespace
 
-Program::Program(const StageSource& vertex, const StageSource& fragment, const char* name) {
+namespace {
+
+// A program linked by `link()` once per context: kept there under `key`, the text of its stages, which
+// is all a program is made from (a custom stage's file and Setup line only name it in errors, and an
+// error keeps nothing). With no GlContext current, linked for the caller alone (`owned`).
+template <class Link>
+GLuint linkedOnce(const std::string& key, Link&& link, bool& owned) {
   GlContext* gl = GlContext::current();
   if (!gl) {
-    id = link(vertex, fragment, name);
-    owned_ = true;
-    return;
+    owned = true;
+    return link();
   }
-  // The same GLSL links to the same program: keyed by both stages' text, which is all a program is
-  // made from (a custom stage's file and Setup line only name it in errors, and an error keeps nothing).
-  id = gl->kept<LinkedProgram>(vertex.text + '\0' + fragment.text, [&] {
-           auto linked = std::make_unique<LinkedProgram>();
-           linked->id = link(vertex, fragment, name);
-           return linked;
-         }).id;
+  return gl
+      ->kept<LinkedProgram>(key,
+                            [&] {
+                              auto linked = std::make_unique<LinkedProgram>();
+                              linked->id = link();
+                              return linked;
+                            })
+      .id;
+}
+
+}  // namespace
+
+// (In the body: owned_ is initialised after id.)
+Program::Program(const StageSource& vertex, const StageSource& fragment, const char* name) {
+  id = linkedOnce(
+      vertex.text + '\0' + fragment.text, [&] { return link(vertex, fragment, name); }, owned_);
 }
 
 Program::Program(const StageSource& compute, const char* name) {
-  auto linkCompute = [&] {
-    const GLuint c = compileStage(GL_COMPUTE_SHADER, compute, name);
-    const GLuint linked = glCreateProgram();
-    glAttachShader(linked, c);
-    glLinkProgram(linked);
-    glDeleteShader(c);
-    GLint ok = 0;
-    glGetProgramiv(linked, GL_LINK_STATUS, &ok);
-    if (ok) return linked;
-    const CompilerMessage error = firstCompilerError(infoLog(linked, true));
-    glDeleteProgram(linked);
-    renderFailure(std::string("linking the ") + name + " program: " + error.text);
-  };
-  GlContext* gl = GlContext::current();
-  if (!gl) {
-    id = linkCompute();
-    owned_ = true;
-    return;
-  }
-  id = gl->kept<LinkedProgram>(std::string("compute") + '\0' + compute.text, [&] {
-           auto linked = std::make_unique<LinkedProgram>();
-           linked->id = linkCompute();
-           return linked;
-         }).id;
+  id = linkedOnce(
+      std::string("compute") + '\0' + compute.text, [&] { return linkCompute(compute, name); }, owned_);
+}
+
+GLuint Program::linkCompute(const StageSource& compute, const char* name) {
+  const GLuint c = compileStage(GL_COMPUTE_SHADER, compute, name);
+  const GLuint linked = glCreateProgram();
+  glAttachShader(linked, c);
+  glLinkProgram(linked);
+  glDeleteShader(c);
+  GLint ok = 0;
+  glGetProgramiv(linked, GL_LINK_STATUS, &ok);
+  if (ok) return linked;
+  const CompilerMessage error = firstCompilerError(infoLog(linked, true));
+  glDeleteProgram(linked);
+  renderFailure(std::string("linking the ") + name + " program: " + error.text);
 }
 
 GLuint Program::link(const StageSource& vertex, const StageSource& fragment, const char* name) {

@@ -66,6 +66,7 @@ class Program {
 
  private:
   static GLuint link(const StageSource& vertex, const StageSource& fragment, const char* name);
+  static GLuint linkCompute(const StageSource& compute, const char* name);
   bool owned_ = false;  // deleted with this Program (no GlContext to keep it)
 };
 
