@@ -470,8 +470,8 @@ ShadedImage blendHair(const Scene& scene, const FragmentBuffers& f, const Shaded
 
 }  // namespace
 
-ShadedImage shadingPass(const Scene& scene, const LightDepth& depth, const Texture& opacity,
-                        size_t& fragments, double& fragmentSeconds) {
+ShadedImage shadingPass(Scene& scene, const LightDepth& depth, const Texture& opacity, size_t& fragments,
+                        double& fragmentSeconds) {
   const RenderSettings& r = scene.settings;
   const int w = scene.subpixel.width, h = scene.subpixel.height;
   ShadedImage image{Texture(GL_RGBA16F, w, h), Texture(GL_RGBA32F, w, h), false};
@@ -543,6 +543,8 @@ ShadedImage shadingPass(const Scene& scene, const LightDepth& depth, const Textu
   const CameraFragments f =
       cameraFragments(bands, scene.kept, headDepth.empty() ? nullptr : headDepth.data(), atlasTexels);
   headDepth = {};
+  readBack.reset();
+  scene.releaseCameraBands();
   fragments = f.count();
   fragmentSeconds += clock.lap();
   // Read in place where the hair is: the fragments outlive these buffers, whose deletion waits for

@@ -86,7 +86,8 @@ struct Scene {
 
   // Frees the geometry once the passes that draw it are done, so what follows (the readback, the
   // images' writing) does not run with the coupe still held: the light's maps after their upload, the
-  // camera's bands after the shading pass, all of it after the last pass.
+  // camera's bands once the shading pass has their fragments (before it shades them), all of it after
+  // the last pass.
   void releaseLightMaps();
   void releaseCameraBands();
   void releaseGeometry();
@@ -111,9 +112,10 @@ LightDepth lightDepthPass(const Scene& scene);
 // RGBA32F, one layer per channel, the light's map size.
 Texture deepOpacityPass(const Scene& scene, LightDepth& depth);
 // At sub-pixel resolution; `fragments`: how many hair fragments the rasteriser kept (0 when OpenGL drew
-// the hair), `fragmentSeconds` the time it took to find them (the device's work waited for).
-ShadedImage shadingPass(const Scene& scene, const LightDepth& depth, const Texture& opacity,
-                        size_t& fragments, double& fragmentSeconds);
+// the hair), `fragmentSeconds` the time it took to find them (the device's work waited for). Releases
+// the camera's bands once their fragments are made.
+ShadedImage shadingPass(Scene& scene, const LightDepth& depth, const Texture& opacity, size_t& fragments,
+                        double& fragmentSeconds);
 // At the image's resolution.
 ShadedImage resolvePass(const Scene& scene, const ShadedImage& subpixels);
 // At sub-pixel resolution, RGBA32F: motion u, v (pixels of the image), 1 where something was drawn.
