@@ -44,6 +44,10 @@ inline constexpr uint32_t kCoverageOne = 1u << 16;
 namespace raster {
 
 inline constexpr int kBandRows = 32;  // rows a thread draws at once
+// How many segments ahead a band's drawing asks for the vertices it will read: a band's segments are a
+// sparse subset of the points (a thirtieth at 1080p), so each segment's vertices would otherwise be a
+// cache miss the prefetcher cannot foresee (15% of the camera's fragments' time).
+inline constexpr size_t kPrefetch = 16;
 
 // A share's product needs 76 bits: GCC's and Clang's 128-bit integer (one multiply on x86-64).
 __extension__ using Uint128 = unsigned __int128;
@@ -252,7 +256,13 @@ struct Bands {
   template <Across across, class F>
   void eachFragment(int band, F&& fragment) const {
     const int64_t rowLo = int64_t(band) * kBandRows, rowHi = std::min<int64_t>(height, rowLo + kBandRows);
-    for (size_t k = bandFirst[size_t(band)]; k < bandFirst[size_t(band) + 1]; ++k) {
+    const size_t end = bandFirst[size_t(band) + 1];
+    for (size_t k = bandFirst[size_t(band)]; k < end; ++k) {
+      if (k + kPrefetch < end) {
+        const Vertex* ahead = &vertices[bandSegments[k + kPrefetch]];
+        __builtin_prefetch(ahead);
+        __builtin_prefetch(ahead + 1);  // in the next cache line one time in four
+      }
       const uint32_t point = bandSegments[k];
       rasteriseSegment<across>(vertices[point], vertices[point + 1], rowLo, rowHi,
                                [&](int64_t i, int64_t j, int32_t depth, uint32_t coverage, Piece piece) {
