@@ -10,6 +10,7 @@
 
 #include "libcore/render/hair_raster.h"
 #include "libcore/util/error.h"
+#include "libcore/util/uninitialised.h"
 
 namespace hairgen {
 
@@ -96,8 +97,9 @@ CameraFragments cameraFragments(const raster::Bands& bands, int kept, const floa
   out.width = bands.width;
   out.height = bands.height;
   out.tail.assign(pixels, 0);
-  std::vector<uint32_t> counts(pixels, 0);
-  std::vector<std::vector<uint32_t>> bandWords(size_t(bands.count));
+  // Each pixel's count of kept fragments, then (summed in order) its first fragment.
+  out.first.resize(pixels + 1);
+  std::vector<std::vector<uint32_t, UninitialisedAllocator<uint32_t>>> bandWords(size_t(bands.count));
   // A band's pixels' slots, one set a thread, reused from band to band (a band's are ~14 MB at 1920
   // pixels a row: allocated for each band, their pages were cleared again each time).
   struct BandSlots {
@@ -120,33 +122,36 @@ CameraFragments cameraFragments(const raster::Bands& bands, int kept, const floa
       const size_t local = texel - base;
       keep(&slots[local * size_t(kept)], used[local], out.tail[texel], kept, depth, coverage, point, piece);
     });
-    std::vector<uint32_t>& words = bandWords[size_t(band)];
+    auto& words = bandWords[size_t(band)];
     size_t count = 0;
     for (const uint8_t n : used) count += n;
     requireShadable(keptSoFar.fetch_add(count) + count, limit);
-    words.reserve(3 * count);
+    words.resize(3 * count);
+    uint32_t* word = words.data();
     for (size_t p = 0; p < end - base; ++p) {
-      counts[base + p] = used[p];
-      for (int k = 0; k < used[p]; ++k) {
+      out.first[base + p] = used[p];
+      for (int k = 0; k < used[p]; ++k, word += 3) {
         const Slot& s = slots[p * size_t(kept) + size_t(k)];
-        words.insert(words.end(), {s.point, std::bit_cast<uint32_t>(metresOf(s.depth)),
-                                   std::min(s.coverage, kCoverageOne) | (s.span << kCoverageBits)});
+        word[0] = s.point;
+        word[1] = std::bit_cast<uint32_t>(metresOf(s.depth));
+        word[2] = std::min(s.coverage, kCoverageOne) | (s.span << kCoverageBits);
       }
     }
   });
-  out.first.resize(pixels + 1);
   uint32_t total = 0;  // at most `limit`
   for (size_t p = 0; p < pixels; ++p) {
+    const uint32_t n = out.first[p];
     out.first[p] = total;
-    total += counts[p];
+    total += n;
   }
   out.first[pixels] = total;
-  out.words.resize(size_t(total) * 3);
-  tbb::parallel_for(0, bands.count, [&](int band) {
-    const std::vector<uint32_t>& words = bandWords[size_t(band)];
-    const size_t at = 3 * size_t(out.first[size_t(band) * raster::kBandRows * width]);
-    std::copy(words.begin(), words.end(), out.words.begin() + ptrdiff_t(at));
-  });
+  // Each band's words after the last's, its own freed as soon as they are: the pages of `words` are the
+  // process's only as they are written, so the two copies are not held whole at once.
+  out.words.reserve(size_t(total) * 3);
+  for (auto& words : bandWords) {
+    out.words.insert(out.words.end(), words.begin(), words.end());
+    words = {};
+  }
   return out;
 }
 
