@@ -1,13 +1,17 @@
 #include "libcore/render/hair_raster.h"
 
+#include <algorithm>
+
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
+
+#include "libcore/util/huge_pages.h"
 
 namespace hairgen::raster {
 
 namespace {
 
-constexpr size_t kBinChunk = size_t(1) << 14;  // segments a thread sorts into bands at once
+constexpr size_t kBinChunk = size_t(1) << 14;  // points, or segments, a thread handles at once
 // A point this many image widths off the image is dropped with its segments: what it could reach of
 // the image is a ribbon the view's field already holds whole (it is made to hold the scene's sphere).
 constexpr int64_t kFarOff = 4;
@@ -18,8 +22,10 @@ constexpr double kWidest = 4096.0;
 
 }  // namespace
 
-Projection project(const Strands& hair, const View& v, double strandWidth) {
+Projection project(const Strands& hair, const View& v, double strandWidth, Bands reuse) {
   Projection out;
+  out.vertices = std::move(reuse.vertices);
+  out.segments = std::move(reuse.bandSegments);
   out.width = v.width;
   out.height = v.height;
   // Every point projected as the view places it, then quantised: from here on, integers.
@@ -28,7 +34,7 @@ Projection project(const Strands& hair, const View& v, double strandWidth) {
   const double halfX = 0.5 * v.width, halfY = 0.5 * v.height;
   const double farOff = double(kFarOff * std::max(v.width, v.height));
   std::vector<Vertex>& vertices = out.vertices;
-  vertices.resize(hair.points.size());
+  resizeLarge(vertices, hair.points.size());
   tbb::parallel_for(tbb::blocked_range<size_t>(0, hair.points.size(), 1 << 14),
                     [&](const tbb::blocked_range<size_t>& r) {
                       for (size_t i = r.begin(); i < r.end(); ++i) {
@@ -47,17 +53,38 @@ Projection project(const Strands& hair, const View& v, double strandWidth) {
                              int32_t(std::lround(std::min(width, kWidest) * kWidthUnit))};
                       }
                     });
-  // The segments: each pair of consecutive points of a strand, both drawn; by their first point.
+  // The segments: each pair of consecutive points of a strand, both drawn; by their first point. Found
+  // chunk by chunk of points on every thread, counted first, then each chunk's written in its place.
+  const std::vector<uint32_t>& firstPoint = hair.firstPoint;
+  const size_t points = firstPoint.size() < 2 ? 0 : size_t(firstPoint.back());
+  const size_t chunks = (points + kBinChunk - 1) / kBinChunk;
+  auto eachSegment = [&](size_t c, auto&& segment) {
+    const size_t lo = c * kBinChunk, hi = std::min(points, lo + kBinChunk);
+    // The end of the strand holding point lo, then of each strand the points pass into.
+    size_t end =
+        size_t(std::upper_bound(firstPoint.begin(), firstPoint.end(), uint32_t(lo)) - firstPoint.begin());
+    for (size_t i = lo; i < hi; ++i) {
+      while (firstPoint[end] <= i) ++end;
+      if (i + 1 < firstPoint[end] && vertices[i].depth >= 0 && vertices[i + 1].depth >= 0)
+        segment(uint32_t(i));
+    }
+  };
+  std::vector<size_t> chunkFirst(chunks + 1, 0);
+  tbb::parallel_for(size_t(0), chunks,
+                    [&](size_t c) { eachSegment(c, [&](uint32_t) { ++chunkFirst[c + 1]; }); });
+  for (size_t c = 0; c < chunks; ++c) chunkFirst[c + 1] += chunkFirst[c];
   std::vector<uint32_t>& segments = out.segments;
-  segments.reserve(hair.points.size());
-  for (size_t s = 0; s + 1 < hair.firstPoint.size(); ++s)
-    for (uint32_t i = hair.firstPoint[s]; i + 1 < hair.firstPoint[s + 1]; ++i)
-      if (vertices[i].depth >= 0 && vertices[i + 1].depth >= 0) segments.push_back(i);
+  segments.clear();  // what `reuse` held is not copied when the storage grows
+  resizeLarge(segments, chunkFirst[chunks]);
+  tbb::parallel_for(size_t(0), chunks, [&](size_t c) {
+    size_t at = chunkFirst[c];
+    eachSegment(c, [&](uint32_t i) { segments[at++] = i; });
+  });
   return out;
 }
 
-Bands projectIntoBands(const Strands& hair, const View& v, double strandWidth) {
-  return intoBands(project(hair, v, strandWidth));
+Bands projectIntoBands(const Strands& hair, const View& v, double strandWidth, Bands reuse) {
+  return intoBands(project(hair, v, strandWidth, std::move(reuse)));
 }
 
 Bands intoBands(Projection&& p) {
@@ -103,7 +130,7 @@ Bands intoBands(Projection&& p) {
     }
   }
   out.bandFirst[size_t(bands)] = total;
-  out.bandSegments.resize(total);
+  resizeLarge(out.bandSegments, total);
   tbb::parallel_for(size_t(0), chunks, [&](size_t c) {
     for (size_t s = c * kBinChunk; s < std::min(segments.size(), (c + 1) * kBinChunk); ++s) {
       int lo, hi;

@@ -275,14 +275,16 @@ struct Bands {
 };
 
 // Projects the hair with `v` (its width × height texels). `strandWidth`: the strands' diameter, metres.
-// A segment with a point nearer than the near plane, or far off the image, is dropped.
-Projection project(const Strands& hair, const View& v, double strandWidth);
+// A segment with a point nearer than the near plane, or far off the image, is dropped. `reuse`: bands no
+// longer needed (another view's of the same hair), whose storage is reused: its pages are already the
+// process's, not faulted in and cleared by the kernel again.
+Projection project(const Strands& hair, const View& v, double strandWidth, Bands reuse = {});
 
 // The projection's segments sorted into bands (its vertices move into them).
 Bands intoBands(Projection&& p);
 
 // project(), then intoBands().
-Bands projectIntoBands(const Strands& hair, const View& v, double strandWidth);
+Bands projectIntoBands(const Strands& hair, const View& v, double strandWidth, Bands reuse = {});
 
 }  // namespace raster
 

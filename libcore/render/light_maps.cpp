@@ -30,9 +30,9 @@ std::vector<glm::vec4> HairLightMaps::opacity(double strandOpacity) const {
 }
 
 HairLightMaps rasteriseLightMaps(const Strands& hair, const View& light, double strandWidth,
-                                 const glm::dvec4& layerSizes) {
+                                 const glm::dvec4& layerSizes, raster::Bands* spent) {
   const int size = light.width;
-  const raster::Bands bands = raster::projectIntoBands(hair, light, strandWidth);
+  raster::Bands bands = raster::projectIntoBands(hair, light, strandWidth);
   HairLightMaps maps;
   maps.size = size;
   maps.start.assign(size_t(size) * size, kNoHair);
@@ -67,6 +67,7 @@ HairLightMaps rasteriseLightMaps(const Strands& hair, const View& light, double 
       raster::addSaturating(sum[3], f.coverage);
     }
   });
+  if (spent) *spent = std::move(bands);
   return maps;
 }
 

@@ -33,8 +33,9 @@ struct HairLightMaps {
 
 // `light`: a square perspective view (its width texels per side). `strandWidth`: the strands' diameter,
 // metres. `layerSizes`: the four layers' depths, metres. A segment with a point nearer than the near
-// plane is dropped.
+// plane is dropped. `spent`: null, or where the light's bands are left once drawn, for the next
+// projection to reuse (hair_raster.h: project).
 HairLightMaps rasteriseLightMaps(const Strands& hair, const View& light, double strandWidth,
-                                 const glm::dvec4& layerSizes);
+                                 const glm::dvec4& layerSizes, raster::Bands* spent = nullptr);
 
 }  // namespace hairgen

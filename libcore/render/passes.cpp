@@ -224,18 +224,20 @@ struct Scene::Preparation {
       return software && !withinLoopBudget(p) ? nullptr : std::make_unique<raster::Projection>(std::move(p));
     };
     // One after the other, each on every thread. For the CPU the light's projection is freed (into its
-    // maps) before the camera's is made; for the device both are held until the Scene uploads them.
+    // maps) before the camera's is made, in its storage; for the device both are held until the Scene
+    // uploads them.
     work.run([=, this, &hair, &lightView, &subpixelView, &r] {
+      raster::Bands spent;
       if (lightByRasteriser && onDevice)
         lightProjection = forDevice(raster::project(hair, lightView, r.strandWidth));
       if (lightByRasteriser && !lightProjection)
-        lightMaps =
-            std::make_unique<HairLightMaps>(rasteriseLightMaps(hair, lightView, r.strandWidth, r.layerSizes));
+        lightMaps = std::make_unique<HairLightMaps>(
+            rasteriseLightMaps(hair, lightView, r.strandWidth, r.layerSizes, &spent));
       if (cameraByRasteriser && onDevice)
-        cameraProjection = forDevice(raster::project(hair, subpixelView, r.strandWidth));
+        cameraProjection = forDevice(raster::project(hair, subpixelView, r.strandWidth, std::move(spent)));
       if (cameraByRasteriser && !cameraProjection)
-        cameraBands =
-            std::make_unique<raster::Bands>(raster::projectIntoBands(hair, subpixelView, r.strandWidth));
+        cameraBands = std::make_unique<raster::Bands>(
+            raster::projectIntoBands(hair, subpixelView, r.strandWidth, std::move(spent)));
     });
     work.run([=, this, &hair] {
       if (ordered) order = frontToBack(hair, view);
