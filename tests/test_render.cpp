@@ -368,6 +368,34 @@ TEST(CameraFragments, APixelKeepsItsNearestFragmentsInDepthOrderAndTheRestInItsT
   }
 }
 
+// What hides the hair hides it pixel by pixel, though the rasteriser skips a segment whose nearest point
+// is as deep as the deepest of the head near it: a strand at 2 m over a head at 1 m, but for one pixel
+// and a stretch on the right at 10 m, keeps fragments in those pixels only, at their full coverage, and
+// nothing in any tail.
+TEST(CameraFragments, TheHeadHidesTheHairInExactlyThePixelsWhereItIsNearer) {
+  std::vector<glm::vec3> points;
+  for (int i = 0; i <= 30; ++i) points.push_back({2.0f + 2.0f * float(i), 20.5f, -2.0f});
+  Strands s;
+  s.addStrand(points);
+  std::vector<float> head(64 * 64, 1.0f);
+  auto at = [](int x, int y) { return size_t(y) * 64 + size_t(x); };
+  for (int y = 0; y < 64; ++y) {
+    head[at(40, y)] = 10.0f;
+    for (int x = 50; x < 64; ++x) head[at(x, y)] = 10.0f;
+  }
+  const CameraFragments f = rasteriseCameraFragments(s, texelView(64), 0.5, kKeptFragments, head.data());
+  for (int y = 0; y < 64; ++y)
+    for (int x = 0; x < 64; ++x) {
+      const size_t p = at(x, y);
+      EXPECT_EQ(f.tail[p], 0u) << x << ", " << y;
+      const bool seen = y == 20 && x >= 2 && x < 62 && (x == 40 || x >= 50);
+      ASSERT_EQ(f.first[p + 1] - f.first[p], seen ? 1u : 0u) << x << ", " << y;
+      if (seen) {
+        EXPECT_NEAR(pixelCoverage(f, p), 0.25, 1e-3) << x;  // 0.5 m wide at 2 m: a quarter texel
+      }
+    }
+}
+
 // Many strands crossing in every direction: the same fragments on one thread as on all, and again.
 TEST(CameraFragments, TheFragmentsAreTheSameBitsOnOneThreadAsOnAll) {
   const Strands s = crossingEveryWay();

@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <atomic>
 #include <bit>
+#include <cmath>
+#include <limits>
 #include <string>
 
 #include <tbb/enumerable_thread_specific.h>
@@ -74,6 +76,51 @@ void keep(Slot* list, uint8_t& n, uint32_t& tail, int kept, int32_t depth, uint3
   list[j].span = spanOf(piece);
 }
 
+// What hides the hair, by tiles of kTile × kTile pixels: a segment all of whose fragments are as deep
+// as the deepest opaque depth over the pixels it can reach has no fragment keep() would get (each
+// fragment's depth lies between its segment's points' depths, and metresOf keeps the order), so it is
+// not drawn. The head hides the back of the hair: a third of the camera's fragments.
+class Hidden {
+ public:
+  Hidden(const float* opaque, int width, int height)
+      : columns_((width + kTile - 1) / kTile),
+        rows_((height + kTile - 1) / kTile),
+        width_(width),
+        height_(height) {
+    if (!opaque) return;
+    deepest_.assign(size_t(columns_) * size_t(rows_), -std::numeric_limits<float>::infinity());
+    tbb::parallel_for(0, rows_, [&](int ty) {
+      for (int y = ty * kTile; y < std::min(height, (ty + 1) * kTile); ++y)
+        for (int x = 0; x < width; ++x) {
+          const float d = opaque[size_t(y) * size_t(width) + size_t(x)];
+          float& m = deepest_[size_t(ty) * size_t(columns_) + size_t(x / kTile)];
+          m = std::isnan(d) ? std::numeric_limits<float>::infinity() : std::max(m, d);
+        }
+    });
+  }
+  bool behind(const raster::Vertex& a, const raster::Vertex& b) const {
+    if (deepest_.empty()) return false;
+    const float nearest = metresOf(std::min(a.depth, b.depth));
+    const int64_t reach = raster::segmentReach(a, b);
+    auto tiles = [&](int64_t lo, int64_t hi, int pixels, int& first, int& last) {
+      first = int(std::max<int64_t>(0, raster::floorDiv(lo - reach, kSubTexel))) / kTile;
+      last = int(std::min<int64_t>(pixels - 1, raster::floorDiv(hi + reach, kSubTexel))) / kTile;
+    };
+    int x0, x1, y0, y1;
+    tiles(std::min(a.x, b.x), std::max(a.x, b.x), width_, x0, x1);
+    tiles(std::min(a.y, b.y), std::max(a.y, b.y), height_, y0, y1);
+    for (int ty = y0; ty <= y1; ++ty)
+      for (int tx = x0; tx <= x1; ++tx)
+        if (!(nearest >= deepest_[size_t(ty) * size_t(columns_) + size_t(tx)])) return false;
+    return true;  // also where it reaches no pixel: it has no fragment
+  }
+
+ private:
+  static constexpr int kTile = 8;  // pixels a side
+  int columns_, rows_, width_, height_;
+  std::vector<float> deepest_;  // per tile, the largest opaque depth (+∞ for a NaN), metres
+};
+
 }  // namespace
 
 CameraFragments rasteriseCameraFragments(const Strands& hair, const View& camera, double strandWidth,
@@ -107,6 +154,7 @@ CameraFragments cameraFragments(const raster::Bands& bands, int kept, const floa
     std::vector<uint8_t> used;
   };
   tbb::enumerable_thread_specific<BandSlots> perThread;
+  const Hidden hidden(opaque, bands.width, bands.height);
   tbb::parallel_for(0, bands.count, [&](int band) {
     const size_t base = size_t(band) * raster::kBandRows * width;
     const size_t end = std::min(pixels, base + raster::kBandRows * width);
@@ -115,13 +163,16 @@ CameraFragments cameraFragments(const raster::Bands& bands, int kept, const floa
     mine.used.assign(end - base, 0);
     std::vector<Slot>& slots = mine.slots;
     std::vector<uint8_t>& used = mine.used;
-    bands.eachFragment<raster::Across::kBox>(band, [&](size_t texel, int32_t depth, uint32_t coverage,
-                                                       uint32_t point, raster::Piece piece) {
-      // Compared as the blend compares them: the fragment's depth as the float it is stored as.
-      if (opaque && metresOf(depth) >= opaque[texel]) return;
-      const size_t local = texel - base;
-      keep(&slots[local * size_t(kept)], used[local], out.tail[texel], kept, depth, coverage, point, piece);
-    });
+    bands.eachFragment<raster::Across::kBox>(
+        band,
+        [&](size_t texel, int32_t depth, uint32_t coverage, uint32_t point, raster::Piece piece) {
+          // Compared as the blend compares them: the fragment's depth as the float it is stored as.
+          if (opaque && metresOf(depth) >= opaque[texel]) return;
+          const size_t local = texel - base;
+          keep(&slots[local * size_t(kept)], used[local], out.tail[texel], kept, depth, coverage, point,
+               piece);
+        },
+        [&](const raster::Vertex& a, const raster::Vertex& b) { return hidden.behind(a, b); });
     auto& words = bandWords[size_t(band)];
     size_t count = 0;
     for (const uint8_t n : used) count += n;

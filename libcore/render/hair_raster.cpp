@@ -100,8 +100,7 @@ Bands intoBands(Projection&& p) {
   auto bandsOf = [&](size_t s, int& lo, int& hi) {
     const Vertex &a = vertices[segments[s]], &b = vertices[segments[s] + 1];
     // A piece's cross-section reaches w·L/(2|du|) ≤ w/√2 across (¾·w here), a tent half a texel more.
-    const int64_t reach =
-        int64_t(std::max(a.width, b.width)) * 3 / (4 * (kWidthUnit / kSubTexel)) + 2 * kSubTexel;
+    const int64_t reach = segmentReach(a, b);
     const int64_t low = floorDiv(std::min(a.y, b.y) - reach, kSubTexel);
     const int64_t high = floorDiv(std::max(a.y, b.y) + reach, kSubTexel);
     lo = 1, hi = 0;

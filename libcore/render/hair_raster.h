@@ -236,6 +236,12 @@ void rasteriseSegment(Vertex a, Vertex b, int64_t rowLo, int64_t rowHi, F&& frag
   }
 }
 
+// A box, in 1/kSubTexel texel, holding every texel a segment a → b has a fragment in: its points' box
+// widened by the reach bandsOf uses for rows (hair_raster.cpp), at least half the ribbon's extent.
+inline int64_t segmentReach(const Vertex& a, const Vertex& b) {
+  return int64_t(std::max(a.width, b.width)) * 3 / (4 * (kWidthUnit / kSubTexel)) + 2 * kSubTexel;
+}
+
 // The hair as a view sees it, quantised: every point, and the segments drawn.
 struct Projection {
   int width = 0, height = 0;       // the image's texels
@@ -252,9 +258,14 @@ struct Bands {
 
   // Calls fragment(texel, depth, coverage, segment's first point, piece) for every fragment of every
   // segment of `band` that falls on the image within the band's rows, in the order of the segments;
-  // texel = row · width + column.
+  // texel = row · width + column. `unwanted(a, b)`: true for a segment a → b none of whose fragments
+  // the caller would keep (it is not drawn: what the caller gets does not change).
   template <Across across, class F>
   void eachFragment(int band, F&& fragment) const {
+    eachFragment<across>(band, fragment, [](const Vertex&, const Vertex&) { return false; });
+  }
+  template <Across across, class F, class U>
+  void eachFragment(int band, F&& fragment, U&& unwanted) const {
     const int64_t rowLo = int64_t(band) * kBandRows, rowHi = std::min<int64_t>(height, rowLo + kBandRows);
     const size_t end = bandFirst[size_t(band) + 1];
     for (size_t k = bandFirst[size_t(band)]; k < end; ++k) {
@@ -264,6 +275,7 @@ struct Bands {
         __builtin_prefetch(ahead + 1);  // in the next cache line one time in four
       }
       const uint32_t point = bandSegments[k];
+      if (unwanted(vertices[point], vertices[point + 1])) continue;
       rasteriseSegment<across>(vertices[point], vertices[point + 1], rowLo, rowHi,
                                [&](int64_t i, int64_t j, int32_t depth, uint32_t coverage, Piece piece) {
                                  if (coverage == 0 || j < rowLo || j >= rowHi || i < 0 || i >= width) return;
