@@ -524,6 +524,7 @@ ShadedImage shadingPass(Scene& scene, const LightDepth& depth, const Texture& op
     fragmentSeconds = clock.lap();
     if (f) {
       requireShadable(f->count, atlasTexels);
+      scene.releaseCameraBands();  // the projection on the device, before the atlas is made
       fragments = f->count;
       return blendHair(scene, {f->words->id, f->first->id, f->tail->id, f->count}, image);
     }
