@@ -191,8 +191,9 @@ struct Scene::Preparation {
   bool cameraChords = false;
   std::unique_ptr<HairLightMaps> lightMaps;    // when hairgen's rasteriser draws them
   std::unique_ptr<raster::Bands> cameraBands;  // when it draws the camera's hair
-  // The same projected for the device, when the rasteriser runs there (Scene::onDevice).
-  std::unique_ptr<raster::Projection> lightProjection, cameraProjection;
+  // The light's projected for the device, when the rasteriser runs there (Scene::onDevice).
+  std::unique_ptr<raster::Projection> lightProjection;
+  bool software = false;  // the device rasterises in software: withinLoopBudget applies
   tbb::task_group work;
 
   Preparation(const Scene& scene, const RenderInput& in) {
@@ -217,15 +218,16 @@ struct Scene::Preparation {
     const RenderSettings& r = in.settings;
     const View& subpixelView = scene.subpixel;
     const bool cameraByRasteriser = scene.rasterised;
-    const bool onDevice = scene.onDevice, software = onDevice && softwareRasteriser();
+    const bool onDevice = scene.onDevice;
+    software = onDevice && softwareRasteriser();
     // On a software rasteriser a projection the device cannot draw within its loop budget
     // (compute_raster.h: withinLoopBudget) is drawn on the CPU.
-    auto forDevice = [software](raster::Projection&& p) {
+    auto forDevice = [software = software](raster::Projection&& p) {
       return software && !withinLoopBudget(p) ? nullptr : std::make_unique<raster::Projection>(std::move(p));
     };
     // One after the other, each on every thread. For the CPU the light's projection is freed (into its
-    // maps) before the camera's is made, in its storage; for the device both are held until the Scene
-    // uploads them.
+    // maps) before the camera's is made, in its storage. For the device the camera's is made by the
+    // Scene once the light's is uploaded and let go (Scene::Scene), so one projection is held at a time.
     work.run([=, this, &hair, &lightView, &subpixelView, &r] {
       raster::Bands spent;
       if (lightByRasteriser && onDevice)
@@ -233,9 +235,7 @@ struct Scene::Preparation {
       if (lightByRasteriser && !lightProjection)
         lightMaps = std::make_unique<HairLightMaps>(
             rasteriseLightMaps(hair, lightView, r.strandWidth, r.layerSizes, &spent));
-      if (cameraByRasteriser && onDevice)
-        cameraProjection = forDevice(raster::project(hair, subpixelView, r.strandWidth, std::move(spent)));
-      if (cameraByRasteriser && !cameraProjection)
+      if (cameraByRasteriser && !onDevice)
         cameraBands = std::make_unique<raster::Bands>(
             raster::projectIntoBands(hair, subpixelView, r.strandWidth, std::move(spent)));
     });
@@ -285,10 +285,18 @@ Scene::Scene(const RenderInput& in)
   if (!preparing->order.empty()) hair.drawInOrder(*in.hair, preparing->order);
   lightMaps = std::move(preparing->lightMaps);
   cameraBands = std::move(preparing->cameraBands);
-  if (preparing->lightProjection)
+  if (preparing->lightProjection) {
     lightOnDevice = std::make_unique<DeviceProjection>(*preparing->lightProjection);
-  if (preparing->cameraProjection)
-    cameraOnDevice = std::make_unique<DeviceProjection>(*preparing->cameraProjection);
+    preparing->lightProjection.reset();
+  }
+  if (rasterised && onDevice) {
+    // On a software rasteriser a projection past its loop budget is drawn on the CPU.
+    raster::Projection p = raster::project(*in.hair, subpixel, in.settings.strandWidth);
+    if (preparing->software && !withinLoopBudget(p))
+      cameraBands = std::make_unique<raster::Bands>(raster::intoBands(std::move(p)));
+    else
+      cameraOnDevice = std::make_unique<DeviceProjection>(p);
+  }
   if (preparing->cameraChords)
     cameraLines = std::make_unique<LineStrips>(preparing->camera, kCameraChunkVertices);
   preparing.reset();
