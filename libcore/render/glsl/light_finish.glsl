@@ -11,6 +11,13 @@ uniform int uSize;            // texels a side
 uniform float uBackground;    // metres
 uniform double uDepthUnit;    // kDepthUnit
 uniform double uOpacityScale;  // StrandOpacity / kCoverageOne
+// Layer k's sum, the largest where it passed a word (and written back so, for a caller reading them).
+uint saturatedLayer(uint t, int k) {
+  uint sum = (overflowData[t] & (1u << k)) != 0u ? 0xFFFFFFFFu : layerData[4u * t + uint(k)];
+  layerData[4u * t + uint(k)] = sum;
+  return sum;
+}
+
 void main() {
   uint t = (gl_WorkGroupID.y * gl_NumWorkGroups.x + gl_WorkGroupID.x) * gl_WorkGroupSize.x +
            gl_LocalInvocationID.x;
@@ -18,11 +25,8 @@ void main() {
   ivec2 at = ivec2(int(t) % uSize, int(t) / uSize);
   int start = startData[t];
   imageStore(uStartImage, at, vec4(start == 0x7FFFFFFF ? uBackground : float(double(start) * uDepthUnit)));
-  dvec4 sums;
-  for (int k = 0; k < 4; ++k) {
-    uint sum = (overflowData[t] & (1u << k)) != 0u ? 0xFFFFFFFFu : layerData[4u * t + uint(k)];
-    layerData[4u * t + uint(k)] = sum;
-    sums[k] = double(sum);
-  }
+  // Each layer by name: NVIDIA's compiler (580) fails to link a dvec4 written at a run-time index.
+  dvec4 sums = dvec4(double(saturatedLayer(t, 0)), double(saturatedLayer(t, 1)), double(saturatedLayer(t, 2)),
+                     double(saturatedLayer(t, 3)));
   imageStore(uOpacityImage, at, vec4(sums * uOpacityScale));
 }
