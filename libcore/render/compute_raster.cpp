@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <bit>
 #include <cmath>
-#include <cstring>
 #include <limits>
 #include <string>
 
@@ -74,16 +73,6 @@ bool fitsDevice(size_t bytes) {
 
 namespace {
 
-bool hasInt64() {
-  GLint n = 0;
-  glGetIntegerv(GL_NUM_EXTENSIONS, &n);
-  for (GLint i = 0; i < n; ++i)
-    if (std::strcmp(reinterpret_cast<const char*>(glGetStringi(GL_EXTENSIONS, GLuint(i))),
-                    "GL_ARB_gpu_shader_int64") == 0)
-      return true;
-  return false;
-}
-
 // Whether the device's floating point gives the CPU's bits where the passes use it (glsl/raster_probe.glsl):
 // GLSL leaves double arithmetic's rounding and a double sqrt's precision to the device, so they are
 // tried on depths and squares chosen to catch a device that rounds otherwise, before any pass relies
@@ -145,7 +134,7 @@ bool withinLoopBudget(const raster::Projection& p) {
 }
 
 bool computeRasterAvailable() {
-  if (!hasInt64()) return false;
+  if (!hasGlExtension("GL_ARB_gpu_shader_int64")) return false;
   GlContext* gl = GlContext::current();
   if (!gl) return floatingPointAgrees();
   return gl

@@ -262,15 +262,18 @@ bool softwareRasteriser() {
   return name.find("llvmpipe") != std::string::npos || name.find("softpipe") != std::string::npos;
 }
 
-bool contextReadsInPlace() {
-  if (!softwareRasteriser()) return false;
+bool hasGlExtension(const char* extension) {
   GLint count = 0;
   glGetIntegerv(GL_NUM_EXTENSIONS, &count);
   for (GLint i = 0; i < count; ++i) {
     const char* name = reinterpret_cast<const char*>(glGetStringi(GL_EXTENSIONS, static_cast<GLuint>(i)));
-    if (name && std::strcmp(name, "GL_AMD_pinned_memory") == 0) return true;
+    if (name && std::strcmp(name, extension) == 0) return true;
   }
   return false;
+}
+
+bool contextReadsInPlace() {
+  return softwareRasteriser() && hasGlExtension("GL_AMD_pinned_memory");
 }
 
 Buffer::Buffer(const void* data, size_t bytes, bool readInPlace) {

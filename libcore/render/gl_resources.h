@@ -99,6 +99,9 @@ struct Framebuffer {
 // Whether the current context rasterises in software (Mesa's llvmpipe or softpipe: its GL_RENDERER).
 bool softwareRasteriser();
 
+// Whether the current context has the OpenGL extension `extension` ("GL_ARB_gpu_shader_int64").
+bool hasGlExtension(const char* extension);
+
 // Whether the current context reads a large array in place, where it lies in the program's memory: a
 // software rasteriser with GL_AMD_pinned_memory (llvmpipe). Not a GPU, even one whose driver has the
 // extension (AMD's): it would read pinned host memory across the bus in every pass.

@@ -50,6 +50,7 @@ int lightMapSize(const RenderInput& in, const BoundingSphere& sphere, const View
 // buffers (the camera's fragments, which cannot be known before, fall back to the CPU themselves).
 bool rasteriseOnDevice(const RenderInput& in, int lightSize) {
   if (in.rasteriser == RenderInput::Rasteriser::kCpu) return false;
+  if (in.rasteriser == RenderInput::Rasteriser::kAuto && softwareRasteriser()) return false;  // no probe
   const bool can = computeRasterAvailable();
   const bool fits = fitsDevice(in.hair->points.size() * sizeof(raster::Vertex)) &&
                     fitsDevice(size_t(lightSize) * size_t(lightSize) * sizeof(glm::uvec4));
@@ -57,7 +58,7 @@ bool rasteriseOnDevice(const RenderInput& in, int lightSize) {
     renderFailure(can ? "the hair is too large for this device's storage buffers; use --rasteriser cpu"
                       : "this device cannot run hairgen's rasteriser (no GL_ARB_gpu_shader_int64); use "
                         "--rasteriser cpu");
-  return can && fits && (in.rasteriser == RenderInput::Rasteriser::kDevice || !softwareRasteriser());
+  return can && fits;
 }
 
 // Lines where every strand is at most a pixel and a half wide (at the scene's nearest point) and
@@ -318,10 +319,8 @@ void Scene::releaseCameraBands() {
 void Scene::releaseGeometry() {
   glBindVertexArray(0);
   hair.release();
-  lightMaps.reset();
-  cameraBands.reset();
-  lightOnDevice.reset();
-  cameraOnDevice.reset();
+  releaseLightMaps();
+  releaseCameraBands();
   cameraLines.reset();
   head.reset();
 }

@@ -62,7 +62,6 @@ RenderOutput renderHair(GlContext&, const RenderInput& in) {
   passDone();
   const ShadedImage image =
       resolvePass(scene, shadingPass(scene, depth, opacity, out.hairFragments, out.timings.fragments));
-  scene.releaseCameraBands();  // the device's projection (the CPU's bands are gone already)
   out.timings.shading = seconds(clock);
   passDone();
   std::optional<Texture> motion;

@@ -58,7 +58,7 @@ struct KeptFragments {
   int perPixel = kKeptFragments;  // in
   double fragments = 0.0;         // out
 };
-inline constexpr int kFootprintTile = 32;  // pixels a side: a band's rows (hair_raster.h's kBandRows)
+inline constexpr int kFootprintTile = raster::kBandRows;  // pixels a side: a band's rows
 double hairCoverage(const View& view, const Strands& hair, double strandWidth, double minWidthPx,
                     KeptFragments* kept = nullptr);
 
