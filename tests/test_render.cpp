@@ -894,6 +894,70 @@ TEST(Render, ABrokenCustomHairFragmentIsAnInputErrorAtItsFileAndLine) {
   }
 }
 
+// Where the rasteriser's fragments are shaded (the atlas), a HairFrag's inputs are globals hairgen sets:
+// its `in` declarations of them, however written, are blanked out, lines kept, and nothing else is.
+TEST(Render, TheAtlasTakesOutAHairFragsInputDeclarationsAndKeepsItsLines) {
+  const std::string body =
+      "layout(location = 0) in vec3 vWorld;\n"
+      "flat in\n"
+      "  float vAlpha;\n"
+      "in highp float vDepth ;\n"
+      "in vec3 vOther;\n"
+      "float f(in float x) { return x; }  // in vec3 vTangent; in a comment goes too\n"
+      "void main() {}\n";
+  const std::string text = assembleStage({.atlas = true}, body);
+  const std::string own = text.substr(text.rfind("#line 1\n") + 8);
+  EXPECT_EQ(std::count(own.begin(), own.end(), '\n'), std::count(body.begin(), body.end(), '\n')) << own;
+  for (const char* gone : {"in vec3 vWorld", "float vAlpha", "vDepth", "vTangent"})
+    EXPECT_EQ(own.find(gone), std::string::npos) << gone << " in:\n" << own;
+  for (const char* kept : {"in vec3 vOther;", "float f(in float x)", "void main() {}"})
+    EXPECT_NE(own.find(kept), std::string::npos) << kept << " not in:\n" << own;
+  EXPECT_NE(assembleStage({}, body).find(body), std::string::npos) << "only the atlas' stages change";
+}
+
+// The same through the renderer: a HairFrag that declares its inputs as a TD might write them shades the
+// rasteriser's fragments with them, and its compiler errors keep the file's line numbers.
+TEST(Render, AHairFragsInputsReachItWhateverItsDeclarationsLookLike) {
+  test::TempDir dir("hairfrag");
+  const std::string declarations =
+      "layout(location = 4) in\n"
+      "  float vAlpha;\n"
+      "smooth in float vDepth;\n"
+      "in vec3 vWorld;\n"
+      "layout(location = 0) out vec4 oColor;\n"
+      "layout(location = 1) out vec4 oData;\n"
+      "float opaque(in float a) { return a; }\n";
+  const CustomShaders shaders =
+      customHairFrag(dir, declarations +
+                              "void main() {\n"
+                              "  oColor = vec4(vWorld.x > 0.0 ? 1.0 : 0.5, 0.0, 0.0, "
+                              "opaque(vAlpha));\n"
+                              "  oData = vec4(vDepth, 1.0, 1.0, 0.0);\n"
+                              "}\n");
+  Strands s;
+  addStraight(s, {-0.04f, 0, 0}, {0.04f, 0, 0});
+  RenderSettings r = frontCamera(64, 1);
+  r.strandWidth = 0.012;
+  RenderOutput out = renderStrands(s, r, nullptr, Visuality{}, shaders);
+  int left = 0, right = 0;
+  for (int y = 0; y < 64; ++y)
+    for (int x = 0; x < 64; ++x) {
+      if (out.beauty.at(kChannelOpacity, x, y) < kCovered || x == 31 || x == 32) continue;
+      EXPECT_NEAR(out.beauty.at("R", x, y), x < 32 ? 0.5f : 1.0f, 1e-3f) << x << "," << y;
+      ++(x < 32 ? left : right);
+    }
+  EXPECT_GT(left, 20);
+  EXPECT_GT(right, 20);
+  const CustomShaders broken =
+      customHairFrag(dir, declarations + "void main() {\n  oColor = vec4(foo);\n}\n");
+  try {
+    renderStrands(s, r, nullptr, Visuality{}, broken);
+    FAIL() << "a HairFrag that does not compile rendered";
+  } catch (const InputError& e) {
+    EXPECT_EQ(e.where().line, 9) << e.what();
+  }
+}
+
 TEST(Render, CompilerLogsFoldToTheirFirstErrorAndItsLine) {
   CompilerMessage mesa = firstCompilerError(
       "0:3(10): warning: `x' unused\n0:12(5): error: `foo' undeclared\n0:13(2): error: syntax error\n");

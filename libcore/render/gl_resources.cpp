@@ -431,18 +431,6 @@ void drawInChunks(size_t chunks, Draw&& draw) {
 
 }  // namespace
 
-void drawPoints(size_t count) {
-  if (!softwareRasteriser()) {  // a GPU queues no binned scenes: one draw, no fences
-    glDrawArrays(GL_POINTS, 0, GLsizei(count));
-    return;
-  }
-  const size_t chunks = (count + kChunkVertices - 1) / kChunkVertices;
-  drawInChunks(chunks, [&](size_t c) {
-    const size_t first = c * kChunkVertices;
-    glDrawArrays(GL_POINTS, GLint(first), GLsizei(std::min(kChunkVertices, count - first)));
-  });
-}
-
 LineStrips::LineStrips(const std::vector<uint32_t>& indices, size_t chunkVertices)
     : count(static_cast<GLsizei>(indices.size())) {
   size_t start = 0;

@@ -135,11 +135,6 @@ std::vector<uint32_t> frontToBack(const Strands& strands, const glm::dmat4& view
 // 1080p, README Performance: smaller chunks than these saved little more memory and cost time.)
 constexpr size_t kChunkVertices = size_t(1) << 18, kCameraChunkVertices = size_t(1) << 17;
 
-// Draws `count` points (GL_POINTS, vertices 0 … count − 1, no attributes) with the program and buffers
-// in use: on a software rasteriser in chunks of kChunkVertices, at most two unfinished at once (below);
-// on a GPU in one draw.
-void drawPoints(size_t count);
-
 // Line strips through some of a coupe's points (line_decimation.h: point indices, kRestartIndex
 // between strips) in an index buffer, for HairGeometry::drawLines.
 struct LineStrips {

@@ -146,12 +146,16 @@ Programs::Programs(bool ribbons, int block, const CustomShaders& custom, bool mo
       resolve(stage(glsl::kFullscreenVertex), stage(glsl::kResolveFragment), "resolve") {
   const std::string defines = custom.hairFrag ? "" : hairShadingDefines(model, colored);
   if (rasterised) {
-    // One point per fragment, each its own sample: the screen door compiled to nothing (SINGLE_SAMPLE).
-    hairAtlas.emplace(
-        stage(glsl::kAtlasVertex),
-        stage(glsl::kHairFragment, custom.hairFrag, "HairFrag",
-              {.shadowFunction = true, .screenDoor = true, .singleSample = true, .defines = defines}),
-        "hair shading");
+    // One texel of the atlas per fragment, each its own sample: the screen door compiled to nothing
+    // (SINGLE_SAMPLE).
+    hairAtlas.emplace(stage(glsl::kFullscreenVertex),
+                      stage(glsl::kHairFragment, custom.hairFrag, "HairFrag",
+                            {.shadowFunction = true,
+                             .screenDoor = true,
+                             .singleSample = true,
+                             .defines = defines,
+                             .atlas = true}),
+                      "hair shading");
     blend.emplace(stage(glsl::kFullscreenVertex), stage(glsl::kBlendFragment), "blend");
   } else {
     hairShade.emplace(stage(glsl::kHairVertex, custom.hairVert, "HairVert", {.ribbon = ribbons}),
@@ -452,10 +456,12 @@ ShadedImage blendHair(const Scene& scene, const FragmentBuffers& f, const Shaded
     const Program& p = *scene.programs.hairAtlas;
     p.use();
     setHairShading(p, scene);
-    p.set("uOpacity", float(scene.settings.strandOpacity));
-    p.set("uAtlasWidth", atlasWidth);
-    p.set("uAtlasSize", glm::vec2(atlasWidth, float(rows)));
-    drawPoints(f.count);
+    p.set("hairgenHasColor", scene.hair.hasColors ? 1 : 0);
+    p.set("hairgenHasNormal", scene.hair.hasNormals ? 1 : 0);
+    p.set("hairgenOpacity", float(scene.settings.strandOpacity));
+    p.set("hairgenAtlasWidth", atlasWidth);
+    p.set("hairgenFragmentCount", int(f.count));  // requireShadable: within the atlas
+    glDrawArrays(GL_TRIANGLES, 0, 3);             // one triangle over the atlas
     checkGl("the hair's shading");
   }
   ShadedImage image{Texture(GL_RGBA16F, w, h), Texture(GL_RGBA32F, w, h), true};

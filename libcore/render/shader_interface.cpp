@@ -1,5 +1,6 @@
 #include "libcore/render/shader_interface.h"
 
+#include <algorithm>
 #include <cctype>
 #include <charconv>
 #include <regex>
@@ -62,6 +63,24 @@ std::string glslFloat(float value) {
   return s;
 }
 
+// `body` with its `in` declarations of the hair's shading inputs blanked out, for the atlas
+// (StagePrelude::atlas): `[layout(...)] [qualifiers] in <type> vWorld;` and the like, one name each, the
+// line breaks in them kept.
+std::string atlasInputsAsGlobals(const std::string& body) {
+  static const std::regex declaration(
+      R"((layout\s*\([^)]*\)\s*)?((flat|smooth|noperspective|centroid|sample|highp|mediump|lowp)\s+)*)"
+      R"(\bin\s+((highp|mediump|lowp)\s+)?\w+\s+(vWorld|vTangent|vColor|vNormal|vAlpha|vDepth)\s*;)");
+  std::string out;
+  auto last = body.cbegin();
+  for (std::sregex_iterator m(body.begin(), body.end(), declaration), end; m != end; ++m) {
+    out.append(last, (*m)[0].first);
+    const std::string removed = m->str();
+    out.append(size_t(std::count(removed.begin(), removed.end(), '\n')), '\n');
+    last = (*m)[0].second;
+  }
+  return out.append(last, body.cend());
+}
+
 }  // namespace
 
 std::string glslConstants() {
@@ -91,6 +110,7 @@ std::string assembleStage(const StagePrelude& prelude, const std::string& body) 
   text += glslConstants();
   if (prelude.shadowFunction) text += glsl::kShadow;
   if (prelude.screenDoor) text += std::string("#define SCREEN_DOOR\n") + glsl::kScreenDoor;
+  if (prelude.atlas) return text + glsl::kAtlasInputs + "#line 1\n" + atlasInputsAsGlobals(body);
   return text + "#line 1\n" + body;
 }
 

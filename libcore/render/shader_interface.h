@@ -56,6 +56,11 @@ struct StagePrelude {
   bool motion = false;          // `#define MOTION`: hairgen's own vertex stages in the motion pass also
                                 // write vMotion, the screen motion since the previous frame
   std::string defines = {};     // more `#define` lines, for hairgen's own stages only (HAIR_MODEL, ...)
+  bool atlas = false;           // the hair's shading stage run on the shading atlas' texels
+                                // (glsl/atlas_inputs.glsl): its inputs vWorld, vTangent, vColor,
+                                // vNormal, vAlpha and vDepth become globals that hairgen sets before
+                                // the stage's main() runs; the stage's `in` declarations of them are
+                                // blanked out (their lines stay, so the compiler's numbers are the file's)
 };
 
 // The GLSL constants: `const int kShading<Name> = <value>;` for every ShadingModel (the name from
