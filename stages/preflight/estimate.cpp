@@ -7,7 +7,10 @@
 #include <cmath>
 #include <thread>
 
+#include <tbb/blocked_range.h>
 #include <tbb/global_control.h>
+#include <tbb/parallel_for.h>
+#include <tbb/parallel_reduce.h>
 #include <tbb/task_arena.h>
 
 #include "libcore/render/views.h"
@@ -28,6 +31,8 @@ double sweepsPerStage(double elements) {
 // One energy evaluation: per Super-Helix element (frame, closed forms) and per collision sample and
 // shape (GrowCoupe3 benchmark: 1 µs for 4 elements, 32 samples and 2 shapes).
 constexpr double kSecondsPerElement = 60e-9, kSecondsPerSample = 12e-9;
+// Strands hairCoverage gives a thread at once: its sums are a chunk's, whatever the thread count.
+constexpr size_t kCoverageChunk = 4096;
 // Interpolation writes each point once with its tangent (InterpolateCoupe3: 150k × 64 in 0.2 s).
 constexpr double kSecondsPerPoint = 25e-9;
 // The volume: per grid node (sweeps, slides) and per splatted vertex (ShadeCoupe3: 800k nodes and 9.6M
@@ -274,45 +279,67 @@ double hairCoverage(const View& view, const Strands& hair, double strandWidth, d
                     KeptFragments* kept) {
   const glm::dvec2 size(view.width, view.height);
   const double screen = size.x * size.y;
-  // The fragments given in each tile of kFootprintTile² pixels.
   const int tilesX = (view.width + kFootprintTile - 1) / kFootprintTile;
   const int tilesY = (view.height + kFootprintTile - 1) / kFootprintTile;
-  std::vector<double> given(kept ? size_t(tilesX) * size_t(tilesY) : 0, 0.0);
+  const size_t tiles = kept ? size_t(tilesX) * size_t(tilesY) : 0;
   // The near plane (glm::perspective's), before which the device clips.
   const double nearDepth = std::max(view.proj[3][2] / (view.proj[2][2] - 1.0), 1e-9);
-  double fragments = 0.0;
-  for (size_t s = 0; s < hair.strandCount(); ++s) {
-    for (uint32_t i = hair.firstPoint[s]; i + 1 < hair.firstPoint[s + 1]; ++i) {
-      glm::dvec3 a = glm::dvec3(view.view * glm::dvec4(glm::dvec3(hair.points[i]), 1.0));
-      glm::dvec3 b = glm::dvec3(view.view * glm::dvec4(glm::dvec3(hair.points[i + 1]), 1.0));
-      // Depth along the view's −z; the part of the segment in front of the eye.
-      double da = -a.z, db = -b.z;
-      if (da < nearDepth && db < nearDepth) continue;
-      if (da < nearDepth) {
-        a += (b - a) * ((nearDepth - da) / (db - da));
-        da = nearDepth;
-      } else if (db < nearDepth) {
-        b += (a - b) * ((nearDepth - db) / (da - db));
-        db = nearDepth;
-      }
-      const double trueA = strandWidth * view.focalPx / da, trueB = strandWidth * view.focalPx / db;
-      const double wa = std::max(trueA, minWidthPx), wb = std::max(trueB, minWidthPx);
-      const glm::dvec2 pa = 0.5 * size + view.focalPx * glm::dvec2(a.x, a.y) / da,
-                       pb = 0.5 * size + view.focalPx * glm::dvec2(b.x, b.y) / db;
-      // The ribbon reaches half its width beyond its centre line.
-      const double reach = 0.5 * std::max(wa, wb);
-      double t0 = 0.0, t1 = 1.0;
-      if (!clipToBox(pa, pb, glm::dvec2(-reach), size + reach, t0, t1)) continue;
-      const double length = glm::length(pb - pa) * (t1 - t0);
-      const double width = wa + (wb - wa) * 0.5 * (t0 + t1);
-      // A quad at least its width long (the joins), and never more than the image.
-      fragments += std::min(std::max(length, width) * width, screen);
-      if (kept) {  // in the tile of the clipped segment's middle
-        const glm::dvec2 middle = glm::clamp(pa + (pb - pa) * (0.5 * (t0 + t1)), glm::dvec2(0.0), size - 1.0);
-        given[size_t(middle.y / kFootprintTile) * size_t(tilesX) + size_t(middle.x / kFootprintTile)] +=
-            std::min(length * (trueA + (trueB - trueA) * 0.5 * (t0 + t1) + 1.0), screen);
+  // Strands in chunks of a fixed size on every thread, each chunk's sums its own, added up in the chunks'
+  // order: the same estimate whatever the thread count.
+  struct Sums {
+    double fragments = 0.0;
+    std::vector<double> given;  // the fragments given in each tile of kFootprintTile² pixels
+  };
+  const size_t strands = hair.strandCount(), chunks = (strands + kCoverageChunk - 1) / kCoverageChunk;
+  std::vector<Sums> sums(chunks);
+  tbb::parallel_for(size_t(0), chunks, [&](size_t c) {
+    Sums& out = sums[c];
+    out.given.assign(tiles, 0.0);
+    for (size_t s = c * kCoverageChunk; s < std::min(strands, (c + 1) * kCoverageChunk); ++s) {
+      if (hair.firstPoint[s] == hair.firstPoint[s + 1]) continue;
+      auto inView = [&](uint32_t i) {
+        return glm::dvec3(view.view * glm::dvec4(glm::dvec3(hair.points[i]), 1.0));
+      };
+      glm::dvec3 next = inView(hair.firstPoint[s]);
+      for (uint32_t i = hair.firstPoint[s]; i + 1 < hair.firstPoint[s + 1]; ++i) {
+        glm::dvec3 a = next, b = inView(i + 1);
+        next = b;
+        // Depth along the view's −z; the part of the segment in front of the eye.
+        double da = -a.z, db = -b.z;
+        if (da < nearDepth && db < nearDepth) continue;
+        if (da < nearDepth) {
+          a += (b - a) * ((nearDepth - da) / (db - da));
+          da = nearDepth;
+        } else if (db < nearDepth) {
+          b += (a - b) * ((nearDepth - db) / (da - db));
+          db = nearDepth;
+        }
+        const double trueA = strandWidth * view.focalPx / da, trueB = strandWidth * view.focalPx / db;
+        const double wa = std::max(trueA, minWidthPx), wb = std::max(trueB, minWidthPx);
+        const glm::dvec2 pa = 0.5 * size + view.focalPx * glm::dvec2(a.x, a.y) / da,
+                         pb = 0.5 * size + view.focalPx * glm::dvec2(b.x, b.y) / db;
+        // The ribbon reaches half its width beyond its centre line.
+        const double reach = 0.5 * std::max(wa, wb);
+        double t0 = 0.0, t1 = 1.0;
+        if (!clipToBox(pa, pb, glm::dvec2(-reach), size + reach, t0, t1)) continue;
+        const double length = glm::length(pb - pa) * (t1 - t0);
+        const double width = wa + (wb - wa) * 0.5 * (t0 + t1);
+        // A quad at least its width long (the joins), and never more than the image.
+        out.fragments += std::min(std::max(length, width) * width, screen);
+        if (kept) {  // in the tile of the clipped segment's middle
+          const glm::dvec2 middle =
+              glm::clamp(pa + (pb - pa) * (0.5 * (t0 + t1)), glm::dvec2(0.0), size - 1.0);
+          out.given[size_t(middle.y / kFootprintTile) * size_t(tilesX) + size_t(middle.x / kFootprintTile)] +=
+              std::min(length * (trueA + (trueB - trueA) * 0.5 * (t0 + t1) + 1.0), screen);
+        }
       }
     }
+  });
+  double fragments = 0.0;
+  std::vector<double> given(tiles, 0.0);
+  for (const Sums& chunk : sums) {
+    fragments += chunk.fragments;
+    for (size_t t = 0; t < tiles; ++t) given[t] += chunk.given[t];
   }
   if (kept) {
     kept->fragments = 0.0;
@@ -336,13 +363,19 @@ WorkEstimate estimateRender(const RenderSettings& r, const Strands& hair, const 
   WorkEstimate e =
       renderCost(r, hair.strandCount(), hair.pointCount(), head ? head->triangleCount() : 0, fragments,
                  kept.fragments, keptFragments, glm::length(sphere.centre - r.cameraPosition), block);
-  double longest = 0.0;
-  for (size_t s = 0; s < hair.strandCount(); ++s) {
-    double length = 0.0;
-    for (uint32_t p = hair.firstPoint[s] + 1; p < hair.firstPoint[s + 1]; ++p)
-      length += glm::length(glm::dvec3(hair.points[p]) - glm::dvec3(hair.points[p - 1]));
-    longest = std::max(longest, length);
-  }
+  // The longest strand (a maximum: the same whatever the thread count).
+  const double longest = tbb::parallel_reduce(
+      tbb::blocked_range<size_t>(0, hair.strandCount(), kCoverageChunk), 0.0,
+      [&](const tbb::blocked_range<size_t>& range, double most) {
+        for (size_t s = range.begin(); s < range.end(); ++s) {
+          double length = 0.0;
+          for (uint32_t p = hair.firstPoint[s] + 1; p < hair.firstPoint[s + 1]; ++p)
+            length += glm::length(glm::dvec3(hair.points[p]) - glm::dvec3(hair.points[p - 1]));
+          most = std::max(most, length);
+        }
+        return most;
+      },
+      [](double x, double y) { return std::max(x, y); });
   blameUnits(e, longest);
   return e;
 }
