@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <memory>
 
 #include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
@@ -12,6 +13,38 @@ namespace hairgen {
 namespace {
 
 constexpr int32_t kNoHair = std::numeric_limits<int32_t>::max();
+
+struct Fragment {
+  uint32_t texel;
+  int32_t depth;
+  uint32_t coverage;
+};
+
+// A band's fragments while it is drawn, in blocks of kBlock, kept from band to band. A band of the
+// 1080p coupe's light has up to millions (tens of MB); a vector doubling to hold them held its new
+// storage and the old at once as it grew, twice a thread, and that was the render's peak memory.
+class FragmentBlocks {
+ public:
+  void clear() { size_ = 0; }
+  void push(const Fragment& f) {
+    if (size_ == blocks_.size() * kBlock)
+      blocks_.push_back(std::make_unique_for_overwrite<Fragment[]>(kBlock));
+    blocks_[size_ / kBlock][size_ % kBlock] = f;
+    ++size_;
+  }
+  template <class F>
+  void forEach(F&& f) const {
+    for (size_t b = 0; b * kBlock < size_; ++b) {
+      const Fragment* block = blocks_[b].get();
+      for (size_t i = 0, n = std::min(kBlock, size_ - b * kBlock); i < n; ++i) f(block[i]);
+    }
+  }
+
+ private:
+  static constexpr size_t kBlock = size_t(1) << 16;  // fragments: 768 KB
+  std::vector<std::unique_ptr<Fragment[]>> blocks_;
+  size_t size_ = 0;
+};
 
 }  // namespace
 
@@ -43,29 +76,24 @@ HairLightMaps rasteriseLightMaps(const Strands& hair, const View& light, double 
     cumulative += layerSizes[k];
     ends[k] = std::llround(cumulative / kDepthUnit);
   }
-  // Each band by one thread, its fragments kept while it is drawn (a band's, not the map's: a few MB):
-  // first where the hair begins in its rows, then the layers' sums.
-  struct Fragment {
-    uint32_t texel;
-    int32_t depth;
-    uint32_t coverage;
-  };
-  tbb::enumerable_thread_specific<std::vector<Fragment>> kept;
+  // Each band by one thread, its fragments kept while it is drawn (a band's, not the map's): first
+  // where the hair begins in its rows, then the layers' sums.
+  tbb::enumerable_thread_specific<FragmentBlocks> kept;
   tbb::parallel_for(0, bands.count, [&](int band) {
-    std::vector<Fragment>& fragments = kept.local();
+    FragmentBlocks& fragments = kept.local();
     fragments.clear();
     bands.eachFragment<raster::Across::kTent>(
         band, [&](size_t t, int32_t depth, uint32_t coverage, uint32_t, raster::Piece) {
           maps.start[t] = std::min(maps.start[t], depth);
-          fragments.push_back({uint32_t(t), depth, coverage});
+          fragments.push({uint32_t(t), depth, coverage});
         });
-    for (const Fragment& f : fragments) {
+    fragments.forEach([&](const Fragment& f) {
       const int64_t behind = int64_t(f.depth) - maps.start[f.texel];
       glm::uvec4& sum = maps.layers[f.texel];
       for (int k = 0; k < 3; ++k)
         if (behind < ends[k]) raster::addSaturating(sum[k], f.coverage);
       raster::addSaturating(sum[3], f.coverage);
-    }
+    });
   });
   if (spent) *spent = std::move(bands);
   return maps;
