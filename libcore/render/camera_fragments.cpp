@@ -41,12 +41,16 @@ uint32_t spanOf(raster::Piece piece) {
 }
 
 // One pixel's kept fragments, `n` of `kept`, nearest first; `tail` its coverage behind them.
-void keep(Slot* list, uint8_t& n, uint32_t& tail, int kept, int32_t depth, uint32_t coverage, uint32_t point,
-          raster::Piece piece) {
+void keep(Slot* list, uint8_t& n, uint32_t& tail, uint32_t& touched, int kept, int32_t depth,
+          uint32_t coverage, uint32_t point, raster::Piece piece) {
   // Segments come in the order of their first point, so a piece of the same strand from the same
   // segment or the one before merges into its fragment (points are one strand's when one apart: a
-  // segment joins a point to the next of its strand).
-  for (int k = 0; k < n; ++k) {
+  // segment joins a point to the next of its strand). No fragment's last segment is later than
+  // `touched`, the last whose piece reached the pixel, so when that is older than the one before this
+  // one, none is looked at (most pieces in thick hair: 8% of the camera's fragments' time).
+  const bool mergeable = point - touched <= 1;
+  touched = point;
+  for (int k = 0; mergeable && k < n; ++k) {
     Slot& s = list[k];
     if (point - s.last > 1) continue;
     raster::addSaturating(s.coverage, coverage);
@@ -152,6 +156,7 @@ CameraFragments cameraFragments(const raster::Bands& bands, int kept, const floa
   struct BandSlots {
     std::vector<Slot> slots;
     std::vector<uint8_t> used;
+    std::vector<uint32_t> touched;  // per pixel, the last segment that reached it (keep())
   };
   tbb::enumerable_thread_specific<BandSlots> perThread;
   const Hidden hidden(opaque, bands.width, bands.height);
@@ -161,6 +166,7 @@ CameraFragments cameraFragments(const raster::Bands& bands, int kept, const floa
     BandSlots& mine = perThread.local();
     mine.slots.resize((end - base) * size_t(kept));
     mine.used.assign(end - base, 0);
+    mine.touched.assign(end - base, UINT32_MAX);
     std::vector<Slot>& slots = mine.slots;
     std::vector<uint8_t>& used = mine.used;
     bands.eachFragment<raster::Across::kBox>(
@@ -169,8 +175,8 @@ CameraFragments cameraFragments(const raster::Bands& bands, int kept, const floa
           // Compared as the blend compares them: the fragment's depth as the float it is stored as.
           if (opaque && metresOf(depth) >= opaque[texel]) return;
           const size_t local = texel - base;
-          keep(&slots[local * size_t(kept)], used[local], out.tail[texel], kept, depth, coverage, point,
-               piece);
+          keep(&slots[local * size_t(kept)], used[local], out.tail[texel], mine.touched[local], kept, depth,
+               coverage, point, piece);
         },
         [&](const raster::Vertex& a, const raster::Vertex& b) { return hidden.behind(a, b); });
     auto& words = bandWords[size_t(band)];
