@@ -69,6 +69,23 @@ RenderOutput renderStage(const CommonOptions& common, const Config& config, GlCo
   stats.counts()["hairFragments"] = out.hairFragments;
   stats.json()["device"]["hairFragmentSeconds"] = out.timings.fragments;
   stats.json()["device"]["hairReadInPlace"] = out.hairReadInPlace;
+  // The rasteriser's passes on the device and its transfers, summed over a sequence's frames as the
+  // phases' seconds are.
+  auto addTimes = [&](const char* key, const std::vector<DeviceTime>& times, bool bytes) {
+    nlohmann::ordered_json& all = stats.json()["device"][key];
+    if (all.is_null()) all = nlohmann::ordered_json::object();
+    for (const DeviceTime& t : times) {
+      nlohmann::ordered_json& one = all[t.name];
+      if (one.is_null())
+        one = bytes ? nlohmann::ordered_json{{"seconds", 0.0}, {"bytes", 0}, {"runs", 0}}
+                    : nlohmann::ordered_json{{"seconds", 0.0}, {"runs", 0}};
+      one["seconds"] = one["seconds"].get<double>() + t.seconds;
+      if (bytes) one["bytes"] = one["bytes"].get<uint64_t>() + t.bytes;
+      one["runs"] = one["runs"].get<int>() + t.runs;
+    }
+  };
+  addTimes("passes", out.timings.devicePasses, false);
+  addTimes("transfers", out.timings.transfers, true);
   return out;
 }
 

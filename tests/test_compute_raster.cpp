@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <numeric>
 #include <random>
 
 #include <glm/gtc/matrix_transform.hpp>
@@ -79,6 +80,38 @@ Strands tangle(int strands, unsigned seed) {
 }
 
 constexpr glm::dvec4 kLayers{0.002, 0.006, 0.015, 0.04};
+
+// The device's prefix sums (the camera's lists' places) are the host's, modulo 2^32: for one word,
+// within one block of 1024, just past it, and over three levels of blocks; words past a word's range
+// (the sums wrap), a limit on each word, and the largest word found alongside.
+TEST(ComputeRaster, PrefixSumsAreTheHostsModulo2To32) {
+  SKIP_WITHOUT_COMPUTE_RASTER();
+  std::mt19937 random(5);
+  const PrefixSum prefixSum;
+  for (const size_t count :
+       {size_t(0), size_t(1), size_t(1023), size_t(1024), size_t(1025), size_t(1100000)}) {
+    std::vector<uint32_t> words(count);
+    for (uint32_t& w : words) w = random() % 8 == 0 ? uint32_t(random()) : uint32_t(random() % 40);
+    const DeviceBuffer in(count * sizeof(uint32_t), words.data()), out((count + 1) * sizeof(uint32_t)),
+        limited((count + 1) * sizeof(uint32_t)), deepest(sizeof(uint32_t));
+    deepest.clear(0);
+    prefixSum(in, count, out, UINT32_MAX, &deepest);
+    prefixSum(in, count, limited, 7);
+    std::vector<uint32_t> sums(count + 1), limitedSums(count + 1);
+    for (size_t i = 0; i < count; ++i) {
+      sums[i + 1] = sums[i] + words[i];  // unsigned: modulo 2^32
+      limitedSums[i + 1] = limitedSums[i] + std::min(words[i], 7u);
+    }
+    SCOPED_TRACE(count);
+    EXPECT_TRUE(out.read<uint32_t>(count + 1) == sums);
+    EXPECT_TRUE(limited.read<uint32_t>(count + 1) == limitedSums);
+    EXPECT_EQ(deepest.read<uint32_t>(1)[0], count ? *std::max_element(words.begin(), words.end()) : 0u);
+    if (count > 1000) {
+      EXPECT_GT(std::accumulate(words.begin(), words.end(), uint64_t(0)), uint64_t(UINT32_MAX))
+          << "the sums pass 2^32";
+    }
+  }
+}
 
 // The light's maps: the integers and the textures the shadow lookup reads.
 TEST(ComputeRaster, TheLightsMapsAreTheCpusBits) {

@@ -161,10 +161,49 @@ void DeviceBuffer::clear(uint32_t word) const {
 }
 
 template <class T>
-std::vector<T> DeviceBuffer::read(size_t count) const {
+std::vector<T> DeviceBuffer::read(size_t count, size_t first) const {
   std::vector<T> out(count);
-  if (count) glGetNamedBufferSubData(id, 0, GLsizeiptr(count * sizeof(T)), out.data());
+  if (count)
+    glGetNamedBufferSubData(id, GLintptr(first * sizeof(T)), GLsizeiptr(count * sizeof(T)), out.data());
   return out;
+}
+
+namespace {
+
+// Words a group of the prefix sum's first pass sums (glsl/prefix_sum.glsl: kScanBlock).
+constexpr size_t kScanBlock = 1024;
+
+}  // namespace
+
+PrefixSum::PrefixSum()
+    : blocks_(computeStage(glsl::kPrefixSum, false, "#define SCAN_BLOCKS\n"), "prefix sum"),
+      add_(computeStage(glsl::kPrefixSum, false, "#define ADD_BLOCKS\n"), "prefix sum's blocks") {}
+
+void PrefixSum::operator()(const DeviceBuffer& in, size_t count, const DeviceBuffer& out, uint32_t limit,
+                           const DeviceBuffer* deepest) const {
+  const size_t sums = count + 1, blocks = (sums + kScanBlock - 1) / kScanBlock;
+  const DeviceBuffer blockSums(blocks * sizeof(uint32_t));
+  blocks_.use();
+  glUniform1ui(blocks_.loc("uSums"), GLuint(sums));
+  glUniform1ui(blocks_.loc("uInputs"), GLuint(count));
+  glUniform1ui(blocks_.loc("uLimit"), limit);
+  glUniform1i(blocks_.loc("uDeepest"), deepest ? 1 : 0);
+  in.bind(0);
+  out.bind(1);
+  blockSums.bind(2);
+  if (deepest) deepest->bind(3);
+  dispatch(blocks * 256, 256);
+  glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT);
+  if (blocks == 1) return;  // the block's sums are the sums
+  // Each block's place among the blocks: the blocks' totals summed alike (a level a 1024th the size).
+  const DeviceBuffer places((blocks + 1) * sizeof(uint32_t));
+  (*this)(blockSums, blocks, places);
+  add_.use();
+  glUniform1ui(add_.loc("uSums"), GLuint(sums));
+  out.bind(1);
+  places.bind(2);
+  dispatch(sums, 256);
+  glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT);
 }
 
 raster::Projection DeviceProjection::read() const {
@@ -176,35 +215,48 @@ raster::Projection DeviceProjection::read() const {
   return p;
 }
 
-DeviceProjection::DeviceProjection(const raster::Projection& p)
+namespace {
+
+// A buffer holding `bytes` of `data`, its upload timed as `transfer`.
+DeviceBuffer uploaded(const void* data, size_t bytes, DeviceTimer* timer, const char* transfer) {
+  const DeviceTimer::Transfer timed(timer, transfer, bytes);
+  return DeviceBuffer(bytes, data);
+}
+
+}  // namespace
+
+DeviceProjection::DeviceProjection(const raster::Projection& p, DeviceTimer* timer, const char* upload)
     : width(p.width),
       height(p.height),
       segments(p.segments.size()),
-      vertices(p.vertices.size() * sizeof(raster::Vertex), p.vertices.data()),
-      segmentList(p.segments.size() * sizeof(uint32_t), p.segments.data()) {
+      vertices(uploaded(p.vertices.data(), p.vertices.size() * sizeof(raster::Vertex), timer, upload)),
+      segmentList(uploaded(p.segments.data(), p.segments.size() * sizeof(uint32_t), timer, upload)) {
   static_assert(sizeof(raster::Vertex) == 16);
 }
 
 void computeLightMaps(const DeviceProjection& hair, const glm::dvec4& layerSizes, double strandOpacity,
-                      float background, const Texture& start, const Texture& opacity,
-                      HairLightMaps* integers) {
+                      float background, const Texture& start, const Texture& opacity, HairLightMaps* integers,
+                      DeviceTimer* timer) {
   const size_t texels = size_t(hair.width) * size_t(hair.height);
+  const Program starts(computeStage(glsl::kLightStart, true, "#define ACROSS_TENT\n"), "light start");
+  const Program sums(computeStage(glsl::kLightLayers, true, "#define ACROSS_TENT\n"), "light layers");
+  const Program finish(computeStage(glsl::kLightFinish, false), "light finish");
   DeviceBuffer begins(texels * sizeof(int32_t)), layers(texels * 4 * sizeof(uint32_t)),
       overflow(texels * sizeof(uint32_t));
-  begins.clear(uint32_t(std::numeric_limits<int32_t>::max()));
-  layers.clear(0);
-  overflow.clear(0);
   {
-    const Program p(computeStage(glsl::kLightStart, true, "#define ACROSS_TENT\n"), "light start");
-    p.use();
-    setRaster(p, hair);
+    const DeviceTimer::Pass timed(timer, "light_start");
+    begins.clear(uint32_t(std::numeric_limits<int32_t>::max()));
+    starts.use();
+    setRaster(starts, hair);
     begins.bind(2);
     drawSegments(hair);
   }
   {
-    const Program p(computeStage(glsl::kLightLayers, true, "#define ACROSS_TENT\n"), "light layers");
-    p.use();
-    setRaster(p, hair);
+    const DeviceTimer::Pass timed(timer, "light_layers");
+    layers.clear(0);
+    overflow.clear(0);
+    sums.use();
+    setRaster(sums, hair);
     // As light_maps.cpp: each layer's far end from where the hair begins; a depth behind it is below
     // 2^31 units, so an end past that is as good as INT32_MAX.
     GLint ends[3];
@@ -213,19 +265,19 @@ void computeLightMaps(const DeviceProjection& hair, const glm::dvec4& layerSizes
       cumulative += layerSizes[k];
       ends[k] = GLint(std::clamp<double>(std::llround(cumulative / kDepthUnit), INT32_MIN, INT32_MAX));
     }
-    glUniform3iv(p.loc("uLayerEnds"), 1, ends);
+    glUniform3iv(sums.loc("uLayerEnds"), 1, ends);
     begins.bind(2);
     layers.bind(3);
     overflow.bind(4);
     drawSegments(hair);
   }
   {
-    const Program p(computeStage(glsl::kLightFinish, false), "light finish");
-    p.use();
-    glUniform1i(p.loc("uSize"), hair.width);
-    glUniform1f(p.loc("uBackground"), background);
-    glUniform1d(p.loc("uDepthUnit"), kDepthUnit);
-    glUniform1d(p.loc("uOpacityScale"), strandOpacity / double(kCoverageOne));
+    const DeviceTimer::Pass timed(timer, "light_finish");
+    finish.use();
+    glUniform1i(finish.loc("uSize"), hair.width);
+    glUniform1f(finish.loc("uBackground"), background);
+    glUniform1d(finish.loc("uDepthUnit"), kDepthUnit);
+    glUniform1d(finish.loc("uOpacityScale"), strandOpacity / double(kCoverageOne));
     begins.bind(2);
     layers.bind(3);
     overflow.bind(4);
@@ -257,11 +309,18 @@ CameraFragments DeviceFragments::read(int width, int height) const {
 }
 
 std::optional<DeviceFragments> computeCameraFragments(const DeviceProjection& hair, int kept,
-                                                      const Texture* opaque, size_t slabBytes) {
+                                                      const Texture* opaque, size_t slabBytes,
+                                                      DeviceTimer* timer) {
   kept = std::clamp(kept, 1, 255);
-  const size_t width = size_t(hair.width), pixels = width * size_t(hair.height);
-  if (!fitsDevice(pixels * sizeof(uint32_t))) return std::nullopt;
+  const size_t width = size_t(hair.width), pixels = width * size_t(hair.height), rows = size_t(hair.height);
+  if (!fitsDevice((pixels + 1) * sizeof(uint32_t))) return std::nullopt;
   const std::string keptDefine = "#define KEPT " + std::to_string(kept) + "\n";
+  const Program count(computeStage(glsl::kCameraCount, true), "camera count");
+  const PrefixSum prefixSum;
+  const Program rowTotals(computeStage(glsl::kCameraRows, false), "camera rows");
+  const Program fill(computeStage(glsl::kCameraFill, true), "camera fill");
+  const Program keep(computeStage(glsl::kCameraKeep, false, keptDefine), "camera keep");
+  const Program pack(computeStage(glsl::kCameraPack, false), "camera pack");
   auto useOpaque = [&](const Program& p) {
     glUniform1i(p.loc("uHasOpaque"), opaque ? 1 : 0);
     glUniform1d(p.loc("uDepthUnit"), kDepthUnit);
@@ -269,117 +328,137 @@ std::optional<DeviceFragments> computeCameraFragments(const DeviceProjection& ha
   };
   // Each pixel's fragments counted.
   DeviceBuffer counts(pixels * sizeof(uint32_t));
-  counts.clear(0);
   {
-    const Program p(computeStage(glsl::kCameraCount, true), "camera count");
-    p.use();
-    setRaster(p, hair);
-    useOpaque(p);
+    const DeviceTimer::Pass timed(timer, "camera_count");
+    counts.clear(0);
+    count.use();
+    setRaster(count, hair);
+    useOpaque(count);
     counts.bind(2);
     drawSegments(hair);
   }
-  // The rows in slabs whose lists fit a buffer; each pixel's list's place within its slab, and its kept
-  // fragments' place among every pixel's (at most min(count, kept) of them), uploaded and let go.
+  // Each pixel's list's place among every pixel's, and its kept fragments' (at most min(count, kept)
+  // of them); per row where both begin, and the deepest pixel's count, for the host.
+  DeviceBuffer offsets((pixels + 1) * sizeof(uint32_t)), keepAt((pixels + 1) * sizeof(uint32_t)),
+      totals((1 + 2 * (rows + 1)) * sizeof(uint32_t));
+  {
+    const DeviceTimer::Pass timed(timer, "camera_scan");
+    totals.clear(0);
+    prefixSum(counts, pixels, offsets, UINT32_MAX, &totals);
+    prefixSum(counts, pixels, keepAt, uint32_t(kept));
+    rowTotals.use();
+    glUniform1ui(rowTotals.loc("uWidth"), GLuint(width));
+    glUniform1ui(rowTotals.loc("uRows"), GLuint(rows));
+    offsets.bind(0);
+    keepAt.bind(1);
+    totals.bind(2);
+    dispatch(rows + 1, 256);
+    glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
+  }
+  std::vector<uint32_t> rowStarts;
+  {
+    const DeviceTimer::Transfer timed(timer, "camera_totals_read", totals.bytes);
+    rowStarts = totals.read<uint32_t>(1 + 2 * (rows + 1));
+  }
+  const uint64_t deepest = rowStarts[0];
+  if (softwareRasteriser() &&
+      deepest * (uint64_t(kept) + 1 + 2 * uint64_t(std::bit_width(deepest))) > kSoftwareLoopBudget)
+    return std::nullopt;
+  // A row's fragments are then below 2^32, and the differences of the sums (modulo 2^32) exact.
+  if (deepest * width > UINT32_MAX) return std::nullopt;
+  auto listsAt = [&](size_t row) { return rowStarts[1 + 2 * row]; };
+  auto keptAt = [&](size_t row) { return rowStarts[2 + 2 * row]; };
+  // The rows in slabs whose lists fit a buffer.
   const size_t slabFragments =
       std::min<size_t>(slabBytes ? slabBytes : kSlabBytes, size_t(maxStorageBlock())) /
       (4 * sizeof(uint32_t));
-  std::vector<int> slabRows{0};
-  size_t slabLargest = 0;
+  std::vector<size_t> slabRows{0};
+  size_t slabLargest = 0, inSlab = 0;
   uint64_t keptBound = 0;
-  std::unique_ptr<DeviceBuffer> offsetBuffer, keepAtBuffer;
-  {
-    const std::vector<uint32_t> count = counts.read<uint32_t>(pixels);
-    const uint64_t deepest = *std::max_element(count.begin(), count.end());
-    if (softwareRasteriser() &&
-        deepest * (uint64_t(kept) + 1 + 2 * uint64_t(std::bit_width(deepest))) > kSoftwareLoopBudget)
-      return std::nullopt;
-    std::vector<uint32_t> offsets(pixels), keepAt(pixels);
-    size_t inSlab = 0;
-    for (int row = 0; row < hair.height; ++row) {
-      uint64_t rowFragments = 0;
-      for (size_t p = size_t(row) * width; p < size_t(row + 1) * width; ++p) rowFragments += count[p];
-      if (rowFragments > slabFragments) return std::nullopt;
-      if (inSlab + rowFragments > slabFragments) {
-        slabRows.push_back(row);
-        inSlab = 0;
-      }
-      for (size_t p = size_t(row) * width; p < size_t(row + 1) * width; ++p) {
-        offsets[p] = uint32_t(inSlab);
-        inSlab += count[p];
-        keepAt[p] = uint32_t(keptBound);
-        keptBound += std::min<uint32_t>(count[p], uint32_t(kept));
-      }
-      slabLargest = std::max(slabLargest, inSlab);
-      if (keptBound > UINT32_MAX || !fitsDevice(keptBound * 3 * sizeof(uint32_t))) return std::nullopt;
+  for (size_t row = 0; row < rows; ++row) {
+    const size_t rowFragments = uint32_t(listsAt(row + 1) - listsAt(row));
+    if (rowFragments > slabFragments) return std::nullopt;
+    if (inSlab + rowFragments > slabFragments) {
+      slabRows.push_back(row);
+      inSlab = 0;
     }
-    offsetBuffer = std::make_unique<DeviceBuffer>(pixels * sizeof(uint32_t), offsets.data());
-    keepAtBuffer = std::make_unique<DeviceBuffer>(pixels * sizeof(uint32_t), keepAt.data());
+    inSlab += rowFragments;
+    slabLargest = std::max(slabLargest, inSlab);
+    keptBound += uint32_t(keptAt(row + 1) - keptAt(row));
   }
-  slabRows.push_back(hair.height);
+  if (keptBound > UINT32_MAX || !fitsDevice(keptBound * 3 * sizeof(uint32_t))) return std::nullopt;
+  slabRows.push_back(rows);
   // Kept: each pixel's kept count, and after them the keeping pass's fault word.
   DeviceBuffer cursors(pixels * sizeof(uint32_t)), lists(slabLargest * 4 * sizeof(uint32_t)),
       keptCounts((pixels + 1) * sizeof(uint32_t)), staging(size_t(keptBound) * 3 * sizeof(uint32_t));
   cursors.clear(0);
   keptCounts.clear(0);
   auto tails = std::make_unique<DeviceBuffer>(pixels * sizeof(uint32_t));
-  const Program fill(computeStage(glsl::kCameraFill, true), "camera fill");
-  const Program keep(computeStage(glsl::kCameraKeep, false, keptDefine), "camera keep");
   for (size_t s = 0; s + 1 < slabRows.size(); ++s) {
     if (slabRows[s] == slabRows[s + 1]) continue;
-    fill.use();
-    setRaster(fill, hair);
-    useOpaque(fill);
-    glUniform1i(fill.loc("uRowLo"), slabRows[s]);
-    glUniform1i(fill.loc("uRowHi"), slabRows[s + 1]);
-    offsetBuffer->bind(2);
-    cursors.bind(3);
-    lists.bind(4);
-    counts.bind(5);
-    drawSegments(hair);
-    keep.use();
-    const size_t lo = size_t(slabRows[s]) * width, hi = size_t(slabRows[s + 1]) * width;
-    glUniform1ui(keep.loc("uPixelLo"), GLuint(lo));
-    glUniform1ui(keep.loc("uPixelHi"), GLuint(hi));
-    glUniform1ui(keep.loc("uFault"), GLuint(pixels));
-    glUniform1d(keep.loc("uDepthUnit"), kDepthUnit);
-    offsetBuffer->bind(0);
-    counts.bind(1);
-    lists.bind(2);
-    keptCounts.bind(3);
-    tails->bind(4);
-    keepAtBuffer->bind(5);
-    staging.bind(6);
-    cursors.bind(7);
-    dispatch(hi - lo, 64);
-    glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT);
+    const size_t lo = slabRows[s] * width, hi = slabRows[s + 1] * width;
+    const uint32_t slabFirst = listsAt(slabRows[s]);
+    {
+      const DeviceTimer::Pass timed(timer, "camera_fill");
+      fill.use();
+      setRaster(fill, hair);
+      useOpaque(fill);
+      glUniform1i(fill.loc("uRowLo"), GLint(slabRows[s]));
+      glUniform1i(fill.loc("uRowHi"), GLint(slabRows[s + 1]));
+      glUniform1ui(fill.loc("uSlabFirst"), slabFirst);
+      offsets.bind(2);
+      cursors.bind(3);
+      lists.bind(4);
+      counts.bind(5);
+      drawSegments(hair);
+    }
+    {
+      const DeviceTimer::Pass timed(timer, "camera_keep");
+      keep.use();
+      glUniform1ui(keep.loc("uPixelLo"), GLuint(lo));
+      glUniform1ui(keep.loc("uPixelHi"), GLuint(hi));
+      glUniform1ui(keep.loc("uSlabFirst"), slabFirst);
+      glUniform1ui(keep.loc("uFault"), GLuint(pixels));
+      glUniform1d(keep.loc("uDepthUnit"), kDepthUnit);
+      offsets.bind(0);
+      counts.bind(1);
+      lists.bind(2);
+      keptCounts.bind(3);
+      tails->bind(4);
+      keepAt.bind(5);
+      staging.bind(6);
+      cursors.bind(7);
+      dispatch(hi - lo, 64);
+      glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT);
+    }
   }
-  // Each pixel's first kept fragment: the kept counts summed, in their own array.
-  std::vector<uint32_t> first = keptCounts.read<uint32_t>(pixels + 1);
-  if (first[pixels] != 0) return std::nullopt;  // the count and fill passes disagreed
-  uint32_t total = 0;
-  for (size_t p = 0; p < pixels; ++p) {
-    const uint32_t n = first[p];
-    first[p] = total;
-    total += n;
-  }
-  first[pixels] = total;
+  // Each pixel's first kept fragment: the kept counts' prefix sum (the last word the total).
   DeviceFragments out;
-  out.count = total;
-  out.first = std::make_unique<DeviceBuffer>(first.size() * sizeof(uint32_t), first.data());
-  first = {};
-  out.words = std::make_unique<DeviceBuffer>(size_t(total) * 3 * sizeof(uint32_t));
+  out.first = std::make_unique<DeviceBuffer>((pixels + 1) * sizeof(uint32_t));
+  {
+    const DeviceTimer::Pass timed(timer, "camera_first");
+    prefixSum(keptCounts, pixels, *out.first);
+  }
+  uint32_t fault = 0;
+  {
+    const DeviceTimer::Transfer timed(timer, "camera_kept_read", 2 * sizeof(uint32_t));
+    fault = keptCounts.read<uint32_t>(1, pixels)[0];
+    out.count = out.first->read<uint32_t>(1, pixels)[0];
+  }
+  if (fault != 0) return std::nullopt;  // the count and fill passes disagreed
+  out.words = std::make_unique<DeviceBuffer>(out.count * 3 * sizeof(uint32_t));
   out.tail = std::move(tails);
   {
-    const Program p(computeStage(glsl::kCameraPack, false), "camera pack");
-    p.use();
-    glUniform1ui(p.loc("uPixels"), GLuint(pixels));
+    const DeviceTimer::Pass timed(timer, "camera_pack");
+    pack.use();
+    glUniform1ui(pack.loc("uPixels"), GLuint(pixels));
     out.first->bind(0);
     out.words->bind(1);
-    keepAtBuffer->bind(2);
+    keepAt.bind(2);
     staging.bind(3);
     dispatch(pixels, 256);
+    glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT);
   }
-  glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT);
   checkGl("the camera's fragments on the device");
   return out;
 }

@@ -291,7 +291,7 @@ Scene::Scene(const RenderInput& in)
   lightMaps = std::move(preparing->lightMaps);
   cameraBands = std::move(preparing->cameraBands);
   if (preparing->lightProjection) {
-    lightOnDevice = std::make_unique<DeviceProjection>(*preparing->lightProjection);
+    lightOnDevice = std::make_unique<DeviceProjection>(*preparing->lightProjection, &timer, "light_upload");
     preparing->lightProjection.reset();
   }
   if (rasterised && onDevice) {
@@ -300,7 +300,7 @@ Scene::Scene(const RenderInput& in)
     if (preparing->software && !withinLoopBudget(p))
       cameraBands = std::make_unique<raster::Bands>(raster::intoBands(std::move(p)));
     else
-      cameraOnDevice = std::make_unique<DeviceProjection>(p);
+      cameraOnDevice = std::make_unique<DeviceProjection>(p, &timer, "camera_upload");
   }
   if (preparing->cameraChords)
     cameraLines = std::make_unique<LineStrips>(preparing->camera, kCameraChunkVertices);
@@ -352,7 +352,7 @@ LightDepth lightDepthPass(const Scene& scene) {
     depth.opacity.emplace(GL_RGBA32F, n, n);
     const RenderSettings& r = scene.settings;
     computeLightMaps(*scene.lightOnDevice, r.layerSizes, r.strandOpacity, kBackgroundZ, depth.hairStart,
-                     *depth.opacity);
+                     *depth.opacity, nullptr, &scene.timer);
   } else if (scene.lightMaps) {
     const std::vector<float> start = scene.lightMaps->startMetres(kBackgroundZ);
     glTextureSubImage2D(depth.hairStart.id, 0, 0, 0, n, n, GL_RED, GL_FLOAT, start.data());
@@ -531,8 +531,8 @@ ShadedImage shadingPass(Scene& scene, const LightDepth& depth, const Texture& op
   const uint64_t atlasTexels = uint64_t(std::min(kAtlasWidth, maxSize)) * uint64_t(maxSize);
   if (scene.cameraOnDevice) {
     // The head's depth is the data's R, read where it lies.
-    const std::optional<DeviceFragments> f =
-        computeCameraFragments(*scene.cameraOnDevice, scene.kept, scene.head ? &image.data : nullptr);
+    const std::optional<DeviceFragments> f = computeCameraFragments(
+        *scene.cameraOnDevice, scene.kept, scene.head ? &image.data : nullptr, 0, &scene.timer);
     glFinish();
     fragmentSeconds = clock.lap();
     if (f) {

@@ -20,6 +20,7 @@
 #include <memory>
 #include <optional>
 
+#include "libcore/render/device_timer.h"
 #include "libcore/render/gl_resources.h"
 #include "libcore/render/renderer.h"
 #include "libcore/render/views.h"
@@ -65,6 +66,10 @@ struct Scene {
   int kept;               // the fragments kept per sub-pixel (RenderInput::keptFragments)
   bool onDevice;          // hairgen's rasteriser runs on the device (RenderInput::rasteriser)
   glm::dmat4 viewProj{1.0}, previousViewProj{1.0};  // world to clip: this frame's camera, the previous one's
+  // The device's time in the rasteriser's compute passes and the host's in their transfers (read once the
+  // frame is done: RenderTimings::devicePasses, transfers); the passes time themselves (mutable), which
+  // changes nothing they draw.
+  mutable DeviceTimer timer;
   // What the CPU prepares for drawing while the GL objects below are made (passes.cpp).
   struct Preparation;
   std::unique_ptr<Preparation> preparing;

@@ -75,6 +75,8 @@ RenderOutput renderHair(GlContext&, const RenderInput& in) {
   readBack(image, motion ? &*motion : nullptr, in.keepDom ? &depth : nullptr, in.keepDom ? &opacity : nullptr,
            out);
   out.timings.readback = seconds(clock);
+  out.timings.devicePasses = scene.timer.passes();
+  out.timings.transfers = scene.timer.transfers();
   passDone();
   return out;
 }

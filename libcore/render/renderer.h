@@ -40,9 +40,21 @@ inline constexpr const char* kChannelMotionV = "motion.v";
 // opacity accumulated in one depth layer (Layer Sizes), so a compositor lists them under one layer.
 inline constexpr const char* kChannelDomLayers[4] = {"dom.layer1", "dom.layer2", "dom.layer3", "dom.layer4"};
 
+// A compute pass of hairgen's rasteriser on the device, or a transfer between the host and the device,
+// in one frame (device_timer.h): the device's time in a pass, the host's in a transfer (its wait for the
+// device included), summed over its runs (a pass runs once a slab of rows, a prefix sum once a level).
+struct DeviceTime {
+  std::string name;      // a pass: its shader (glsl/NAME.glsl), "camera_keep"; a transfer, "camera_upload"
+  double seconds = 0.0;  // s
+  uint64_t bytes = 0;    // a transfer's
+  int runs = 0;
+};
+
 struct RenderTimings {
   double upload = 0.0, lightDepth = 0.0, opacity = 0.0, shading = 0.0, motion = 0.0, readback = 0.0;  // s
   double fragments = 0.0;  // of shading: the camera's hair fragments found by hairgen's rasteriser, s
+  // Where the rasteriser ran on the device: its passes and transfers, in the order each first ran.
+  std::vector<DeviceTime> devicePasses, transfers;
 };
 
 struct RenderOutput {

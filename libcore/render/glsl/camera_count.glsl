@@ -1,5 +1,6 @@
 // The camera's fragments on the device (camera_fragments.h), first pass: how many fragments each pixel
-// gets (those the head hides are none). The host sums them into each pixel's place in the lists.
+// gets (those the head hides are none). Their prefix sums (prefix_sum.glsl) are each pixel's place in
+// the lists.
 layout(binding = kUnitSubpixelData) uniform sampler2D uOpaque;  // R: the head's depth, metres
 uniform int uHasOpaque;
 uniform double uDepthUnit;  // kDepthUnit

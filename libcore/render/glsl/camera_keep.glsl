@@ -1,11 +1,11 @@
 // The camera's fragments on the device, third pass, per pixel: its list sorted by segment (the order the
 // CPU's bands draw them in), then kept as camera_fragments.cpp keeps them: the KEPT nearest, one
 // strand's consecutive pieces merged, the rest's coverage in the tail. For the pixels [uPixelLo,
-// uPixelHi) of a slab. The kept fragments' three words go to the pixel's place in Staging (the host's
-// sums of min(count, KEPT)), their count to Kept. A list the fill pass did not fill exactly (the two
+// uPixelHi) of a slab. The kept fragments' three words go to the pixel's place in Staging (the prefix
+// sum of min(count, KEPT)), their count to Kept. A list the fill pass did not fill exactly (the two
 // passes disagreed on a pixel's fragments) is reported, and the host draws the frame's fragments on the CPU.
 layout(local_size_x = 64) in;
-layout(std430, binding = 0) readonly buffer Offsets { uint offsetData[]; };  // within the slab
+layout(std430, binding = 0) readonly buffer Offsets { uint offsetData[]; };  // among every pixel's
 layout(std430, binding = 1) readonly buffer Counts { uint countData[]; };
 layout(std430, binding = 2) buffer Lists { uvec4 listData[]; };
 layout(std430, binding = 3) buffer Kept { uint keptData[]; };
@@ -14,6 +14,7 @@ layout(std430, binding = 5) readonly buffer KeepAt { uint keepAtData[]; };
 layout(std430, binding = 6) writeonly buffer Staging { uint stagingData[]; };
 layout(std430, binding = 7) readonly buffer Cursors { uint cursorData[]; };
 uniform uint uPixelLo, uPixelHi;
+uniform uint uSlabFirst;  // the slab's first pixel's offset
 uniform uint uFault;  // where in Kept a pixel whose list the fill pass did not fill exactly sets 1
 uniform double uDepthUnit;
 // The kept fragments, nearest first, a field an array (arrays of structures indexed at run time were
@@ -90,7 +91,7 @@ void main() {
   uint p = uPixelLo + (gl_WorkGroupID.y * gl_NumWorkGroups.x + gl_WorkGroupID.x) * gl_WorkGroupSize.x +
            gl_LocalInvocationID.x;
   if (p >= uPixelHi) return;
-  uint base = offsetData[p], n = countData[p];
+  uint base = offsetData[p] - uSlabFirst, n = countData[p];
   if (cursorData[p] != n) {
     keptData[uFault] = 1u;
     return;

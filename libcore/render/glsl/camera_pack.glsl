@@ -1,5 +1,5 @@
 // The camera's fragments on the device, last pass: each pixel's kept fragments from its place in Staging
-// into CameraFragments' layout, three words each from the pixel's first (the host's sums of the kept
+// into CameraFragments' layout, three words each from the pixel's first (the prefix sum of the kept
 // counts).
 layout(local_size_x = 256) in;
 layout(std430, binding = 0) readonly buffer First { uint firstData[]; };
