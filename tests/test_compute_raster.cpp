@@ -82,14 +82,14 @@ Strands tangle(int strands, unsigned seed) {
 constexpr glm::dvec4 kLayers{0.002, 0.006, 0.015, 0.04};
 
 // The device's prefix sums (the camera's lists' places) are the host's, modulo 2^32: for one word,
-// within one block of 1024, just past it, and over three levels of blocks; words past a word's range
-// (the sums wrap), a limit on each word, and the largest word found alongside.
+// within one block, just past it, and over two levels of blocks; words past a word's range (the sums
+// wrap), a limit on each word, and the largest word found alongside.
 TEST(ComputeRaster, PrefixSumsAreTheHostsModulo2To32) {
   SKIP_WITHOUT_COMPUTE_RASTER();
   std::mt19937 random(5);
   const PrefixSum prefixSum;
-  for (const size_t count :
-       {size_t(0), size_t(1), size_t(1023), size_t(1024), size_t(1025), size_t(1100000)}) {
+  const size_t block = PrefixSum::kBlock;
+  for (const size_t count : {size_t(0), size_t(1), block - 1, block, block + 1, 300 * block + 17}) {
     std::vector<uint32_t> words(count);
     for (uint32_t& w : words) w = random() % 8 == 0 ? uint32_t(random()) : uint32_t(random() % 40);
     const DeviceBuffer in(count * sizeof(uint32_t), words.data()), out((count + 1) * sizeof(uint32_t)),

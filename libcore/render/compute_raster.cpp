@@ -170,18 +170,20 @@ std::vector<T> DeviceBuffer::read(size_t count, size_t first) const {
 
 namespace {
 
-// Words a group of the prefix sum's first pass sums (glsl/prefix_sum.glsl: kScanBlock).
-constexpr size_t kScanBlock = 1024;
+std::string scanDefines(const char* pass) {
+  return std::string("#define ") + pass + "\n#define SCAN_LANES " + std::to_string(PrefixSum::kLanes) +
+         "u\n#define SCAN_PER_INVOCATION " + std::to_string(PrefixSum::kPerInvocation) + "u\n";
+}
 
 }  // namespace
 
 PrefixSum::PrefixSum()
-    : blocks_(computeStage(glsl::kPrefixSum, false, "#define SCAN_BLOCKS\n"), "prefix sum"),
-      add_(computeStage(glsl::kPrefixSum, false, "#define ADD_BLOCKS\n"), "prefix sum's blocks") {}
+    : blocks_(computeStage(glsl::kPrefixSum, false, scanDefines("SCAN_BLOCKS")), "prefix sum"),
+      add_(computeStage(glsl::kPrefixSum, false, scanDefines("ADD_BLOCKS")), "prefix sum's blocks") {}
 
 void PrefixSum::operator()(const DeviceBuffer& in, size_t count, const DeviceBuffer& out, uint32_t limit,
                            const DeviceBuffer* deepest) const {
-  const size_t sums = count + 1, blocks = (sums + kScanBlock - 1) / kScanBlock;
+  const size_t sums = count + 1, blocks = (sums + kBlock - 1) / kBlock;
   const DeviceBuffer blockSums(blocks * sizeof(uint32_t));
   blocks_.use();
   glUniform1ui(blocks_.loc("uSums"), GLuint(sums));
@@ -192,10 +194,10 @@ void PrefixSum::operator()(const DeviceBuffer& in, size_t count, const DeviceBuf
   out.bind(1);
   blockSums.bind(2);
   if (deepest) deepest->bind(3);
-  dispatch(blocks * 256, 256);
+  dispatch(blocks * kLanes, kLanes);
   glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT);
   if (blocks == 1) return;  // the block's sums are the sums
-  // Each block's place among the blocks: the blocks' totals summed alike (a level a 1024th the size).
+  // Each block's place among the blocks: the blocks' totals summed alike (a level a kBlock-th the size).
   const DeviceBuffer places((blocks + 1) * sizeof(uint32_t));
   (*this)(blockSums, blocks, places);
   add_.use();

@@ -66,6 +66,11 @@ bool withinLoopBudget(const raster::Projection& p);
 // programs (once per context: Program).
 class PrefixSum {
  public:
+  // The first pass's groups: kLanes invocations, each summing kPerInvocation words in turn, then the
+  // lanes' totals scanned in shared memory. On llvmpipe, which switches between a group's invocations
+  // at every barrier, long runs in turn and few lanes cost least (64 × 64: a 2-megapixel image's sums in
+  // 0.02 s there, 0.09 s at 256 × 4); on a GPU a lane's 64 words lie in 2 cache lines of its own.
+  static constexpr size_t kLanes = 64, kPerInvocation = 64, kBlock = kLanes * kPerInvocation;
   PrefixSum();
   void operator()(const DeviceBuffer& in, size_t count, const DeviceBuffer& out, uint32_t limit = UINT32_MAX,
                   const DeviceBuffer* deepest = nullptr) const;

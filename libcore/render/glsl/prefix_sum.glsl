@@ -2,21 +2,18 @@
 // (G. E. Blelloch, "Prefix sums and their applications", 1990: an up-sweep that sums a balanced tree in
 // place, then a down-sweep that hands each node the sum of everything to its left). Unsigned sums, modulo 2^32:
 // integer addition is associative, so the bits do not depend on the order the device adds in.
-// SCAN_BLOCKS: each group of 256 invocations scans a block of kScanBlock words (kScanPerInvocation in
-// turn per invocation, then the invocations' totals in shared memory), and writes the block's total;
-// ADD_BLOCKS: each word gets its block's place among the blocks (the blocks' totals, scanned).
-// The loops are short (8 steps each way, 4 words): far inside a software rasteriser's loop budget.
-layout(local_size_x = 256) in;
-const uint kScanPerInvocation = 4u;
-const uint kScanBlock = 256u * kScanPerInvocation;
+// SCAN_BLOCKS: each group of kScanLanes invocations scans a block of kScanBlock words
+// (kScanPerInvocation in turn per invocation, then the invocations' totals in shared memory), and
+// writes the block's total; ADD_BLOCKS: each word gets its block's place among the blocks (the blocks'
+// totals, scanned). The host defines SCAN_LANES and SCAN_PER_INVOCATION (compute_raster.h: PrefixSum).
+// An invocation loops 2 log2(kScanLanes) + 2 kScanPerInvocation times: far inside a software
+// rasteriser's loop budget.
+const uint kScanLanes = SCAN_LANES, kScanPerInvocation = SCAN_PER_INVOCATION;
+const uint kScanBlock = kScanLanes * kScanPerInvocation;
 uniform uint uSums;  // the sums written: words [0, uSums) of Out
 
-uint invocationIndex() {
-  return (gl_WorkGroupID.y * gl_NumWorkGroups.x + gl_WorkGroupID.x) * gl_WorkGroupSize.x +
-         gl_LocalInvocationID.x;
-}
-
 #ifdef SCAN_BLOCKS
+layout(local_size_x = SCAN_LANES) in;
 layout(std430, binding = 0) readonly buffer In { uint inData[]; };
 layout(std430, binding = 1) writeonly buffer Out { uint outData[]; };
 layout(std430, binding = 2) writeonly buffer BlockSums { uint blockSumData[]; };
@@ -24,7 +21,7 @@ layout(std430, binding = 3) buffer Deepest { uint deepestData[]; };
 uniform uint uInputs;  // words of In; those past them count 0
 uniform uint uLimit;   // each word counts at most this much
 uniform int uDeepest;  // 1: the largest word of In raises Deepest's first
-shared uint partial[256];
+shared uint partial[kScanLanes];
 shared uint groupDeepest;
 
 void main() {
@@ -41,20 +38,20 @@ void main() {
   }
   partial[lane] = sum;
   if (lane == 0u) groupDeepest = 0u;
-  for (uint d = 1u; d < 256u; d <<= 1) {
+  for (uint d = 1u; d < kScanLanes; d <<= 1) {
     barrier();
     uint at = (lane + 1u) * 2u * d - 1u;
-    if (at < 256u) partial[at] += partial[at - d];
+    if (at < kScanLanes) partial[at] += partial[at - d];
   }
   barrier();
   if (lane == 0u) {
-    blockSumData[block] = partial[255];
-    partial[255] = 0u;
+    blockSumData[block] = partial[kScanLanes - 1u];
+    partial[kScanLanes - 1u] = 0u;
   }
-  for (uint d = 128u; d > 0u; d >>= 1) {
+  for (uint d = kScanLanes / 2u; d > 0u; d >>= 1) {
     barrier();
     uint at = (lane + 1u) * 2u * d - 1u;
-    if (at < 256u) {
+    if (at < kScanLanes) {
       uint left = partial[at - d];
       partial[at - d] = partial[at];
       partial[at] += left;
@@ -70,10 +67,12 @@ void main() {
 #endif
 
 #ifdef ADD_BLOCKS
+layout(local_size_x = 256) in;
 layout(std430, binding = 1) buffer Out { uint outData[]; };
 layout(std430, binding = 2) readonly buffer BlockSums { uint blockSumData[]; };  // scanned
 void main() {
-  uint i = invocationIndex();
+  uint i = (gl_WorkGroupID.y * gl_NumWorkGroups.x + gl_WorkGroupID.x) * gl_WorkGroupSize.x +
+           gl_LocalInvocationID.x;
   if (i < uSums) outData[i] += blockSumData[i / kScanBlock];
 }
 #endif
