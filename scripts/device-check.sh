@@ -201,6 +201,23 @@ run() {
       say "(d) peak memory $(awk -v p="$peak" -v c="$cache" 'BEGIN {printf "%.0f MB = %.2f x the cache'"'"'s %.0f MB", p / 1e6, p / c, c / 1e6}') (target 3 x)"
       say "    device start: $(json "$figures/stats.6.json" "d['device'].get('start', 'not recorded by this build')")"
       say "    rasteriser: $(json "$figures/stats.6.json" "d['device'].get('rasteriser', 'cpu (this build has only the CPU one)')"), the camera's fragments $(for i in 2 3 4 5 6; do json "$figures/stats.$i.json" "d['device'].get('hairFragmentSeconds', float('nan'))"; done | median) s of the shading (median)"
+      # Where the rasteriser's time on the device goes: each compute pass (GL timestamps) and each
+      # transfer (the host's time, waits included), medians of the 5 runs (docs/files.md, --stats).
+      python3 - "$figures" <<'PY' 2>&1 | tee -a "$summary"
+import json, statistics, sys
+runs = [json.load(open(f"{sys.argv[1]}/stats.{i}.json"))["device"] for i in range(2, 7)]
+for key, what in (("passes", "device"), ("transfers", "host")):
+    last = runs[-1].get(key, {})
+    if not last:
+        print(f"    no device.{key} (a build before them, or the CPU's rasteriser ran)")
+        continue
+    median = {n: statistics.median(r[key][n]["seconds"] for r in runs if n in r.get(key, {})) for n in last}
+    print(f"    device.{key} ({what} ms, median of 5): " + ", ".join(
+        f"{n} {s * 1e3:.3f}" + (f" ({last[n]['bytes']:,} bytes)" if "bytes" in last[n] else "") +
+        (f" x{last[n]['runs']}" if last[n]["runs"] > 1 else "") for n, s in median.items()))
+    if key == "passes":
+        print(f"    all passes: {sum(median.values()) * 1e3:.3f} ms (target for the GPU passes: 5 ms)")
+PY
       # The same frame with the rasteriser on the CPU's threads: the same EXRs to the byte (issue 34:
       # one rasteriser, one answer), and what it costs here.
       local t0 t1

@@ -44,7 +44,7 @@ inline constexpr const char* kChannelDomLayers[4] = {"dom.layer1", "dom.layer2",
 // in one frame (device_timer.h): the device's time in a pass, the host's in a transfer (its wait for the
 // device included), summed over its runs (a pass runs once a slab of rows, a prefix sum once a level).
 struct DeviceTime {
-  std::string name;      // a pass: its shader (glsl/NAME.glsl), "camera_keep"; a transfer, "camera_upload"
+  std::string name;      // a pass: after its shader (glsl/camera_keep.glsl: "camera_keep"); "camera_upload"
   double seconds = 0.0;  // s
   uint64_t bytes = 0;    // a transfer's
   int runs = 0;
