@@ -241,5 +241,34 @@ TEST(ComputeRaster, ARenderIsTheSameBitsWhereverTheRasteriserRuns) {
     EXPECT_TRUE(device.dom.planes[c] == cpu.dom.planes[c]) << cpu.dom.channels[c];
 }
 
+// Strands so wide that a segment's texels pass a software rasteriser's loop budget (withinLoopBudget):
+// there the CPU draws them, the device elsewhere, and the image is the same bits either way.
+TEST(ComputeRaster, ARenderPastTheLoopBudgetIsTheSameBits) {
+  SKIP_WITHOUT_COMPUTE_RASTER();
+  test::Job job = test::loadJob("thesis/coupe3/setup.txt", SetupUse::kRender);
+  Strands wide;
+  for (int i = 0; i < 4; ++i) {
+    const float y = 0.05f * float(i) - 0.08f;
+    wide.addStrand({{-0.4f, y, 0.0f}, {0.0f, y + 0.01f, 0.02f}, {0.4f, y, 0.0f}});
+  }
+  RenderSettings r = job.config.render;
+  r.resolution = {320, 240};
+  r.strandWidth = 0.2;  // metres: a segment's texels past the budget, in the light's view and the camera's
+  RenderOptions options;
+  options.keepDom = true;
+  options.force = true;  // sheets, not hairs, on purpose
+  options.rasteriser = RenderInput::Rasteriser::kCpu;
+  const RenderOutput cpu = render(gl(), wide, nullptr, job.config.visuality, r, {}, options);
+  options.rasteriser = RenderInput::Rasteriser::kDevice;
+  const RenderOutput device = render(gl(), wide, nullptr, job.config.visuality, r, {}, options);
+  EXPECT_GT(cpu.hairFragments, 10000u);
+  EXPECT_EQ(device.rasterisedOnDevice, !softwareRasteriser());
+  ASSERT_EQ(device.beauty.channels, cpu.beauty.channels);
+  for (size_t c = 0; c < cpu.beauty.channels.size(); ++c)
+    EXPECT_TRUE(device.beauty.planes[c] == cpu.beauty.planes[c]) << cpu.beauty.channels[c];
+  for (size_t c = 0; c < cpu.dom.channels.size(); ++c)
+    EXPECT_TRUE(device.dom.planes[c] == cpu.dom.planes[c]) << cpu.dom.channels[c];
+}
+
 }  // namespace
 }  // namespace hairgen

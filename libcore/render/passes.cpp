@@ -198,8 +198,12 @@ struct Scene::Preparation {
   std::unique_ptr<raster::Bands> cameraBands;  // when it draws the camera's hair
   // The light's projected for the device, when the rasteriser runs there (Scene::onDevice).
   std::unique_ptr<raster::Projection> lightProjection;
-  bool software = false;  // the device rasterises in software: withinLoopBudget applies
+  bool software = false;  // the device rasterises in software
   tbb::task_group work;
+
+  // Whether the device draws a projection: on a software rasteriser only one within its loop budget
+  // (compute_raster.h: withinLoopBudget), the CPU the rest. Any thread may ask (`software` is known).
+  bool deviceDraws(const raster::Projection& p) const { return !software || withinLoopBudget(p); }
 
   Preparation(const Scene& scene, const RenderInput& in) {
     // A pixel's width in metres at the nearest of the scene: depth over focalPx on the view's axis, and
@@ -225,18 +229,15 @@ struct Scene::Preparation {
     const bool cameraByRasteriser = scene.rasterised;
     const bool onDevice = scene.onDevice;
     software = onDevice && softwareRasteriser();
-    // On a software rasteriser a projection the device cannot draw within its loop budget
-    // (compute_raster.h: withinLoopBudget) is drawn on the CPU.
-    auto forDevice = [software = software](raster::Projection&& p) {
-      return software && !withinLoopBudget(p) ? nullptr : std::make_unique<raster::Projection>(std::move(p));
-    };
     // One after the other, each on every thread. For the CPU the light's projection is freed (into its
     // maps) before the camera's is made, in its storage. For the device the camera's is made by the
     // Scene once the light's is uploaded and let go (Scene::Scene), so one projection is held at a time.
     work.run([=, this, &hair, &lightView, &subpixelView, &r] {
       raster::Bands spent;
-      if (lightByRasteriser && onDevice)
-        lightProjection = forDevice(raster::project(hair, lightView, r.strandWidth));
+      if (lightByRasteriser && onDevice) {
+        raster::Projection p = raster::project(hair, lightView, r.strandWidth);
+        if (deviceDraws(p)) lightProjection = std::make_unique<raster::Projection>(std::move(p));
+      }
       if (lightByRasteriser && !lightProjection)
         lightMaps = std::make_unique<HairLightMaps>(
             rasteriseLightMaps(hair, lightView, r.strandWidth, r.layerSizes, &spent));
@@ -295,12 +296,11 @@ Scene::Scene(const RenderInput& in)
     preparing->lightProjection.reset();
   }
   if (rasterised && onDevice) {
-    // On a software rasteriser a projection past its loop budget is drawn on the CPU.
     raster::Projection p = raster::project(*in.hair, subpixel, in.settings.strandWidth);
-    if (preparing->software && !withinLoopBudget(p))
-      cameraBands = std::make_unique<raster::Bands>(raster::intoBands(std::move(p)));
-    else
+    if (preparing->deviceDraws(p))
       cameraOnDevice = std::make_unique<DeviceProjection>(p, &timer, "camera_upload");
+    else
+      cameraBands = std::make_unique<raster::Bands>(raster::intoBands(std::move(p)));
   }
   if (preparing->cameraChords)
     cameraLines = std::make_unique<LineStrips>(preparing->camera, kCameraChunkVertices);
