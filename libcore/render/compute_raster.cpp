@@ -259,14 +259,11 @@ void computeLightMaps(const DeviceProjection& hair, const glm::dvec4& layerSizes
     overflow.clear(0);
     sums.use();
     setRaster(sums, hair);
-    // As light_maps.cpp: each layer's far end from where the hair begins; a depth behind it is below
-    // 2^31 units, so an end past that is as good as INT32_MAX.
+    // A depth behind where the hair begins is below 2^31 units, so an end past that is as good as
+    // INT32_MAX (the uniform's largest).
+    const std::array<int64_t, 3> far = layerEnds(layerSizes);
     GLint ends[3];
-    double cumulative = 0.0;
-    for (int k = 0; k < 3; ++k) {
-      cumulative += layerSizes[k];
-      ends[k] = GLint(std::clamp<double>(std::llround(cumulative / kDepthUnit), INT32_MIN, INT32_MAX));
-    }
+    for (int k = 0; k < 3; ++k) ends[k] = GLint(std::clamp<int64_t>(far[k], INT32_MIN, INT32_MAX));
     glUniform3iv(sums.loc("uLayerEnds"), 1, ends);
     begins.bind(2);
     layers.bind(3);

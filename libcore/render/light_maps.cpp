@@ -62,6 +62,16 @@ std::vector<glm::vec4> HairLightMaps::opacity(double strandOpacity) const {
   return out;
 }
 
+std::array<int64_t, 3> layerEnds(const glm::dvec4& layerSizes) {
+  std::array<int64_t, 3> ends;
+  double cumulative = 0.0;
+  for (int k = 0; k < 3; ++k) {
+    cumulative += layerSizes[k];
+    ends[k] = std::llround(cumulative / kDepthUnit);
+  }
+  return ends;
+}
+
 HairLightMaps rasteriseLightMaps(const Strands& hair, const View& light, double strandWidth,
                                  const glm::dvec4& layerSizes, raster::Bands* spent) {
   const int size = light.width;
@@ -70,12 +80,7 @@ HairLightMaps rasteriseLightMaps(const Strands& hair, const View& light, double 
   maps.size = size;
   maps.start.assign(size_t(size) * size, kNoHair);
   maps.layers.assign(size_t(size) * size, glm::uvec4(0));
-  int64_t ends[4];
-  double cumulative = 0.0;
-  for (int k = 0; k < 4; ++k) {
-    cumulative += layerSizes[k];
-    ends[k] = std::llround(cumulative / kDepthUnit);
-  }
+  const std::array<int64_t, 3> ends = layerEnds(layerSizes);
   // Each band by one thread, its fragments kept while it is drawn (a band's, not the map's): first
   // where the hair begins in its rows, then the layers' sums.
   tbb::enumerable_thread_specific<FragmentBlocks> kept;

@@ -9,6 +9,7 @@
 // maps are the same bits on any thread count. Pure math: no OpenGL.
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <vector>
 
@@ -30,6 +31,11 @@ struct HairLightMaps {
   // Each layer's opacity: coverage × `strandOpacity` (a texel covered once by a strand is that opaque).
   std::vector<glm::vec4> opacity(double strandOpacity) const;
 };
+
+// The first three layers' far ends behind where the hair begins, in kDepthUnit: `layerSizes` (metres)
+// summed in turn, each sum rounded. The fourth layer holds everything behind. The CPU's maps and the
+// device's (compute_raster.h) both take them from here.
+std::array<int64_t, 3> layerEnds(const glm::dvec4& layerSizes);
 
 // `light`: a square perspective view (its width texels per side). `strandWidth`: the strands' diameter,
 // metres. `layerSizes`: the four layers' depths, metres. A segment with a point nearer than the near
