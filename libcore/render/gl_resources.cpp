@@ -81,6 +81,21 @@ GLuint compileStage(GLenum type, const StageSource& source, const char* program)
                 " stage: line " + std::to_string(error.line) + ": " + error.text);
 }
 
+// The compiled `stages` linked into a program, and deleted: the program, or 0 with the linker's first
+// error in `error`.
+GLuint linkStages(std::initializer_list<GLuint> stages, CompilerMessage& error) {
+  const GLuint linked = glCreateProgram();
+  for (const GLuint s : stages) glAttachShader(linked, s);
+  glLinkProgram(linked);
+  for (const GLuint s : stages) glDeleteShader(s);
+  GLint ok = 0;
+  glGetProgramiv(linked, GL_LINK_STATUS, &ok);
+  if (ok) return linked;
+  error = firstCompilerError(infoLog(linked, true));
+  glDeleteProgram(linked);
+  return 0;
+}
+
 }  // namespace
 
 namespace {
@@ -129,16 +144,9 @@ Program::Program(const StageSource& compute, const char* name) {
 }
 
 GLuint Program::linkCompute(const StageSource& compute, const char* name) {
-  const GLuint c = compileStage(GL_COMPUTE_SHADER, compute, name);
-  const GLuint linked = glCreateProgram();
-  glAttachShader(linked, c);
-  glLinkProgram(linked);
-  glDeleteShader(c);
-  GLint ok = 0;
-  glGetProgramiv(linked, GL_LINK_STATUS, &ok);
-  if (ok) return linked;
-  const CompilerMessage error = firstCompilerError(infoLog(linked, true));
-  glDeleteProgram(linked);
+  CompilerMessage error;
+  if (const GLuint linked = linkStages({compileStage(GL_COMPUTE_SHADER, compute, name)}, error))
+    return linked;
   renderFailure(std::string("linking the ") + name + " program: " + error.text);
 }
 
@@ -151,17 +159,8 @@ GLuint Program::link(const StageSource& vertex, const StageSource& fragment, con
     glDeleteShader(v);
     throw;
   }
-  const GLuint id = glCreateProgram();
-  glAttachShader(id, v);
-  glAttachShader(id, f);
-  glLinkProgram(id);
-  glDeleteShader(v);
-  glDeleteShader(f);
-  GLint ok = 0;
-  glGetProgramiv(id, GL_LINK_STATUS, &ok);
-  if (ok) return id;
-  const CompilerMessage error = firstCompilerError(infoLog(id, true));
-  glDeleteProgram(id);
+  CompilerMessage error;
+  if (const GLuint linked = linkStages({v, f}, error)) return linked;
   // A link error is about the two stages together: it names the custom one (the fragment stage's file
   // when both are), and the other.
   const StageSource* blamed = fragment.custom ? &fragment : vertex.custom ? &vertex : nullptr;
