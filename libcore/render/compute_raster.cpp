@@ -208,7 +208,9 @@ void PrefixSum::operator()(const DeviceBuffer& in, size_t count, const DeviceBuf
   glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT);
 }
 
-raster::Projection DeviceProjection::read() const {
+raster::Projection DeviceProjection::read(DeviceTimer* timer) const {
+  const DeviceTimer::Transfer timed(timer, "camera_projection_read",
+                                    vertices.bytes + segments * sizeof(uint32_t));
   raster::Projection p;
   p.width = width;
   p.height = height;

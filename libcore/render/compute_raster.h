@@ -84,7 +84,8 @@ class PrefixSum {
 struct DeviceProjection {
   explicit DeviceProjection(const raster::Projection& p, DeviceTimer* timer = nullptr,
                             const char* upload = "projection_upload");
-  raster::Projection read() const;  // back from the device, for the CPU's rasteriser
+  // Back from the device, for the CPU's rasteriser; with a timer, its transfer camera_projection_read.
+  raster::Projection read(DeviceTimer* timer = nullptr) const;
   int width, height;
   size_t segments;
   DeviceBuffer vertices, segmentList;

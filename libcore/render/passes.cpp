@@ -554,7 +554,7 @@ ShadedImage shadingPass(Scene& scene, const LightDepth& depth, const Texture& op
   // On the CPU: where the rasteriser runs there, or its fragments did not fit the device's buffers (the
   // projection read back from the device: the hair itself may be gone).
   std::optional<raster::Bands> readBack;
-  if (!scene.cameraBands) readBack.emplace(raster::intoBands(scene.cameraOnDevice->read()));
+  if (!scene.cameraBands) readBack.emplace(raster::intoBands(scene.cameraOnDevice->read(&scene.timer)));
   const raster::Bands& bands = scene.cameraBands ? *scene.cameraBands : *readBack;
   const CameraFragments f =
       cameraFragments(bands, scene.kept, headDepth.empty() ? nullptr : headDepth.data(), atlasTexels);
