@@ -172,14 +172,14 @@ namespace {
 
 std::string scanDefines(const char* pass) {
   return std::string("#define ") + pass + "\n#define SCAN_LANES " + std::to_string(PrefixSum::kLanes) +
-         "u\n#define SCAN_PER_INVOCATION " + std::to_string(PrefixSum::kPerInvocation) + "u\n";
+         "\n#define SCAN_PER_INVOCATION " + std::to_string(PrefixSum::kPerInvocation) + "\n";
 }
 
 }  // namespace
 
 PrefixSum::PrefixSum()
     : blocks_(computeStage(glsl::kPrefixSum, false, scanDefines("SCAN_BLOCKS")), "prefix sum"),
-      add_(computeStage(glsl::kPrefixSum, false, scanDefines("ADD_BLOCKS")), "prefix sum's blocks") {}
+      add_(computeStage(glsl::kPrefixSum, false, scanDefines("ADD_BLOCKS")), "prefix sum's add") {}
 
 void PrefixSum::operator()(const DeviceBuffer& in, size_t count, const DeviceBuffer& out, uint32_t limit,
                            const DeviceBuffer* deepest) const {

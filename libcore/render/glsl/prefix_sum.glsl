@@ -8,7 +8,7 @@
 // totals, scanned). The host defines SCAN_LANES and SCAN_PER_INVOCATION (compute_raster.h: PrefixSum).
 // An invocation loops 2 log2(kScanLanes) + 2 kScanPerInvocation times: far inside a software
 // rasteriser's loop budget.
-const uint kScanLanes = SCAN_LANES, kScanPerInvocation = SCAN_PER_INVOCATION;
+const uint kScanLanes = uint(SCAN_LANES), kScanPerInvocation = uint(SCAN_PER_INVOCATION);
 const uint kScanBlock = kScanLanes * kScanPerInvocation;
 uniform uint uSums;  // the sums written: words [0, uSums) of Out
 
@@ -25,8 +25,10 @@ shared uint partial[kScanLanes];
 shared uint groupDeepest;
 
 void main() {
+  // Barriers only in uniform control flow: a group past the end (dispatch's rows of groups) runs
+  // through them too, reading and writing nothing.
   uint block = gl_WorkGroupID.y * gl_NumWorkGroups.x + gl_WorkGroupID.x;
-  if (block * kScanBlock >= uSums) return;  // a whole group past the end (dispatch's rows of groups)
+  bool inside = block * kScanBlock < uSums;
   uint lane = gl_LocalInvocationID.x, first = block * kScanBlock + lane * kScanPerInvocation;
   uint before[kScanPerInvocation];
   uint sum = 0u, deepest = 0u;
@@ -45,7 +47,7 @@ void main() {
   }
   barrier();
   if (lane == 0u) {
-    blockSumData[block] = partial[kScanLanes - 1u];
+    if (inside) blockSumData[block] = partial[kScanLanes - 1u];
     partial[kScanLanes - 1u] = 0u;
   }
   for (uint d = kScanLanes / 2u; d > 0u; d >>= 1) {
