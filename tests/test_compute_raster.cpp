@@ -2,7 +2,8 @@
 // camera_fragments.h) on this machine's OpenGL (llvmpipe in CI): the same integer maps and the same kept
 // fragments, to the bit, for hair crossing every way, strands thinner and wider than a pixel, segments
 // seen end on, strands running off the image, behind a head's depth, the camera's rows in slabs, sums
-// past a word, and segments handed to the device in a shuffled order.
+// past a word, segments handed to the device in a shuffled order, and strands past a software
+// rasteriser's loop budget; and the device's prefix sums against the host's.
 #include <gtest/gtest.h>
 
 #include <algorithm>
