@@ -20,13 +20,13 @@
 //             Uniforms uView, uProj, uViewport, uFocalPx, uWidth, uOpacity, uMinWidth. Writes
 //             gl_Position and vWorld, vTangent, vColor, vNormal (vec3), vAlpha, vDepth (float: metres
 //             along the view axis; the light's passes read it).
-//   HairFrag  reads those outputs (declared one name to an `in` declaration: where hairgen's
-//             rasteriser draws the hair they are globals it sets, and it takes those declarations
-//             out); uniforms uEye, uLightPosition, uLightColor, uAmbient, uAmbientColor,
-//             uDiffuseColor, uSpecularColor, uGlossiness, uModel, uBlend; writes oColor (location 0:
-//             RGB, and the strand's opacity: the pixel's blend reads it where hairgen's rasteriser
-//             draws the hair; otherwise the image's A is the sub-pixels something was drawn in) and
-//             oData (location 1: Z in metres, hair opacity 1, the shadow, 0).
+//   HairFrag  reads those outputs (where hairgen's rasteriser draws the hair, plain globals that it
+//             sets: docs/rendering.md, Custom shaders, says what that asks of the file); uniforms uEye,
+//             uLightPosition, uLightColor, uAmbient, uAmbientColor, uDiffuseColor, uSpecularColor,
+//             uGlossiness, uModel, uBlend; writes oColor (location 0: RGB, and the strand's opacity: the
+//             pixel's blend reads it where hairgen's rasteriser draws the hair; otherwise the image's A is
+//             the sub-pixels something was drawn in) and oData (location 1: Z in metres, hair opacity 1, the
+//             shadow, 0).
 //   HeadVert  attributes aPosition, aNormal at locations 0-1; uniforms uView, uProj; writes gl_Position
 //             and vWorld, vNormal, vDepth.
 //   HeadFrag  reads those; uniforms uLightPosition, uLightColor, uAmbient, uHeadColor; writes oColor

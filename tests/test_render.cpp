@@ -895,66 +895,90 @@ TEST(Render, ABrokenCustomHairFragmentIsAnInputErrorAtItsFileAndLine) {
 }
 
 // Where the rasteriser's fragments are shaded (the atlas), a HairFrag's inputs are globals hairgen sets:
-// its `in` declarations of them, however written, are blanked out, lines kept, and nothing else is.
-TEST(Render, TheAtlasTakesOutAHairFragsInputDeclarationsAndKeepsItsLines) {
+// each `in` declaration of them, however qualified, loses its qualifiers and nothing else (every line
+// and column stays the file's), and hairgen's main() after the file sets the names it declared.
+TEST(Render, TheAtlasMakesAHairFragsInputDeclarationsGlobalsAndKeepsItsColumns) {
   const std::string body =
-      "layout(location = 0) in vec3 vWorld;\n"
-      "flat in\n"
-      "  float vAlpha;\n"
-      "in highp float vDepth ;\n"
+      "layout(location = 0) in vec3 vWorld, vTangent;\n"
+      "in flat\n"
+      "  vec3 vColor /* strand colour */;\n"
+      "in vec3 vWorld2, vNormal;\n"
       "in vec3 vOther;\n"
-      "float f(in float x) { return x; }  // in vec3 vTangent; in a comment goes too\n"
+      "float f(in float x) { return x; }  // in vec3 vNormal;\n"
       "void main() {}\n";
   const std::string text = assembleStage({.atlas = true}, body);
   const std::string own = text.substr(text.rfind("#line 1\n") + 8);
-  EXPECT_EQ(std::count(own.begin(), own.end(), '\n'), std::count(body.begin(), body.end(), '\n')) << own;
-  for (const char* gone : {"in vec3 vWorld", "float vAlpha", "vDepth", "vTangent"})
-    EXPECT_EQ(own.find(gone), std::string::npos) << gone << " in:\n" << own;
-  for (const char* kept : {"in vec3 vOther;", "float f(in float x)", "void main() {}"})
-    EXPECT_NE(own.find(kept), std::string::npos) << kept << " not in:\n" << own;
+  ASSERT_EQ(own.substr(0, body.size()).size(), body.size());
+  const std::string kept = own.substr(0, body.size());
+  const std::string expected =
+      "                        vec3 vWorld, vTangent;\n"
+      "       \n"
+      "  vec3 vColor /* strand colour */;\n"
+      "in vec3 vWorld2, vNormal;\n"  // not all hair inputs: left as it is
+      "in vec3 vOther;\n"
+      "float f(in float x) { return x; }  // in vec3 vNormal;\n"
+      "void main() {}\n";
+  EXPECT_EQ(kept, expected);
+  const std::string after = own.substr(body.size());
+  for (const char* set : {"vWorld = ", "vTangent = ", "vColor = ", "hairgenShade();"})
+    EXPECT_NE(after.find(set), std::string::npos) << set << " not in:\n" << after;
+  for (const char* unset : {"vNormal = ", "vAlpha = ", "vDepth = ", "hairgenAtlasRows - 1"})
+    EXPECT_EQ(after.find(unset), std::string::npos) << unset << " in:\n" << after;
   EXPECT_NE(assembleStage({}, body).find(body), std::string::npos) << "only the atlas' stages change";
+  EXPECT_EQ(assembleStage({.atlas = true}, "in float vAlpha;\n").find("hairgenShade();"), std::string::npos)
+      << "no main(): none of hairgen's either, so the linker says what is missing";
 }
 
-// The same through the renderer: a HairFrag that declares its inputs as a TD might write them shades the
-// rasteriser's fragments with them, and its compiler errors keep the file's line numbers.
+// The same through the renderer: hairgen's own HairFrag text with its inputs declared as a TD might
+// write them (two to a declaration, qualifiers in another order, comments, gl_FragCoord redeclared with
+// rows from the top) shades the rasteriser's fragments as hairgen's own stage does, over an atlas of
+// several rows; and a compiler error in it keeps the file's line.
 TEST(Render, AHairFragsInputsReachItWhateverItsDeclarationsLookLike) {
   test::TempDir dir("hairfrag");
+  const std::string own =
+      readFileText(test::sourceDir() / "libcore" / "render" / "glsl" / "hair_fragment.glsl");
   const std::string declarations =
-      "layout(location = 4) in\n"
-      "  float vAlpha;\n"
-      "smooth in float vDepth;\n"
-      "in vec3 vWorld;\n"
-      "layout(location = 0) out vec4 oColor;\n"
-      "layout(location = 1) out vec4 oData;\n"
-      "float opaque(in float a) { return a; }\n";
-  const CustomShaders shaders =
-      customHairFrag(dir, declarations +
-                              "void main() {\n"
-                              "  oColor = vec4(vWorld.x > 0.0 ? 1.0 : 0.5, 0.0, 0.0, "
-                              "opaque(vAlpha));\n"
-                              "  oData = vec4(vDepth, 1.0, 1.0, 0.0);\n"
-                              "}\n");
+      "in vec3 vWorld;\nin vec3 vTangent;\nin vec3 vColor;\nin vec3 vNormal;\nin float vAlpha;\nin float "
+      "vDepth;\n";
+  const size_t at = own.find(declarations);
+  ASSERT_NE(at, std::string::npos) << "hair_fragment.glsl declares its inputs otherwise now";
+  const std::string odd =
+      "layout(location = 0) in vec3 vWorld, vTangent;  // two at once\n"
+      "in flat vec3 vColor;\n"
+      "smooth in /* a comment */ vec3 vNormal;\n"
+      "in float vAlpha /* coverage x StrandOpacity */;\n"
+      "layout(origin_upper_left) in vec4 gl_FragCoord;\n"
+      "in float vDepth;\n";
+  const std::string text = own.substr(0, at) + odd + own.substr(at + declarations.size());
   Strands s;
-  addStraight(s, {-0.04f, 0, 0}, {0.04f, 0, 0});
-  RenderSettings r = frontCamera(64, 1);
-  r.strandWidth = 0.012;
-  RenderOutput out = renderStrands(s, r, nullptr, Visuality{}, shaders);
-  int left = 0, right = 0;
-  for (int y = 0; y < 64; ++y)
-    for (int x = 0; x < 64; ++x) {
-      if (out.beauty.at(kChannelOpacity, x, y) < kCovered || x == 31 || x == 32) continue;
-      EXPECT_NEAR(out.beauty.at("R", x, y), x < 32 ? 0.5f : 1.0f, 1e-3f) << x << "," << y;
-      ++(x < 32 ? left : right);
-    }
-  EXPECT_GT(left, 20);
-  EXPECT_GT(right, 20);
-  const CustomShaders broken =
-      customHairFrag(dir, declarations + "void main() {\n  oColor = vec4(foo);\n}\n");
+  for (int k = 0; k < 40; ++k) {
+    const float y = -0.035f + 0.07f * float(k) / 39.0f;
+    addStraight(s, {-0.04f, y, 0.01f * float(k % 3)}, {0.04f, y + 0.01f, 0.0f});
+  }
+  RenderSettings r = frontCamera(128, 1);
+  r.strandWidth = 0.002;
+  r.strandOpacity = 0.6;
+  const RenderOutput reference = renderStrands(s, r);
+  const RenderOutput custom = renderStrands(s, r, nullptr, Visuality{}, customHairFrag(dir, text));
+  ASSERT_GT(custom.hairFragments, 4096u) << "an atlas of two rows or more";
+  int hair = 0;
+  for (const char* c : {"R", "G", "B", "A"})
+    for (int y = 0; y < 128; ++y)
+      for (int x = 0; x < 128; ++x) {
+        ASSERT_NEAR(custom.beauty.at(c, x, y), reference.beauty.at(c, x, y), 2e-3f)
+            << c << " " << x << "," << y;
+        hair += std::string(c) == "A" && reference.beauty.at(c, x, y) > 0.1f;
+      }
+  EXPECT_GT(hair, 2000);
+  const size_t mainAt = text.find("void main()");
+  const int mainLine = int(std::count(text.begin(), text.begin() + ptrdiff_t(mainAt), '\n')) + 1;
+  std::string broken = text;
+  broken.insert(text.find('\n', mainAt) + 1, "  foo = 1;\n");
   try {
-    renderStrands(s, r, nullptr, Visuality{}, broken);
+    renderStrands(s, r, nullptr, Visuality{}, customHairFrag(dir, broken));
     FAIL() << "a HairFrag that does not compile rendered";
   } catch (const InputError& e) {
-    EXPECT_EQ(e.where().line, 9) << e.what();
+    EXPECT_EQ(e.where().line, mainLine + 1) << e.what();
   }
 }
 

@@ -459,7 +459,9 @@ ShadedImage blendHair(const Scene& scene, const FragmentBuffers& f, const Shaded
     p.set("hairgenHasColor", scene.hair.hasColors ? 1 : 0);
     p.set("hairgenHasNormal", scene.hair.hasNormals ? 1 : 0);
     p.set("hairgenOpacity", float(scene.settings.strandOpacity));
+    p.set("uOpacity", float(scene.settings.strandOpacity));  // a HairFrag may read it, as on OpenGL's lines
     p.set("hairgenAtlasWidth", atlasWidth);
+    p.set("hairgenAtlasRows", int(rows));
     p.set("hairgenFragmentCount", int(f.count));  // requireShadable: within the atlas
     glDrawArrays(GL_TRIANGLES, 0, 3);             // one triangle over the atlas
     checkGl("the hair's shading");

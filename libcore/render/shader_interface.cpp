@@ -3,8 +3,10 @@
 #include <algorithm>
 #include <cctype>
 #include <charconv>
+#include <iterator>
 #include <regex>
 #include <sstream>
+#include <vector>
 
 #include "glsl/embedded_glsl.h"
 #include "libcore/config/params.h"
@@ -63,22 +65,68 @@ std::string glslFloat(float value) {
   return s;
 }
 
-// `body` with its `in` declarations of the hair's shading inputs blanked out, for the atlas
-// (StagePrelude::atlas): `[layout(...)] [qualifiers] in <type> vWorld;` and the like, one name each, the
-// line breaks in them kept.
-std::string atlasInputsAsGlobals(const std::string& body) {
-  static const std::regex declaration(
-      R"((layout\s*\([^)]*\)\s*)?((flat|smooth|noperspective|centroid|sample|highp|mediump|lowp)\s+)*)"
-      R"(\bin\s+((highp|mediump|lowp)\s+)?\w+\s+(vWorld|vTangent|vColor|vNormal|vAlpha|vDepth)\s*;)");
-  std::string out;
-  auto last = body.cbegin();
-  for (std::sregex_iterator m(body.begin(), body.end(), declaration), end; m != end; ++m) {
-    out.append(last, (*m)[0].first);
-    const std::string removed = m->str();
-    out.append(size_t(std::count(removed.begin(), removed.end(), '\n')), '\n');
-    last = (*m)[0].second;
+// The hair shading stage's inputs, as hair_vertex.glsl writes them, in the order hairgenInputs()
+// (glsl/atlas_inputs.glsl) gives them.
+constexpr const char* kHairInputs[] = {"vWorld", "vTangent", "vColor", "vNormal", "vAlpha", "vDepth"};
+
+// `text` with each comment turned to spaces (its line breaks kept): the same length, so what is found
+// in it is at the same place in `text`.
+std::string withoutComments(const std::string& text) {
+  std::string out = text;
+  for (size_t i = 0; i + 1 < out.size(); ++i) {
+    if (out[i] != '/' || (out[i + 1] != '/' && out[i + 1] != '*')) continue;
+    const bool line = out[i + 1] == '/';
+    size_t end = line ? out.find('\n', i) : out.find("*/", i + 2);
+    end = end == std::string::npos ? out.size() : (line ? end : end + 2);
+    for (size_t k = i; k < end; ++k)
+      if (out[k] != '\n') out[k] = ' ';
+    i = end - 1;
   }
-  return out.append(last, body.cend());
+  return out;
+}
+
+// The hair's shading stage as it runs on the atlas (StagePrelude::atlas), after glsl/atlas_inputs.glsl:
+//   - each `in` declaration all of whose names are hair inputs (`in vec3 vWorld;`, `flat in vec3 vColor;`,
+//     `layout(location = 1) in float vAlpha, vDepth;`) becomes a plain global: its qualifiers (in,
+//     layout, interpolation, precision) are overwritten with spaces, so lines and columns stay the file's;
+//   - after it, hairgen's main(): the fragment's inputs into those globals, then the stage's own main()
+//     (renamed hairgenShade by the prelude). It reads gl_FragCoord after the stage, which may redeclare it
+//     (origin_upper_left counts rows from the top).
+// A stage with no main() is left without hairgen's, so the linker says so as it would anywhere.
+std::string forTheAtlas(const std::string& body) {
+  static const std::regex declaration(
+      R"(((?:(?:layout\s*\([^)]*\)|\b(?:in|flat|smooth|noperspective|centroid|sample|highp|mediump|lowp)\b)\s*)+))"
+      R"((\w+)\s+([A-Za-z_]\w*(?:\s*,\s*[A-Za-z_]\w*)*)\s*;)");
+  static const std::regex inWord(R"(\bin\b)"), name(R"([A-Za-z_]\w*)"), mainFunction(R"(\bmain\s*\()");
+  const std::string code = withoutComments(body);
+  std::string out = body;
+  bool declared[std::size(kHairInputs)] = {};
+  for (std::sregex_iterator m(code.begin(), code.end(), declaration), end; m != end; ++m) {
+    if (!std::regex_search(m->str(1), inWord)) continue;
+    const std::string names = m->str(3);
+    std::vector<size_t> inputs;
+    for (std::sregex_iterator n(names.begin(), names.end(), name); n != end; ++n) {
+      const auto* found = std::find(std::begin(kHairInputs), std::end(kHairInputs), n->str());
+      if (found == std::end(kHairInputs)) break;
+      inputs.push_back(size_t(found - std::begin(kHairInputs)));
+    }
+    if (inputs.size() != size_t(std::count(names.begin(), names.end(), ',')) + 1) continue;
+    for (size_t k = size_t(m->position(1)); k < size_t(m->position(1) + m->length(1)); ++k)
+      if (out[k] != '\n') out[k] = ' ';
+    for (size_t input : inputs) declared[input] = true;
+  }
+  if (!std::regex_search(code, mainFunction)) return out;
+  const bool fromTop = code.find("origin_upper_left") != std::string::npos;
+  out +=
+      "\n#undef main\nvoid main() {\n  vec3 hairgenIn0, hairgenIn1, hairgenIn2, hairgenIn3;\n"
+      "  float hairgenIn4, hairgenIn5;\n  ivec2 hairgenTexel = ivec2(gl_FragCoord.xy);\n";
+  if (fromTop) out += "  hairgenTexel.y = hairgenAtlasRows - 1 - hairgenTexel.y;\n";
+  out +=
+      "  if (!hairgenInputs(hairgenTexel, hairgenIn0, hairgenIn1, hairgenIn2, hairgenIn3, hairgenIn4, "
+      "hairgenIn5)) discard;\n";
+  for (size_t k = 0; k < std::size(kHairInputs); ++k)
+    if (declared[k]) out += std::string("  ") + kHairInputs[k] + " = hairgenIn" + std::to_string(k) + ";\n";
+  return out + "  hairgenShade();\n}\n";
 }
 
 }  // namespace
@@ -110,7 +158,7 @@ std::string assembleStage(const StagePrelude& prelude, const std::string& body) 
   text += glslConstants();
   if (prelude.shadowFunction) text += glsl::kShadow;
   if (prelude.screenDoor) text += std::string("#define SCREEN_DOOR\n") + glsl::kScreenDoor;
-  if (prelude.atlas) return text + glsl::kAtlasInputs + "#line 1\n" + atlasInputsAsGlobals(body);
+  if (prelude.atlas) return text + glsl::kAtlasInputs + "#line 1\n" + forTheAtlas(body);
   return text + "#line 1\n" + body;
 }
 

@@ -57,10 +57,11 @@ struct StagePrelude {
                                 // write vMotion, the screen motion since the previous frame
   std::string defines = {};     // more `#define` lines, for hairgen's own stages only (HAIR_MODEL, ...)
   bool atlas = false;           // the hair's shading stage run on the shading atlas' texels
-                                // (glsl/atlas_inputs.glsl): its inputs vWorld, vTangent, vColor,
-                                // vNormal, vAlpha and vDepth become globals that hairgen sets before
-                                // the stage's main() runs; the stage's `in` declarations of them are
-                                // blanked out (their lines stay, so the compiler's numbers are the file's)
+                                // (glsl/atlas_inputs.glsl): its `in` declarations of vWorld, vTangent,
+                                // vColor, vNormal, vAlpha and vDepth become plain globals (their
+                                // qualifiers blanked, so lines and columns stay the file's), which a
+                                // main() hairgen puts after the stage sets before it calls the stage's
+                                // own (renamed hairgenShade)
 };
 
 // The GLSL constants: `const int kShading<Name> = <value>;` for every ShadingModel (the name from
