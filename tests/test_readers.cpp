@@ -5,6 +5,8 @@
 #include <functional>
 #include <string>
 
+#include <tbb/global_control.h>
+
 #include "libcore/io/hair_cache.h"
 #include "libcore/io/hairsalon_io.h"
 #include "libcore/io/ply_io.h"
@@ -131,6 +133,28 @@ TEST(RenderEstimate, CoverageCountsOnlyWhatIsOnScreen) {
   EXPECT_EQ(hairCoverage(view, away, 1e-4, 1.0), 0.0);
   // However wide, a segment covers at most the image.
   EXPECT_LE(hairCoverage(view, hair, 1.0, 1.0), double(hair.pointCount() - hair.strandCount()) * 640 * 640);
+}
+
+// The estimate decides refusals, so it is the same on any thread count: its sums are taken over ranges
+// of strands split alike and added in the same order (10,000 strands: several ranges).
+TEST(RenderEstimate, CoverageIsTheSameOnAnyThreadCount) {
+  RenderSettings r;
+  r.resolution = {640, 640};
+  r.cameraPosition = {0.0, 0.15, 1.0};
+  r.cameraTarget = {0.0, 0.15, 0.0};
+  Strands hair = brush(10000, 16);
+  for (size_t i = 0; i < hair.points.size(); ++i) hair.points[i].x += 1e-4f * float(i % 97);  // uneven sums
+  const View view = cameraView(r, boundingSphere(hair, nullptr));
+  auto coverage = [&](int threads) {
+    tbb::global_control limit(tbb::global_control::max_allowed_parallelism, size_t(threads));
+    KeptFragments kept;
+    const double fragments = hairCoverage(view, hair, 1e-4, 1.0, &kept);
+    return std::pair(fragments, kept.fragments);
+  };
+  const auto one = coverage(1);
+  EXPECT_GT(one.first, 0.0);
+  EXPECT_EQ(coverage(2), one);
+  EXPECT_EQ(coverage(3), one);
 }
 
 // The fragments hairgen's rasteriser keeps: a lone strand's are its length times its true width and

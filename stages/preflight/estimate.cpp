@@ -9,7 +9,6 @@
 
 #include <tbb/blocked_range.h>
 #include <tbb/global_control.h>
-#include <tbb/parallel_for.h>
 #include <tbb/parallel_reduce.h>
 #include <tbb/task_arena.h>
 
@@ -31,8 +30,10 @@ double sweepsPerStage(double elements) {
 // One energy evaluation: per Super-Helix element (frame, closed forms) and per collision sample and
 // shape (GrowCoupe3 benchmark: 1 µs for 4 elements, 32 samples and 2 shapes).
 constexpr double kSecondsPerElement = 60e-9, kSecondsPerSample = 12e-9;
-// Strands hairCoverage gives a thread at once: its sums are a chunk's, whatever the thread count.
-constexpr size_t kCoverageChunk = 4096;
+// The fewest strands hairCoverage gives a thread at once (its ranges split alike on any thread count).
+constexpr size_t kCoverageGrain = 4096;
+// The strands estimateRender measures the longest of on a thread at once.
+constexpr size_t kLengthGrain = 4096;
 // Interpolation writes each point once with its tangent (InterpolateCoupe3: 150k × 64 in 0.2 s).
 constexpr double kSecondsPerPoint = 25e-9;
 // The volume: per grid node (sweeps, slides) and per splatted vertex (ShadeCoupe3: 800k nodes and 9.6M
@@ -285,63 +286,68 @@ double hairCoverage(const View& view, const Strands& hair, double strandWidth, d
   const size_t tiles = kept ? size_t(tilesX) * size_t(tilesY) : 0;
   // The near plane (glm::perspective's), before which the device clips.
   const double nearDepth = std::max(view.proj[3][2] / (view.proj[2][2] - 1.0), 1e-9);
-  // Strands in chunks of a fixed size on every thread, each chunk's sums its own, added up in the chunks'
-  // order: the same estimate whatever the thread count.
+  // Strands in ranges split the same way whatever the thread count, and their sums added in the same
+  // tree (parallel_deterministic_reduce): the same estimate on any number of threads, with a tile
+  // array for only the ranges being summed at once.
   struct Sums {
     double fragments = 0.0;
     std::vector<double> given;  // the fragments given in each tile of kFootprintTile² pixels
   };
-  const size_t strands = hair.strandCount(), chunks = (strands + kCoverageChunk - 1) / kCoverageChunk;
-  std::vector<Sums> sums(chunks);
-  tbb::parallel_for(size_t(0), chunks, [&](size_t c) {
-    Sums& out = sums[c];
-    out.given.assign(tiles, 0.0);
-    for (size_t s = c * kCoverageChunk; s < std::min(strands, (c + 1) * kCoverageChunk); ++s) {
-      if (hair.firstPoint[s] == hair.firstPoint[s + 1]) continue;
-      auto inView = [&](uint32_t i) {
-        return glm::dvec3(view.view * glm::dvec4(glm::dvec3(hair.points[i]), 1.0));
-      };
-      glm::dvec3 next = inView(hair.firstPoint[s]);
-      for (uint32_t i = hair.firstPoint[s]; i + 1 < hair.firstPoint[s + 1]; ++i) {
-        glm::dvec3 a = next, b = inView(i + 1);
-        next = b;
-        // Depth along the view's −z; the part of the segment in front of the eye.
-        double da = -a.z, db = -b.z;
-        if (da < nearDepth && db < nearDepth) continue;
-        if (da < nearDepth) {
-          a += (b - a) * ((nearDepth - da) / (db - da));
-          da = nearDepth;
-        } else if (db < nearDepth) {
-          b += (a - b) * ((nearDepth - db) / (da - db));
-          db = nearDepth;
+  const Sums total = tbb::parallel_deterministic_reduce(
+      tbb::blocked_range<size_t>(0, hair.strandCount(), kCoverageGrain), Sums{},
+      [&](const tbb::blocked_range<size_t>& range, Sums sums) {
+        sums.given.resize(tiles, 0.0);
+        for (size_t s = range.begin(); s < range.end(); ++s) {
+          if (hair.firstPoint[s] == hair.firstPoint[s + 1]) continue;
+          auto inView = [&](uint32_t i) {
+            return glm::dvec3(view.view * glm::dvec4(glm::dvec3(hair.points[i]), 1.0));
+          };
+          glm::dvec3 next = inView(hair.firstPoint[s]);
+          for (uint32_t i = hair.firstPoint[s]; i + 1 < hair.firstPoint[s + 1]; ++i) {
+            glm::dvec3 a = next, b = inView(i + 1);
+            next = b;
+            // Depth along the view's −z; the part of the segment in front of the eye.
+            double da = -a.z, db = -b.z;
+            if (da < nearDepth && db < nearDepth) continue;
+            if (da < nearDepth) {
+              a += (b - a) * ((nearDepth - da) / (db - da));
+              da = nearDepth;
+            } else if (db < nearDepth) {
+              b += (a - b) * ((nearDepth - db) / (da - db));
+              db = nearDepth;
+            }
+            const double trueA = strandWidth * view.focalPx / da, trueB = strandWidth * view.focalPx / db;
+            const double wa = std::max(trueA, minWidthPx), wb = std::max(trueB, minWidthPx);
+            const glm::dvec2 pa = 0.5 * size + view.focalPx * glm::dvec2(a.x, a.y) / da,
+                             pb = 0.5 * size + view.focalPx * glm::dvec2(b.x, b.y) / db;
+            // The ribbon reaches half its width beyond its centre line.
+            const double reach = 0.5 * std::max(wa, wb);
+            double t0 = 0.0, t1 = 1.0;
+            if (!clipToBox(pa, pb, glm::dvec2(-reach), size + reach, t0, t1)) continue;
+            const double length = glm::length(pb - pa) * (t1 - t0);
+            const double width = wa + (wb - wa) * 0.5 * (t0 + t1);
+            // A quad at least its width long (the joins), and never more than the image.
+            sums.fragments += std::min(std::max(length, width) * width, screen);
+            if (kept) {  // in the tile of the clipped segment's middle
+              const glm::dvec2 middle =
+                  glm::clamp(pa + (pb - pa) * (0.5 * (t0 + t1)), glm::dvec2(0.0), size - 1.0);
+              sums.given[size_t(middle.y / kFootprintTile) * size_t(tilesX) +
+                         size_t(middle.x / kFootprintTile)] +=
+                  std::min(length * (trueA + (trueB - trueA) * 0.5 * (t0 + t1) + 1.0), screen);
+            }
+          }
         }
-        const double trueA = strandWidth * view.focalPx / da, trueB = strandWidth * view.focalPx / db;
-        const double wa = std::max(trueA, minWidthPx), wb = std::max(trueB, minWidthPx);
-        const glm::dvec2 pa = 0.5 * size + view.focalPx * glm::dvec2(a.x, a.y) / da,
-                         pb = 0.5 * size + view.focalPx * glm::dvec2(b.x, b.y) / db;
-        // The ribbon reaches half its width beyond its centre line.
-        const double reach = 0.5 * std::max(wa, wb);
-        double t0 = 0.0, t1 = 1.0;
-        if (!clipToBox(pa, pb, glm::dvec2(-reach), size + reach, t0, t1)) continue;
-        const double length = glm::length(pb - pa) * (t1 - t0);
-        const double width = wa + (wb - wa) * 0.5 * (t0 + t1);
-        // A quad at least its width long (the joins), and never more than the image.
-        out.fragments += std::min(std::max(length, width) * width, screen);
-        if (kept) {  // in the tile of the clipped segment's middle
-          const glm::dvec2 middle =
-              glm::clamp(pa + (pb - pa) * (0.5 * (t0 + t1)), glm::dvec2(0.0), size - 1.0);
-          out.given[size_t(middle.y / kFootprintTile) * size_t(tilesX) + size_t(middle.x / kFootprintTile)] +=
-              std::min(length * (trueA + (trueB - trueA) * 0.5 * (t0 + t1) + 1.0), screen);
-        }
-      }
-    }
-  });
-  double fragments = 0.0;
-  std::vector<double> given(tiles, 0.0);
-  for (const Sums& chunk : sums) {
-    fragments += chunk.fragments;
-    for (size_t t = 0; t < tiles; ++t) given[t] += chunk.given[t];
-  }
+        return sums;
+      },
+      [](Sums a, const Sums& b) {
+        a.fragments += b.fragments;
+        a.given.resize(std::max(a.given.size(), b.given.size()), 0.0);
+        for (size_t t = 0; t < b.given.size(); ++t) a.given[t] += b.given[t];
+        return a;
+      });
+  const double fragments = total.fragments;
+  std::vector<double> given = total.given;
+  given.resize(tiles, 0.0);  // no strands: no range was summed
   if (kept) {
     kept->fragments = 0.0;
     for (int ty = 0; ty < tilesY; ++ty)
@@ -366,7 +372,7 @@ WorkEstimate estimateRender(const RenderSettings& r, const Strands& hair, const 
                  kept.fragments, keptFragments, glm::length(sphere.centre - r.cameraPosition), block);
   // The longest strand (a maximum: the same whatever the thread count).
   const double longest = tbb::parallel_reduce(
-      tbb::blocked_range<size_t>(0, hair.strandCount(), kCoverageChunk), 0.0,
+      tbb::blocked_range<size_t>(0, hair.strandCount(), kLengthGrain), 0.0,
       [&](const tbb::blocked_range<size_t>& range, double most) {
         for (size_t s = range.begin(); s < range.end(); ++s) {
           double length = 0.0;
