@@ -22,13 +22,17 @@ constexpr double kWidest = 4096.0;
 
 // std::lround's answer (halves away from zero) for |x| < 2^31, inline: libm's call was a tenth of a
 // second of the 1080p coupe's two projections. The truncation and the remainder are exact.
-int32_t rounded(double x) {
+constexpr int32_t rounded(double x) {
   int64_t i = int64_t(x);
   const double rest = x - double(i);
   if (rest >= 0.5) ++i;
   if (rest <= -0.5) --i;
   return int32_t(i);
 }
+static_assert(rounded(0.5) == 1 && rounded(-0.5) == -1 && rounded(1.5) == 2 && rounded(-1.5) == -2 &&
+              rounded(2.5) == 3 && rounded(-2.5) == -3 && rounded(0.49999999999999994) == 0 &&
+              rounded(-0.49999999999999994) == 0 && rounded(2147483646.5) == 2147483647 &&
+              rounded(-2147483647.5) == -2147483648.0);
 
 }  // namespace
 
