@@ -66,6 +66,12 @@ RenderOutput renderStage(const CommonOptions& common, const Config& config, GlCo
   const char* rasteriser = out.rasterisedOnDevice ? "device" : "cpu";
   stats.json()["device"]["lightMaps"] = out.lightMapsByRasteriser ? rasteriser : "opengl";
   stats.json()["device"]["rasteriser"] = rasteriser;
+  if (!out.deviceRefused.empty()) {
+    // Once a render (each frame of a sequence asks the context, which kept the answer).
+    if (!stats.json()["device"].contains("deviceRefused"))
+      note(common, "render: hairgen's rasteriser runs on the CPU, the same image: " + out.deviceRefused);
+    stats.json()["device"]["deviceRefused"] = out.deviceRefused;
+  }
   stats.counts()["hairFragments"] = out.hairFragments;
   stats.json()["device"]["hairFragmentSeconds"] = out.timings.fragments;
   stats.json()["device"]["hairReadInPlace"] = out.hairReadInPlace;

@@ -85,6 +85,13 @@ constexpr glm::dvec4 kLayers{0.002, 0.006, 0.015, 0.04};
 // The device's prefix sums (the camera's lists' places) are the host's, modulo 2^32: for one word,
 // within one block, just past it, and over two levels of blocks; words past a word's range (the sums
 // wrap), a limit on each word, and the largest word found alongside.
+// Every pass compiles and links on this device, at the kept counts a pixel can have: where one does not,
+// a render on `auto` would quietly draw on the CPU (computePassesFailure), so CI says so here.
+TEST(ComputeRaster, EveryPassBuildsOnThisDevice) {
+  SKIP_WITHOUT_COMPUTE_RASTER();
+  for (int kept : {1, kKeptFragments, 255}) EXPECT_EQ(computePassesFailure(kept), "") << kept << " kept";
+}
+
 TEST(ComputeRaster, PrefixSumsAreTheHostsModulo2To32) {
   SKIP_WITHOUT_COMPUTE_RASTER();
   std::mt19937 random(5);

@@ -147,6 +147,40 @@ bool computeRasterAvailable() {
       .agrees;
 }
 
+namespace {
+
+struct PassesBuilt {
+  std::string failure;
+};
+
+}  // namespace
+
+std::string computePassesFailure(int kept) {
+  const std::string keptDefine = "#define KEPT " + std::to_string(std::clamp(kept, 1, 255)) + "\n";
+  auto build = [&] {
+    auto built = std::make_unique<PassesBuilt>();
+    try {
+      // Each as computeLightMaps and computeCameraFragments make it, so theirs are these, kept.
+      const Program starts(computeStage(glsl::kLightStart, true, "#define ACROSS_TENT\n"), "light start");
+      const Program sums(computeStage(glsl::kLightLayers, true, "#define ACROSS_TENT\n"), "light layers");
+      const Program finish(computeStage(glsl::kLightFinish, false), "light finish");
+      const Program count(computeStage(glsl::kCameraCount, true), "camera count");
+      const PrefixSum prefixSum;
+      const Program rowTotals(computeStage(glsl::kCameraRows, false), "camera rows");
+      const Program fill(computeStage(glsl::kCameraFill, true), "camera fill");
+      const Program keep(computeStage(glsl::kCameraKeep, false, keptDefine), "camera keep");
+      const Program pack(computeStage(glsl::kCameraPack, false), "camera pack");
+    } catch (const Error& e) {
+      const std::string what = e.what(), prefix = "rendering: ";  // renderFailure's
+      built->failure = what.starts_with(prefix) ? what.substr(prefix.size()) : what;
+    }
+    return built;
+  };
+  GlContext* gl = GlContext::current();
+  if (!gl) return build()->failure;
+  return gl->kept<PassesBuilt>("compute raster passes " + keptDefine, build).failure;
+}
+
 DeviceBuffer::DeviceBuffer(size_t size, const void* data) : bytes(std::max<size_t>(size, 4)) {
   glCreateBuffers(1, &id);
   glNamedBufferStorage(id, GLsizeiptr(bytes), size ? data : nullptr, 0);

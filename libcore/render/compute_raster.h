@@ -17,6 +17,7 @@
 #include <cstdint>
 #include <memory>
 #include <optional>
+#include <string>
 #include <vector>
 
 #include <glm/glm.hpp>
@@ -31,6 +32,12 @@ namespace hairgen {
 
 // Whether the current context can run the compute passes (GL_ARB_gpu_shader_int64).
 bool computeRasterAvailable();
+
+// Why the current context's compiler cannot build every compute pass for `kept` fragments a pixel
+// (renderFailure's words, the compiler's first error among them); empty when it builds them all. The
+// programs are kept in the context for the passes, and the answer too. A driver whose compiler rejects
+// a pass leaves a GPU drawing on the CPU, the same bits, rather than failing every render.
+std::string computePassesFailure(int kept);
 
 // Whether an array of `bytes` fits one of the device's storage buffers (GL_MAX_SHADER_STORAGE_BLOCK_SIZE:
 // 128 MiB on llvmpipe, 2 GiB on NVIDIA's drivers).

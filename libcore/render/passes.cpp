@@ -48,7 +48,8 @@ int lightMapSize(const RenderInput& in, const BoundingSphere& sphere, const View
 // Whether hairgen's rasteriser runs on the device (RenderInput::rasteriser): where it can, and the hair's
 // projected points (16 bytes each) and the light's integer maps (16 bytes a texel) fit its storage
 // buffers (the camera's fragments, which cannot be known before, fall back to the CPU themselves).
-bool rasteriseOnDevice(const RenderInput& in, int lightSize) {
+// `refused`: why not, where the device's compiler rejects one of the passes (computePassesFailure).
+bool rasteriseOnDevice(const RenderInput& in, int lightSize, std::string& refused) {
   if (in.rasteriser == RenderInput::Rasteriser::kCpu) return false;
   if (in.rasteriser == RenderInput::Rasteriser::kAuto && softwareRasteriser()) return false;  // no probe
   const bool can = computeRasterAvailable();
@@ -58,7 +59,12 @@ bool rasteriseOnDevice(const RenderInput& in, int lightSize) {
     renderFailure(can ? "the hair is too large for this device's storage buffers; use --rasteriser cpu"
                       : "this device cannot run hairgen's rasteriser (no GL_ARB_gpu_shader_int64); use "
                         "--rasteriser cpu");
-  return can && fits;
+  if (!(can && fits)) return false;
+  refused = computePassesFailure(in.keptFragments);
+  if (!refused.empty() && in.rasteriser == RenderInput::Rasteriser::kDevice)
+    renderFailure("this device's compiler rejects hairgen's rasteriser (" + refused +
+                  "); use --rasteriser cpu");
+  return refused.empty();
 }
 
 // Lines where every strand is at most a pixel and a half wide (at the scene's nearest point) and
@@ -272,7 +278,7 @@ Scene::Scene(const RenderInput& in)
       motion(in.previous.has_value()),
       rasterised(!in.shaders.hairVert),
       kept(in.keptFragments),
-      onDevice(rasteriseOnDevice(in, light.width)),
+      onDevice(rasteriseOnDevice(in, light.width, deviceRefused)),
       preparing(std::make_unique<Preparation>(*this, in)),
       hair(*in.hair, tangentsFor(*in.hair), motion ? in.previous->hair : nullptr, in.readInPlace),
       head(in.head && !in.head->triangles.empty()

@@ -19,6 +19,7 @@
 
 #include <memory>
 #include <optional>
+#include <string>
 
 #include "libcore/render/device_timer.h"
 #include "libcore/render/gl_resources.h"
@@ -64,7 +65,10 @@ struct Scene {
   bool motion;            // the previous frame was given: motion vectors too
   bool rasterised;        // the camera's hair comes from hairgen's rasteriser (not a custom HairVert)
   int kept;               // the fragments kept per sub-pixel (RenderInput::keptFragments)
-  bool onDevice;          // hairgen's rasteriser runs on the device (RenderInput::rasteriser)
+  // Why hairgen's rasteriser runs on the CPU where `auto` would have put it on the device: the device's
+  // compiler rejects one of its passes (computePassesFailure); empty otherwise.
+  std::string deviceRefused;
+  bool onDevice;  // hairgen's rasteriser runs on the device (RenderInput::rasteriser)
   glm::dmat4 viewProj{1.0}, previousViewProj{1.0};  // world to clip: this frame's camera, the previous one's
   // The device's time in the rasteriser's compute passes and the host's in their transfers (read once the
   // frame is done: RenderTimings::devicePasses, transfers); the passes time themselves (mutable), which

@@ -47,6 +47,7 @@ RenderOutput renderHair(GlContext&, const RenderInput& in) {
   out.hairReadInPlace = scene.hair.readsStrandsInPlace();
   out.lightMapsByRasteriser = scene.lightMaps || scene.lightOnDevice;
   out.rasterisedOnDevice = scene.lightOnDevice || scene.cameraOnDevice;
+  out.deviceRefused = scene.deviceRefused;
   if (in.uploaded && !out.hairReadInPlace) in.uploaded();
   auto passDone = [&] {
     if (in.progress) in.progress->advance();

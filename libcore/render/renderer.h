@@ -71,10 +71,11 @@ struct RenderOutput {
   // rasterisedOnDevice), or OpenGL's lines.
   bool lightMapsByRasteriser = false;
   bool rasterisedOnDevice =
-      false;                 // whether hairgen's rasteriser ran on the device (RenderInput::rasteriser)
-  size_t hairFragments = 0;  // the camera's kept hair fragments (camera_fragments.h), at the sub-pixels
-  RenderSettings settings;   // what was rendered: the input's, with the camera and light the render stage
-                             // aimed when asked to frame the hair
+      false;                  // whether hairgen's rasteriser ran on the device (RenderInput::rasteriser)
+  std::string deviceRefused;  // why it ran on the CPU where `auto` would have put it on the device, or empty
+  size_t hairFragments = 0;   // the camera's kept hair fragments (camera_fragments.h), at the sub-pixels
+  RenderSettings settings;    // what was rendered: the input's, with the camera and light the render stage
+                              // aimed when asked to frame the hair
 };
 
 // The frame before this one, for motion vectors: the same strands (as many points) and head (as many
