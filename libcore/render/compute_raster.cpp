@@ -149,6 +149,26 @@ bool computeRasterAvailable() {
 
 namespace {
 
+// The light's passes (computeLightMaps).
+struct LightPasses {
+  Program starts{computeStage(glsl::kLightStart, true, "#define ACROSS_TENT\n"), "light start"};
+  Program sums{computeStage(glsl::kLightLayers, true, "#define ACROSS_TENT\n"), "light layers"};
+  Program finish{computeStage(glsl::kLightFinish, false), "light finish"};
+};
+
+// The camera's passes for `kept` fragments a pixel, 1-255 (computeCameraFragments).
+struct CameraPasses {
+  explicit CameraPasses(int kept)
+      : keep(computeStage(glsl::kCameraKeep, false, "#define KEPT " + std::to_string(kept) + "\n"),
+             "camera keep") {}
+  Program count{computeStage(glsl::kCameraCount, true), "camera count"};
+  PrefixSum prefixSum;
+  Program rowTotals{computeStage(glsl::kCameraRows, false), "camera rows"};
+  Program fill{computeStage(glsl::kCameraFill, true), "camera fill"};
+  Program keep;
+  Program pack{computeStage(glsl::kCameraPack, false), "camera pack"};
+};
+
 struct PassesBuilt {
   std::string failure;
 };
@@ -156,20 +176,13 @@ struct PassesBuilt {
 }  // namespace
 
 std::string computePassesFailure(int kept) {
-  const std::string keptDefine = "#define KEPT " + std::to_string(std::clamp(kept, 1, 255)) + "\n";
+  kept = std::clamp(kept, 1, 255);
   auto build = [&] {
     auto built = std::make_unique<PassesBuilt>();
     try {
-      // Each as computeLightMaps and computeCameraFragments make it, so theirs are these, kept.
-      const Program starts(computeStage(glsl::kLightStart, true, "#define ACROSS_TENT\n"), "light start");
-      const Program sums(computeStage(glsl::kLightLayers, true, "#define ACROSS_TENT\n"), "light layers");
-      const Program finish(computeStage(glsl::kLightFinish, false), "light finish");
-      const Program count(computeStage(glsl::kCameraCount, true), "camera count");
-      const PrefixSum prefixSum;
-      const Program rowTotals(computeStage(glsl::kCameraRows, false), "camera rows");
-      const Program fill(computeStage(glsl::kCameraFill, true), "camera fill");
-      const Program keep(computeStage(glsl::kCameraKeep, false, keptDefine), "camera keep");
-      const Program pack(computeStage(glsl::kCameraPack, false), "camera pack");
+      // As the passes make them, so theirs are these, kept in the context.
+      const LightPasses light;
+      const CameraPasses camera(kept);
     } catch (const Error& e) {
       const std::string what = e.what(), prefix = "rendering: ";  // renderFailure's
       built->failure = what.starts_with(prefix) ? what.substr(prefix.size()) : what;
@@ -178,7 +191,7 @@ std::string computePassesFailure(int kept) {
   };
   GlContext* gl = GlContext::current();
   if (!gl) return build()->failure;
-  return gl->kept<PassesBuilt>("compute raster passes " + keptDefine, build).failure;
+  return gl->kept<PassesBuilt>("compute raster passes, kept " + std::to_string(kept), build).failure;
 }
 
 DeviceBuffer::DeviceBuffer(size_t size, const void* data) : bytes(std::max<size_t>(size, 4)) {
@@ -276,9 +289,8 @@ void computeLightMaps(const DeviceProjection& hair, const glm::dvec4& layerSizes
                       float background, const Texture& start, const Texture& opacity, HairLightMaps* integers,
                       DeviceTimer* timer) {
   const size_t texels = size_t(hair.width) * size_t(hair.height);
-  const Program starts(computeStage(glsl::kLightStart, true, "#define ACROSS_TENT\n"), "light start");
-  const Program sums(computeStage(glsl::kLightLayers, true, "#define ACROSS_TENT\n"), "light layers");
-  const Program finish(computeStage(glsl::kLightFinish, false), "light finish");
+  const LightPasses passes;
+  const Program &starts = passes.starts, &sums = passes.sums, &finish = passes.finish;
   DeviceBuffer begins(texels * sizeof(int32_t)), layers(texels * 4 * sizeof(uint32_t)),
       overflow(texels * sizeof(uint32_t));
   {
@@ -349,13 +361,10 @@ std::optional<DeviceFragments> computeCameraFragments(const DeviceProjection& ha
   kept = std::clamp(kept, 1, 255);
   const size_t width = size_t(hair.width), pixels = width * size_t(hair.height), rows = size_t(hair.height);
   if (!fitsDevice((pixels + 1) * sizeof(uint32_t))) return std::nullopt;
-  const std::string keptDefine = "#define KEPT " + std::to_string(kept) + "\n";
-  const Program count(computeStage(glsl::kCameraCount, true), "camera count");
-  const PrefixSum prefixSum;
-  const Program rowTotals(computeStage(glsl::kCameraRows, false), "camera rows");
-  const Program fill(computeStage(glsl::kCameraFill, true), "camera fill");
-  const Program keep(computeStage(glsl::kCameraKeep, false, keptDefine), "camera keep");
-  const Program pack(computeStage(glsl::kCameraPack, false), "camera pack");
+  const CameraPasses passes(kept);
+  const Program &count = passes.count, &rowTotals = passes.rowTotals, &fill = passes.fill,
+                &keep = passes.keep, &pack = passes.pack;
+  const PrefixSum& prefixSum = passes.prefixSum;
   auto useOpaque = [&](const Program& p) {
     glUniform1i(p.loc("uHasOpaque"), opaque ? 1 : 0);
     glUniform1d(p.loc("uDepthUnit"), kDepthUnit);
