@@ -116,11 +116,17 @@ Strands brush(size_t strands, uint32_t points) {
   return s;
 }
 
-TEST(RenderEstimate, CoverageCountsOnlyWhatIsOnScreen) {
+// A 640×640 camera 1 m in front of the brush, level with its middle.
+RenderSettings facingTheBrush() {
   RenderSettings r;
   r.resolution = {640, 640};
   r.cameraPosition = {0.0, 0.15, 1.0};
   r.cameraTarget = {0.0, 0.15, 0.0};
+  return r;
+}
+
+TEST(RenderEstimate, CoverageCountsOnlyWhatIsOnScreen) {
+  const RenderSettings r = facingTheBrush();
   const Strands hair = brush(100, 16);
   const View view = cameraView(r, boundingSphere(hair, nullptr));
   const double seen = hairCoverage(view, hair, 1e-4, 1.0);
@@ -138,10 +144,7 @@ TEST(RenderEstimate, CoverageCountsOnlyWhatIsOnScreen) {
 // The estimate decides refusals, so it is the same on any thread count: its sums are taken over ranges
 // of strands split alike and added in the same order (10,000 strands: several ranges).
 TEST(RenderEstimate, CoverageIsTheSameOnAnyThreadCount) {
-  RenderSettings r;
-  r.resolution = {640, 640};
-  r.cameraPosition = {0.0, 0.15, 1.0};
-  r.cameraTarget = {0.0, 0.15, 0.0};
+  const RenderSettings r = facingTheBrush();
   Strands hair = brush(10000, 16);
   for (size_t i = 0; i < hair.points.size(); ++i) hair.points[i].x += 1e-4f * float(i % 97);  // uneven sums
   const View view = cameraView(r, boundingSphere(hair, nullptr));
@@ -161,10 +164,7 @@ TEST(RenderEstimate, CoverageIsTheSameOnAnyThreadCount) {
 // one (0.2 pixel wide here: 1.2 pixels a pixel of length); a thousand strands over the same pixels are
 // at most the kept count a pixel of the tiles they cross, not a thousand times one.
 TEST(RenderEstimate, KeptFragmentsAreALengthTimesAWidthAtMostKeptAPixel) {
-  RenderSettings r;
-  r.resolution = {640, 640};
-  r.cameraPosition = {0.0, 0.15, 1.0};
-  r.cameraTarget = {0.0, 0.15, 0.0};
+  const RenderSettings r = facingTheBrush();
   Strands one;
   one.addStrand({{0.0f, 0.0f, 0.0f}, {0.0f, 0.3f, 0.0f}});
   const View view = cameraView(r, boundingSphere(one, nullptr));
