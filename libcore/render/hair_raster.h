@@ -215,11 +215,11 @@ void rasteriseSegment(Vertex a, Vertex b, int64_t rowLo, int64_t rowHi, F&& frag
     // costs a band its rows, not its width.
     const int64_t insideFirst = -floorDiv(-(below + reachOut), kSubTexel);
     const int64_t insideLast = floorDiv(above - reachOut, kSubTexel) - 1;
-    const uint64_t insideShare =
-        uint64_t(Uint128(area * uint64_t(acrossTotal<across>(kSubTexel))) * perExtent >> 40);
     for (int64_t m = mFirst; m <= mLast; ++m) {
       if (alongX && (m < rowLo || m >= rowHi) && m >= insideFirst && m <= insideLast && m < mLast) {
         const int64_t next = std::min({m < rowLo ? rowLo : mLast, insideLast + 1, mLast});  // not passed over
+        const uint64_t insideShare =  // asked for only here: most pieces have no run to pass over
+            uint64_t(Uint128(area * uint64_t(acrossTotal<across>(kSubTexel))) * perExtent >> 40);
         given += uint64_t(next - m) * insideShare;
         m = next - 1;
         continue;
