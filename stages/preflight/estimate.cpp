@@ -293,50 +293,50 @@ double hairCoverage(const View& view, const Strands& hair, double strandWidth, d
     double fragments = 0.0;
     std::vector<double> given;  // the fragments given in each tile of kFootprintTile² pixels
   };
-  const Sums total = tbb::parallel_deterministic_reduce(
+  // Strand s's segments added to `sums`.
+  auto addStrand = [&](size_t s, Sums& sums) {
+    if (hair.firstPoint[s] == hair.firstPoint[s + 1]) return;
+    auto inView = [&](uint32_t i) {
+      return glm::dvec3(view.view * glm::dvec4(glm::dvec3(hair.points[i]), 1.0));
+    };
+    glm::dvec3 next = inView(hair.firstPoint[s]);
+    for (uint32_t i = hair.firstPoint[s]; i + 1 < hair.firstPoint[s + 1]; ++i) {
+      glm::dvec3 a = next, b = inView(i + 1);
+      next = b;
+      // Depth along the view's −z; the part of the segment in front of the eye.
+      double da = -a.z, db = -b.z;
+      if (da < nearDepth && db < nearDepth) continue;
+      if (da < nearDepth) {
+        a += (b - a) * ((nearDepth - da) / (db - da));
+        da = nearDepth;
+      } else if (db < nearDepth) {
+        b += (a - b) * ((nearDepth - db) / (da - db));
+        db = nearDepth;
+      }
+      const double trueA = strandWidth * view.focalPx / da, trueB = strandWidth * view.focalPx / db;
+      const double wa = std::max(trueA, minWidthPx), wb = std::max(trueB, minWidthPx);
+      const glm::dvec2 pa = 0.5 * size + view.focalPx * glm::dvec2(a.x, a.y) / da,
+                       pb = 0.5 * size + view.focalPx * glm::dvec2(b.x, b.y) / db;
+      // The ribbon reaches half its width beyond its centre line.
+      const double reach = 0.5 * std::max(wa, wb);
+      double t0 = 0.0, t1 = 1.0;
+      if (!clipToBox(pa, pb, glm::dvec2(-reach), size + reach, t0, t1)) continue;
+      const double length = glm::length(pb - pa) * (t1 - t0);
+      const double width = wa + (wb - wa) * 0.5 * (t0 + t1);
+      // A quad at least its width long (the joins), and never more than the image.
+      sums.fragments += std::min(std::max(length, width) * width, screen);
+      if (kept) {  // in the tile of the clipped segment's middle
+        const glm::dvec2 middle = glm::clamp(pa + (pb - pa) * (0.5 * (t0 + t1)), glm::dvec2(0.0), size - 1.0);
+        sums.given[size_t(middle.y / kFootprintTile) * size_t(tilesX) + size_t(middle.x / kFootprintTile)] +=
+            std::min(length * (trueA + (trueB - trueA) * 0.5 * (t0 + t1) + 1.0), screen);
+      }
+    }
+  };
+  Sums total = tbb::parallel_deterministic_reduce(
       tbb::blocked_range<size_t>(0, hair.strandCount(), kCoverageGrain), Sums{},
       [&](const tbb::blocked_range<size_t>& range, Sums sums) {
         sums.given.resize(tiles, 0.0);
-        for (size_t s = range.begin(); s < range.end(); ++s) {
-          if (hair.firstPoint[s] == hair.firstPoint[s + 1]) continue;
-          auto inView = [&](uint32_t i) {
-            return glm::dvec3(view.view * glm::dvec4(glm::dvec3(hair.points[i]), 1.0));
-          };
-          glm::dvec3 next = inView(hair.firstPoint[s]);
-          for (uint32_t i = hair.firstPoint[s]; i + 1 < hair.firstPoint[s + 1]; ++i) {
-            glm::dvec3 a = next, b = inView(i + 1);
-            next = b;
-            // Depth along the view's −z; the part of the segment in front of the eye.
-            double da = -a.z, db = -b.z;
-            if (da < nearDepth && db < nearDepth) continue;
-            if (da < nearDepth) {
-              a += (b - a) * ((nearDepth - da) / (db - da));
-              da = nearDepth;
-            } else if (db < nearDepth) {
-              b += (a - b) * ((nearDepth - db) / (da - db));
-              db = nearDepth;
-            }
-            const double trueA = strandWidth * view.focalPx / da, trueB = strandWidth * view.focalPx / db;
-            const double wa = std::max(trueA, minWidthPx), wb = std::max(trueB, minWidthPx);
-            const glm::dvec2 pa = 0.5 * size + view.focalPx * glm::dvec2(a.x, a.y) / da,
-                             pb = 0.5 * size + view.focalPx * glm::dvec2(b.x, b.y) / db;
-            // The ribbon reaches half its width beyond its centre line.
-            const double reach = 0.5 * std::max(wa, wb);
-            double t0 = 0.0, t1 = 1.0;
-            if (!clipToBox(pa, pb, glm::dvec2(-reach), size + reach, t0, t1)) continue;
-            const double length = glm::length(pb - pa) * (t1 - t0);
-            const double width = wa + (wb - wa) * 0.5 * (t0 + t1);
-            // A quad at least its width long (the joins), and never more than the image.
-            sums.fragments += std::min(std::max(length, width) * width, screen);
-            if (kept) {  // in the tile of the clipped segment's middle
-              const glm::dvec2 middle =
-                  glm::clamp(pa + (pb - pa) * (0.5 * (t0 + t1)), glm::dvec2(0.0), size - 1.0);
-              sums.given[size_t(middle.y / kFootprintTile) * size_t(tilesX) +
-                         size_t(middle.x / kFootprintTile)] +=
-                  std::min(length * (trueA + (trueB - trueA) * 0.5 * (t0 + t1) + 1.0), screen);
-            }
-          }
-        }
+        for (size_t s = range.begin(); s < range.end(); ++s) addStrand(s, sums);
         return sums;
       },
       [](Sums a, const Sums& b) {
@@ -346,7 +346,7 @@ double hairCoverage(const View& view, const Strands& hair, double strandWidth, d
         return a;
       });
   const double fragments = total.fragments;
-  std::vector<double> given = total.given;
+  std::vector<double> given = std::move(total.given);
   given.resize(tiles, 0.0);  // no strands: no range was summed
   if (kept) {
     kept->fragments = 0.0;
