@@ -65,9 +65,14 @@ std::string glslFloat(float value) {
   return s;
 }
 
-// The hair shading stage's inputs, as hair_vertex.glsl writes them, in the order hairgenInputs()
-// (glsl/atlas_inputs.glsl) gives them.
-constexpr const char* kHairInputs[] = {"vWorld", "vTangent", "vColor", "vNormal", "vAlpha", "vDepth"};
+// The hair shading stage's inputs, as hair_vertex.glsl writes them, and their fields in HairgenInputs
+// (glsl/atlas_inputs.glsl).
+struct HairInput {
+  const char* name;
+  const char* field;
+};
+constexpr HairInput kHairInputs[] = {{"vWorld", "world"},   {"vTangent", "tangent"}, {"vColor", "color"},
+                                     {"vNormal", "normal"}, {"vAlpha", "alpha"},     {"vDepth", "depth"}};
 
 // `text` with each comment turned to spaces (its line breaks kept): the same length, so what is found
 // in it is at the same place in `text`.
@@ -106,7 +111,8 @@ std::string forTheAtlas(const std::string& body) {
     const std::string names = m->str(3);
     std::vector<size_t> inputs;
     for (std::sregex_iterator n(names.begin(), names.end(), name); n != end; ++n) {
-      const auto* found = std::find(std::begin(kHairInputs), std::end(kHairInputs), n->str());
+      const auto* found = std::find_if(std::begin(kHairInputs), std::end(kHairInputs),
+                                       [&](const HairInput& input) { return n->str() == input.name; });
       if (found == std::end(kHairInputs)) break;
       inputs.push_back(size_t(found - std::begin(kHairInputs)));
     }
@@ -118,14 +124,13 @@ std::string forTheAtlas(const std::string& body) {
   if (!std::regex_search(code, mainFunction)) return out;
   const bool fromTop = code.find("origin_upper_left") != std::string::npos;
   out +=
-      "\n#undef main\nvoid main() {\n  vec3 hairgenIn0, hairgenIn1, hairgenIn2, hairgenIn3;\n"
-      "  float hairgenIn4, hairgenIn5;\n  ivec2 hairgenTexel = ivec2(gl_FragCoord.xy);\n";
+      "\n#undef main\nvoid main() {\n  HairgenInputs hairgenIn;\n  ivec2 hairgenTexel = "
+      "ivec2(gl_FragCoord.xy);\n";
   if (fromTop) out += "  hairgenTexel.y = hairgenAtlasRows - 1 - hairgenTexel.y;\n";
-  out +=
-      "  if (!hairgenInputs(hairgenTexel, hairgenIn0, hairgenIn1, hairgenIn2, hairgenIn3, hairgenIn4, "
-      "hairgenIn5)) discard;\n";
+  out += "  if (!hairgenInputs(hairgenTexel, hairgenIn)) discard;\n";
   for (size_t k = 0; k < std::size(kHairInputs); ++k)
-    if (declared[k]) out += std::string("  ") + kHairInputs[k] + " = hairgenIn" + std::to_string(k) + ";\n";
+    if (declared[k])
+      out += std::string("  ") + kHairInputs[k].name + " = hairgenIn." + kHairInputs[k].field + ";\n";
   return out + "  hairgenShade();\n}\n";
 }
 

@@ -21,9 +21,13 @@ uniform int hairgenAtlasWidth;       // texels
 uniform int hairgenAtlasRows;        // texels
 uniform int hairgenFragmentCount;    // at most the atlas' texels, fewer than 2^31
 #define HAIRGEN_POINT(data, i) vec3(data[3 * (i)], data[3 * (i) + 1], data[3 * (i) + 2])
+// A fragment's inputs, as hair_vertex.glsl writes them.
+struct HairgenInputs {
+  vec3 world, tangent, color, normal;
+  float alpha, depth;
+};
 // The inputs of the fragment at the atlas' `texel` (column, row from the bottom); false past the last.
-bool hairgenInputs(ivec2 texel, out vec3 world, out vec3 tangent, out vec3 color, out vec3 normal,
-                   out float alpha, out float depth) {
+bool hairgenInputs(ivec2 texel, out HairgenInputs v) {
   int at = texel.y * hairgenAtlasWidth + texel.x;
   if (at >= hairgenFragmentCount) return false;
   uint j = uint(at);
@@ -31,16 +35,16 @@ bool hairgenInputs(ivec2 texel, out vec3 world, out vec3 tangent, out vec3 color
   uint word = hairgenFragmentData[3u * j + 2u];
   float coverage = float(word & ((1u << kCoverageBits) - 1u)) / float(kCoverageOne);
   float s = float(word >> kCoverageBits) / float(kSpanUnit);
-  world = mix(HAIRGEN_POINT(hairgenPointData, i), HAIRGEN_POINT(hairgenPointData, i + 1u), s);
-  tangent = mix(HAIRGEN_POINT(hairgenTangentData, i), HAIRGEN_POINT(hairgenTangentData, i + 1u), s);
-  color = hairgenHasColor != 0
-              ? mix(HAIRGEN_POINT(hairgenColorData, i), HAIRGEN_POINT(hairgenColorData, i + 1u), s)
-              : vec3(1.0);
-  normal = hairgenHasNormal != 0
-               ? mix(HAIRGEN_POINT(hairgenNormalData, i), HAIRGEN_POINT(hairgenNormalData, i + 1u), s)
-               : vec3(0.0);
-  alpha = min(coverage * hairgenOpacity, 1.0);
-  depth = uintBitsToFloat(hairgenFragmentData[3u * j + 1u]);
+  v.world = mix(HAIRGEN_POINT(hairgenPointData, i), HAIRGEN_POINT(hairgenPointData, i + 1u), s);
+  v.tangent = mix(HAIRGEN_POINT(hairgenTangentData, i), HAIRGEN_POINT(hairgenTangentData, i + 1u), s);
+  v.color = hairgenHasColor != 0
+                ? mix(HAIRGEN_POINT(hairgenColorData, i), HAIRGEN_POINT(hairgenColorData, i + 1u), s)
+                : vec3(1.0);
+  v.normal = hairgenHasNormal != 0
+                 ? mix(HAIRGEN_POINT(hairgenNormalData, i), HAIRGEN_POINT(hairgenNormalData, i + 1u), s)
+                 : vec3(0.0);
+  v.alpha = min(coverage * hairgenOpacity, 1.0);
+  v.depth = uintBitsToFloat(hairgenFragmentData[3u * j + 1u]);
   return true;
 }
 #define main hairgenShade
