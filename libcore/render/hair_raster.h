@@ -70,25 +70,62 @@ struct Piece {
   int64_t twice, length;
 };
 
-// base + ⌊d·t / (2n)⌋ for t = t0, t0 + 2·kSubTexel, t0 + 4·kSubTexel, …: exact, with one division to
-// start and none after.
+// ⌊n / d⌋ for many n and one d > 0, exactly, without a division each: a double's reciprocal gives the
+// quotient to within one (|n| < 2^63 and a quotient below 2^50, as the rasteriser's are) and integers
+// correct it without a branch. A segment and its pieces divide by its length along the major axis a
+// dozen times: as integer divisions whose rounding toward zero was mended by a branch on the sign, the
+// light's and the camera's rasterisers took 22% and 27% longer on the 1080p coupe's short segments.
+class Divider {
+ public:
+  explicit Divider(int64_t d) : Divider(d, 1.0 / double(d)) {}
+  // `reciprocal`: 1/d rounded, as 1.0 / double(d) gives it (or that of d/2^k scaled by 2^-k, which is
+  // the same double).
+  Divider(int64_t d, double reciprocal) : d_(d), reciprocal_(reciprocal) {}
+  int64_t floor(int64_t n) const {
+    int64_t q = int64_t(double(n) * reciprocal_);  // truncated: one more or less than ⌊n/d⌋ at most
+    int64_t r = n - q * d_;
+    // Corrected without a branch: which way it is off changes with the sign of n, segment by segment.
+    const int64_t over = r >> 63;  // −1 where q is one too many
+    q += over;
+    r += d_ & over;
+    const int64_t under = -int64_t(r >= d_);
+    q -= under;
+    r -= d_ & under;
+    if (r < 0 || r >= d_) [[unlikely]]  // never for the rasteriser's quotients (|q| < 2^50)
+      return floorDiv(n, d_);
+    return q;
+  }
+  // ⌊n / d⌋ and what remains of n, for n ≥ 0 below 2^63.
+  uint64_t floor(uint64_t n, uint64_t& remainder) const {
+    const int64_t q = floor(int64_t(n));
+    remainder = n - uint64_t(q) * uint64_t(d_);
+    return uint64_t(q);
+  }
+  int64_t divisor() const { return d_; }
+  double reciprocal() const { return reciprocal_; }
+
+ private:
+  int64_t d_;
+  double reciprocal_;
+};
+
+// base + ⌊d·t / (2n)⌋ for t = t0, t0 + 2·kSubTexel, t0 + 4·kSubTexel, …: exact, with no division after
+// the first (`twoN` divides by 2n).
 class MidpointStep {
  public:
-  MidpointStep(int64_t base, int64_t d, int64_t n, int64_t t0) : den_(2 * n) {
-    q_ = floorDiv(d * t0, den_);
+  MidpointStep(int64_t base, int64_t d, const Divider& twoN, int64_t t0) : den_(twoN.divisor()) {
+    q_ = twoN.floor(d * t0);
     r_ = d * t0 - q_ * den_;
     q_ += base;
-    stepQ_ = floorDiv(2 * kSubTexel * d, den_);
+    stepQ_ = twoN.floor(2 * kSubTexel * d);
     stepR_ = 2 * kSubTexel * d - stepQ_ * den_;
   }
   int64_t value() const { return q_; }
   void next() {
-    q_ += stepQ_;
     r_ += stepR_;
-    if (r_ >= den_) {
-      r_ -= den_;
-      ++q_;
-    }
+    const int64_t carry = -int64_t(r_ >= den_);  // without a branch: it follows the slope
+    q_ += stepQ_ - carry;
+    r_ -= den_ & carry;
   }
 
  private:
@@ -144,6 +181,7 @@ constexpr int64_t acrossTotal(int64_t extent) {
 // fragments a segment has does not depend on the rows asked for.
 template <Across across, class F>
 void rasteriseSegment(Vertex a, Vertex b, int64_t rowLo, int64_t rowHi, F&& fragment) {
+  static_assert(kSubTexel == 256 && kWidthUnit / kSubTexel == 256 && kWidthUnit == kCoverageOne);
   const bool alongX = std::abs(int64_t(b.x) - a.x) >= std::abs(int64_t(b.y) - a.y);
   auto major = [&](const Vertex& v) { return int64_t(alongX ? v.x : v.y); };
   auto minor = [&](const Vertex& v) { return int64_t(alongX ? v.y : v.x); };
@@ -152,26 +190,35 @@ void rasteriseSegment(Vertex a, Vertex b, int64_t rowLo, int64_t rowHi, F&& frag
   const int64_t u0 = major(a), u1 = major(b), v0 = minor(a);
   const int64_t du = u1 - u0, dv = minor(b) - v0, dz = int64_t(b.depth) - a.depth;
   if (du == 0) return;  // seen end on: no length, no area
+  // Every quotient below is by 2·du (or 256·du): one reciprocal for all of them (Divider).
+  const Divider twoDu(2 * du);
   // Rounded to the nearest 1/kSubTexel, so short segments are not all a little short.
   const uint64_t length = roundedSqrt(uint64_t(du * du + dv * dv));
   const uint64_t width = (uint64_t(a.width) + uint64_t(b.width)) / 2;  // 1/kWidthUnit texel
-  // The ribbon's extent across the major axis, 1/kWidthUnit texel; half of it in 1/kSubTexel, at least
-  // one (a thinner ribbon is shared as a line is).
-  const uint64_t extent = width * length / uint64_t(du);
-  const int64_t halfExtent =
-      std::max<int64_t>(1, int64_t((extent + kWidthUnit / kSubTexel) / (2 * (kWidthUnit / kSubTexel))));
+  // The ribbon's extent across the major axis, ⌊w·L/|du|⌋ in 1/kWidthUnit texel, and a whole texel's
+  // piece's area, w·L/|du| rounded to kCoverageOne per texel² (kSubTexel·kWidthUnit/kCoverageOne·du
+  // divides w·kSubTexel·L: the same quotient, rounded half up).
+  uint64_t twiceRest;  // 2·(w·L mod du)
+  const uint64_t extent = twoDu.floor(2 * width * length, twiceRest);
+  const uint64_t wholeArea = extent + (twiceRest >= uint64_t(du) ? 1 : 0);
+  // Half the extent in 1/kSubTexel, at least one (a thinner ribbon is shared as a line is).
+  const int64_t halfExtent = std::max<int64_t>(1, int64_t((extent + 256) / 512));
   // The reciprocal of what the shares of the cross-section sum to, in 1/2^40, so a texel's part of a
   // piece's area is a multiplication and a shift.
   const uint64_t perExtent = (uint64_t(1) << 40) / uint64_t(acrossTotal<across>(2 * halfExtent));
   // The texels along the major axis, [first, last], narrowed to those that can reach the rows.
   int64_t first = u0 >> 8, last = (u1 - 1) >> 8;
-  const int64_t reach = int64_t(extent / (2 * (kWidthUnit / kSubTexel))) + 2 * kSubTexel;
+  const int64_t reach = int64_t(extent / 512) + 2 * kSubTexel;
   if (!alongX) {
     first = std::max(first, rowLo);
     last = std::min(last, rowHi - 1);
-  } else if (dv != 0) {
+  } else if (const int64_t vLow = std::min(v0, v0 + dv) - reach, vHigh = std::max(v0, v0 + dv) + reach;
+             vHigh < rowLo * kSubTexel || vLow >= rowHi * kSubTexel) {
+    return;
+  } else if (dv != 0 && (vLow < rowLo * kSubTexel || vHigh >= rowHi * kSubTexel)) {
     // v at a piece's middle is v0 + dv·(u − u0)/du; found in double with two texels to spare either
-    // side (a texel whose fragments fall outside the rows is dropped by the caller).
+    // side (a texel whose fragments fall outside the rows is dropped by the caller). A segment whose
+    // reach lies within the rows keeps every texel.
     double c0 =
         (double(u0) + (double(rowLo * kSubTexel - reach) - double(v0)) * double(du) / double(dv)) / kSubTexel;
     double c1 =
@@ -180,43 +227,59 @@ void rasteriseSegment(Vertex a, Vertex b, int64_t rowLo, int64_t rowHi, F&& frag
     if (c0 > double(last) + 2.0 || c1 < double(first) - 2.0) return;
     first = std::max(first, int64_t(std::floor(c0)) - 2);
     last = std::min(last, int64_t(std::ceil(c1)) + 2);
-  } else if (v0 + reach < rowLo * kSubTexel || v0 - reach >= rowHi * kSubTexel) {
-    return;
   }
-  const uint64_t perArea = uint64_t(du) * (uint64_t(kWidthUnit) * kSubTexel / kCoverageOne);
-  static_assert(kSubTexel == 256);
-  // A whole texel's piece: its area, and its middle's v and depth stepped from texel to texel (the
-  // middle moves 2·kSubTexel in `twice` a texel); a piece cut by the segment's end is computed on its own.
-  const uint64_t wholeArea = (width * kSubTexel * length + perArea / 2) / perArea;
+  // A piece cut by the segment's end: its area w·o·L/|du| rounded, over 256·du.
+  const Divider perArea(256 * du, twoDu.reciprocal() / 128);
+  const uint64_t widthLength = width * length;
+  // A whole texel's piece's middle's v and depth stepped from texel to texel (the middle moves
+  // 2·kSubTexel in `twice` a texel); a piece cut by the segment's end is computed on its own.
   const int64_t twiceFirst = 2 * first * kSubTexel + kSubTexel - 2 * u0;
-  MidpointStep vStep(v0, dv, du, twiceFirst), depthStep(a.depth, dz, du, twiceFirst);
+  MidpointStep vStep(v0, dv, twoDu, twiceFirst), depthStep(a.depth, dz, twoDu, twiceFirst);
+  constexpr int64_t reachOut = across == Across::kBox ? 0 : kSubTexel / 2;
   for (int64_t c = first; c <= last; ++c, vStep.next(), depthStep.next()) {
     const int64_t lo = std::max(u0, c * kSubTexel), hi = std::min(u1, (c + 1) * kSubTexel);
     if (hi <= lo) continue;
     const bool whole = hi - lo == kSubTexel;
     // The piece's middle, as a fraction of the segment: (lo + hi − 2·u0) / (2·du).
     const int64_t twice = lo + hi - 2 * u0;
-    const int64_t v = whole ? vStep.value() : v0 + floorDiv(dv * twice, 2 * du);
-    const int32_t depth = int32_t(whole ? depthStep.value() : a.depth + floorDiv(dz * twice, 2 * du));
+    const int64_t v = whole ? vStep.value() : v0 + twoDu.floor(dv * twice);
+    const int32_t depth = int32_t(whole ? depthStep.value() : a.depth + twoDu.floor(dz * twice));
     // w·o·L/|du|: 1/(kWidthUnit·kSubTexel) texel², to kCoverageOne per texel², rounded.
-    const uint64_t area = whole ? wholeArea : (width * uint64_t(hi - lo) * length + perArea / 2) / perArea;
+    const uint64_t area =
+        whole ? wholeArea
+              : uint64_t(perArea.floor(int64_t(widthLength * uint64_t(hi - lo) + 128 * uint64_t(du))));
     // Where the piece lies from the caller's first point (the points were swapped when reversed).
     const Piece piece{reversed ? 2 * du - twice : twice, du};
     // The texels across whose filters reach the cross-section [v − halfExtent, v + halfExtent].
     const int64_t below = v - halfExtent, above = v + halfExtent;
-    const int64_t reachOut = across == Across::kBox ? 0 : kSubTexel / 2;
-    const int64_t mFirst = floorDiv(below - reachOut, kSubTexel);
-    const int64_t mLast = floorDiv(above + reachOut - 1, kSubTexel);
+    const int64_t mFirst = (below - reachOut) >> 8;  // ⌊·/kSubTexel⌋
+    const int64_t mLast = (above + reachOut - 1) >> 8;
+    auto emit = [&](int64_t m, uint64_t share) {
+      if (alongX)
+        fragment(c, m, depth, uint32_t(share), piece);
+      else
+        fragment(m, c, depth, uint32_t(share), piece);
+    };
     uint64_t given = 0;
+    if (!alongX || (mFirst >= rowLo && mLast < rowHi)) {  // every texel across wanted: most pieces
+      for (int64_t m = mFirst; m < mLast; ++m) {
+        const uint64_t share =
+            uint64_t(Uint128(area * uint64_t(acrossShare<across>(m, below, above))) * perExtent >> 40);
+        given += share;
+        emit(m, share);
+      }
+      emit(mLast, area - given);
+      continue;
+    }
     // Along x the texels across are rows, and those outside [rowLo, rowHi) are not wanted. Every texel
     // whose filter lies inside the cross-section, [insideFirst, insideLast], holds the same share, so a
     // run of unwanted ones is passed over with their shares' sum: `given` as adding them one by one
     // leaves it, so the wanted texels' shares are the same bits, and a strand thousands of texels wide
     // costs a band its rows, not its width.
-    const int64_t insideFirst = -floorDiv(-(below + reachOut), kSubTexel);
-    const int64_t insideLast = floorDiv(above - reachOut, kSubTexel) - 1;
+    const int64_t insideFirst = -((-(below + reachOut)) >> 8);  // ⌈·/kSubTexel⌉
+    const int64_t insideLast = ((above - reachOut) >> 8) - 1;
     for (int64_t m = mFirst; m <= mLast; ++m) {
-      if (alongX && (m < rowLo || m >= rowHi) && m >= insideFirst && m <= insideLast && m < mLast) {
+      if ((m < rowLo || m >= rowHi) && m >= insideFirst && m <= insideLast && m < mLast) {
         const int64_t next = std::min({m < rowLo ? rowLo : mLast, insideLast + 1, mLast});  // not passed over
         const uint64_t insideShare =  // asked for only here: most pieces have no run to pass over
             uint64_t(Uint128(area * uint64_t(acrossTotal<across>(kSubTexel))) * perExtent >> 40);
@@ -228,10 +291,7 @@ void rasteriseSegment(Vertex a, Vertex b, int64_t rowLo, int64_t rowHi, F&& frag
       if (m < mLast)
         share = uint64_t(Uint128(area * uint64_t(acrossShare<across>(m, below, above))) * perExtent >> 40);
       given += share;
-      if (alongX)
-        fragment(c, m, depth, uint32_t(share), piece);
-      else
-        fragment(m, c, depth, uint32_t(share), piece);
+      emit(m, share);
     }
   }
 }
