@@ -209,6 +209,41 @@ TEST(HairRaster, ABandOfAWideStrandIsTheSameBitsAndCostsItsRows) {
     }
 }
 
+// The rasteriser's quotients by a reciprocal are integer division's, rounded toward −∞: at the signs'
+// and the remainders' edges, for the divisors and numerators a segment has (its length along the major
+// axis, up to 2^27 in 1/kSubTexel; products up to 2^63), and past 2^50, where the double's estimate is
+// off by more than one and the exact division is taken instead.
+TEST(HairRaster, ADividersQuotientsAreIntegerDivisions) {
+  uint64_t state = 0x9e3779b97f4a7c15ull;
+  auto next = [&] {
+    state ^= state << 13, state ^= state >> 7, state ^= state << 17;
+    return state;
+  };
+  std::vector<int64_t> divisors = {1, 2, 3, 255, 256, 512, 513, (int64_t(1) << 27) - 1, int64_t(1) << 28};
+  while (divisors.size() < 200) divisors.push_back(int64_t(1 + next() % (uint64_t(1) << (1 + next() % 34))));
+  size_t checked = 0;
+  for (const int64_t d : divisors) {
+    const raster::Divider divider(d);
+    std::vector<int64_t> numerators = {0, 1, -1, d - 1, d, d + 1, -d, -d - 1, -d + 1, 3 * d, -3 * d};
+    for (int k = 0; k < 400; ++k) {
+      const int bits = int(next() % 63);
+      const int64_t magnitude = int64_t(next() >> (63 - bits));  // below 2^(bits + 1)
+      const int64_t n = next() % 2 ? magnitude : -magnitude;
+      numerators.insert(numerators.end(), {n, n - n % d, n - n % d - 1, n - n % d + 1});
+    }
+    numerators.push_back(std::numeric_limits<int64_t>::max() - d);  // a quotient near 2^63 / d
+    for (const int64_t n : numerators) {
+      ASSERT_EQ(divider.floor(n), raster::floorDiv(n, d)) << n << " / " << d;
+      ++checked;
+    }
+    uint64_t rest = 0;
+    const uint64_t n = next() >> 2;
+    ASSERT_EQ(divider.floor(n, rest), n / uint64_t(d));
+    EXPECT_EQ(rest, n % uint64_t(d));
+  }
+  EXPECT_GT(checked, size_t(200 * 1600));
+}
+
 // Two strands over the same texels, the second 4 mm behind the first: with layers of 2, 6, 15 and 40 mm
 // it adds to the second layer and those behind, not the first; where the hair begins is the first's
 // depth. (A strand's width in texels is its width over its depth: 0.5 texel at 1 m, 0.498 at 1.004 m.)
