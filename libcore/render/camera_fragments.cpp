@@ -174,7 +174,7 @@ CameraFragments cameraFragments(const raster::Bands& bands, int kept, const floa
     BandSlots& mine = perThread.local();
     mine.slots.resize((end - base) * size_t(kept));
     mine.used.assign(end - base, 0);
-    mine.touched.assign(end - base, UINT32_MAX);
+    mine.touched.resize(end - base);  // set by a pixel's first keep() in the band, which merges nothing
     std::vector<Slot>& slots = mine.slots;
     std::vector<uint8_t>& used = mine.used;
     bands.eachFragment<raster::Across::kBox>(

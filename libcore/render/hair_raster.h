@@ -31,10 +31,13 @@
 namespace hairgen {
 
 // Window positions are kept in 1/kSubTexel texel: 8 bits of sub-texel position, as GPUs snap vertices.
-inline constexpr int kSubTexel = 256;
+inline constexpr int kSubTexelBits = 8;
+inline constexpr int kSubTexel = 1 << kSubTexelBits;
 // A strand's projected width in 1/kWidthUnit texel, so a strand a tenth of a texel wide covers what it
 // should to 0.2% (products with a length in 1/kSubTexel still fit in 64 bits).
 inline constexpr int kWidthUnit = 1 << 16;
+// 1/kWidthUnit texel in 1/kSubTexel texel.
+inline constexpr int kWidthPerSub = kWidthUnit / kSubTexel;
 // Depth along the view's axis in whole micrometres: a 40 µm strand is 40 units, and 2^31 units reach
 // 2 km.
 inline constexpr double kDepthUnit = 1.0e-6;
@@ -181,7 +184,9 @@ constexpr int64_t acrossTotal(int64_t extent) {
 // fragments a segment has does not depend on the rows asked for.
 template <Across across, class F>
 void rasteriseSegment(Vertex a, Vertex b, int64_t rowLo, int64_t rowHi, F&& fragment) {
-  static_assert(kSubTexel == 256 && kWidthUnit / kSubTexel == 256 && kWidthUnit == kCoverageOne);
+  // A piece's area w·o·L/|du| (1/(kWidthUnit·kSubTexel) texel²) is in kCoverageOne per texel² over
+  // kSubTexel·du.
+  static_assert(kWidthUnit == kCoverageOne);
   const bool alongX = std::abs(int64_t(b.x) - a.x) >= std::abs(int64_t(b.y) - a.y);
   auto major = [&](const Vertex& v) { return int64_t(alongX ? v.x : v.y); };
   auto minor = [&](const Vertex& v) { return int64_t(alongX ? v.y : v.x); };
@@ -190,25 +195,25 @@ void rasteriseSegment(Vertex a, Vertex b, int64_t rowLo, int64_t rowHi, F&& frag
   const int64_t u0 = major(a), u1 = major(b), v0 = minor(a);
   const int64_t du = u1 - u0, dv = minor(b) - v0, dz = int64_t(b.depth) - a.depth;
   if (du == 0) return;  // seen end on: no length, no area
-  // Every quotient below is by 2·du (or 256·du): one reciprocal for all of them (Divider).
+  // Every quotient below is by 2·du (or kSubTexel·du): one reciprocal for all of them (Divider).
   const Divider twoDu(2 * du);
   // Rounded to the nearest 1/kSubTexel, so short segments are not all a little short.
   const uint64_t length = roundedSqrt(uint64_t(du * du + dv * dv));
   const uint64_t width = (uint64_t(a.width) + uint64_t(b.width)) / 2;  // 1/kWidthUnit texel
   // The ribbon's extent across the major axis, ⌊w·L/|du|⌋ in 1/kWidthUnit texel, and a whole texel's
-  // piece's area, w·L/|du| rounded to kCoverageOne per texel² (kSubTexel·kWidthUnit/kCoverageOne·du
-  // divides w·kSubTexel·L: the same quotient, rounded half up).
+  // piece's area, w·L/|du| rounded to kCoverageOne per texel² (w·kSubTexel·L over kSubTexel·du: the
+  // same quotient, rounded half up).
   uint64_t twiceRest;  // 2·(w·L mod du)
   const uint64_t extent = twoDu.floor(2 * width * length, twiceRest);
   const uint64_t wholeArea = extent + (twiceRest >= uint64_t(du) ? 1 : 0);
   // Half the extent in 1/kSubTexel, at least one (a thinner ribbon is shared as a line is).
-  const int64_t halfExtent = std::max<int64_t>(1, int64_t((extent + 256) / 512));
+  const int64_t halfExtent = std::max<int64_t>(1, int64_t((extent + kWidthPerSub) / (2 * kWidthPerSub)));
   // The reciprocal of what the shares of the cross-section sum to, in 1/2^40, so a texel's part of a
   // piece's area is a multiplication and a shift.
   const uint64_t perExtent = (uint64_t(1) << 40) / uint64_t(acrossTotal<across>(2 * halfExtent));
   // The texels along the major axis, [first, last], narrowed to those that can reach the rows.
-  int64_t first = u0 >> 8, last = (u1 - 1) >> 8;
-  const int64_t reach = int64_t(extent / 512) + 2 * kSubTexel;
+  int64_t first = u0 >> kSubTexelBits, last = (u1 - 1) >> kSubTexelBits;
+  const int64_t reach = int64_t(extent / (2 * kWidthPerSub)) + 2 * kSubTexel;
   if (!alongX) {
     first = std::max(first, rowLo);
     last = std::min(last, rowHi - 1);
@@ -228,8 +233,8 @@ void rasteriseSegment(Vertex a, Vertex b, int64_t rowLo, int64_t rowHi, F&& frag
     first = std::max(first, int64_t(std::floor(c0)) - 2);
     last = std::min(last, int64_t(std::ceil(c1)) + 2);
   }
-  // A piece cut by the segment's end: its area w·o·L/|du| rounded, over 256·du.
-  const Divider perArea(256 * du, twoDu.reciprocal() / 128);
+  // A piece cut by the segment's end: its area w·o·L/|du| rounded, over kSubTexel·du.
+  const Divider perArea(kSubTexel * du, twoDu.reciprocal() / (kSubTexel / 2));
   const uint64_t widthLength = width * length;
   // A whole texel's piece's middle's v and depth stepped from texel to texel (the middle moves
   // 2·kSubTexel in `twice` a texel); a piece cut by the segment's end is computed on its own.
@@ -245,15 +250,20 @@ void rasteriseSegment(Vertex a, Vertex b, int64_t rowLo, int64_t rowHi, F&& frag
     const int64_t v = whole ? vStep.value() : v0 + twoDu.floor(dv * twice);
     const int32_t depth = int32_t(whole ? depthStep.value() : a.depth + twoDu.floor(dz * twice));
     // w·o·L/|du|: 1/(kWidthUnit·kSubTexel) texel², to kCoverageOne per texel², rounded.
-    const uint64_t area =
-        whole ? wholeArea
-              : uint64_t(perArea.floor(int64_t(widthLength * uint64_t(hi - lo) + 128 * uint64_t(du))));
+    const uint64_t area = whole ? wholeArea
+                                : uint64_t(perArea.floor(int64_t(widthLength * uint64_t(hi - lo) +
+                                                                 kSubTexel / 2 * uint64_t(du))));
     // Where the piece lies from the caller's first point (the points were swapped when reversed).
     const Piece piece{reversed ? 2 * du - twice : twice, du};
     // The texels across whose filters reach the cross-section [v − halfExtent, v + halfExtent].
     const int64_t below = v - halfExtent, above = v + halfExtent;
-    const int64_t mFirst = (below - reachOut) >> 8;  // ⌊·/kSubTexel⌋
-    const int64_t mLast = (above + reachOut - 1) >> 8;
+    const int64_t mFirst = (below - reachOut) >> kSubTexelBits;  // ⌊·/kSubTexel⌋
+    const int64_t mLast = (above + reachOut - 1) >> kSubTexelBits;
+    // Texel m's share of the piece's area, and the fragment it makes (the last texel across takes
+    // what the others left, so the shares sum to the area).
+    auto shareOf = [&](int64_t m) {
+      return uint64_t(Uint128(area * uint64_t(acrossShare<across>(m, below, above))) * perExtent >> 40);
+    };
     auto emit = [&](int64_t m, uint64_t share) {
       if (alongX)
         fragment(c, m, depth, uint32_t(share), piece);
@@ -263,8 +273,7 @@ void rasteriseSegment(Vertex a, Vertex b, int64_t rowLo, int64_t rowHi, F&& frag
     uint64_t given = 0;
     if (!alongX || (mFirst >= rowLo && mLast < rowHi)) {  // every texel across wanted: most pieces
       for (int64_t m = mFirst; m < mLast; ++m) {
-        const uint64_t share =
-            uint64_t(Uint128(area * uint64_t(acrossShare<across>(m, below, above))) * perExtent >> 40);
+        const uint64_t share = shareOf(m);
         given += share;
         emit(m, share);
       }
@@ -276,8 +285,8 @@ void rasteriseSegment(Vertex a, Vertex b, int64_t rowLo, int64_t rowHi, F&& frag
     // run of unwanted ones is passed over with their shares' sum: `given` as adding them one by one
     // leaves it, so the wanted texels' shares are the same bits, and a strand thousands of texels wide
     // costs a band its rows, not its width.
-    const int64_t insideFirst = -((-(below + reachOut)) >> 8);  // ⌈·/kSubTexel⌉
-    const int64_t insideLast = ((above - reachOut) >> 8) - 1;
+    const int64_t insideFirst = -((-(below + reachOut)) >> kSubTexelBits);  // ⌈·/kSubTexel⌉
+    const int64_t insideLast = ((above - reachOut) >> kSubTexelBits) - 1;
     for (int64_t m = mFirst; m <= mLast; ++m) {
       if ((m < rowLo || m >= rowHi) && m >= insideFirst && m <= insideLast && m < mLast) {
         const int64_t next = std::min({m < rowLo ? rowLo : mLast, insideLast + 1, mLast});  // not passed over
@@ -287,9 +296,7 @@ void rasteriseSegment(Vertex a, Vertex b, int64_t rowLo, int64_t rowHi, F&& frag
         m = next - 1;
         continue;
       }
-      uint64_t share = area - given;
-      if (m < mLast)
-        share = uint64_t(Uint128(area * uint64_t(acrossShare<across>(m, below, above))) * perExtent >> 40);
+      const uint64_t share = m < mLast ? shareOf(m) : area - given;
       given += share;
       emit(m, share);
     }

@@ -580,7 +580,12 @@ ShadedImage shadingPass(Scene& scene, const LightDepth& depth, const Texture& op
   return blendHair(scene, {words.id, first.id, tail.id, f.count()}, image);
 }
 
-ShadedImage resolvePass(const Scene& scene, const ShadedImage& subpixels) {
+ShadedImage resolvePass(const Scene& scene, ShadedImage&& subpixels) {
+  // One sample a pixel, blended: the resolve would copy the image as it is (its sums over one sample;
+  // the blend writes Z below 3e38 and W 0, the resolve's own bounds), into a 1080p frame's 66 MB of
+  // fresh textures with a pass, so it is read where it was drawn. OpenGL's own strands count their A
+  // here.
+  if (scene.block == 1 && subpixels.blended) return std::move(subpixels);
   const int w = scene.camera.width, h = scene.camera.height;
   ShadedImage image{Texture(GL_RGBA32F, w, h), Texture(GL_RGBA32F, w, h), true};
   Framebuffer fb({&image.color, &image.data}, w, h, false);

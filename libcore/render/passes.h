@@ -125,8 +125,8 @@ Texture deepOpacityPass(const Scene& scene, LightDepth& depth);
 // the camera's bands once their fragments are made.
 ShadedImage shadingPass(Scene& scene, const LightDepth& depth, const Texture& opacity, size_t& fragments,
                         double& fragmentSeconds);
-// At the image's resolution.
-ShadedImage resolvePass(const Scene& scene, const ShadedImage& subpixels);
+// At the image's resolution: a blended image of one sample a pixel is that image, as it is.
+ShadedImage resolvePass(const Scene& scene, ShadedImage&& subpixels);
 // At sub-pixel resolution, RGBA32F: motion u, v (pixels of the image), 1 where something was drawn.
 Texture motionPass(const Scene& scene);
 // At the image's resolution: u, v.

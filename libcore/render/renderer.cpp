@@ -61,11 +61,8 @@ RenderOutput renderHair(GlContext&, const RenderInput& in) {
   scene.releaseLightMaps();
   out.timings.opacity = seconds(clock);
   passDone();
-  ShadedImage shaded = shadingPass(scene, depth, opacity, out.hairFragments, out.timings.fragments);
-  // One sample a pixel, blended: the resolve would copy the image as it is (a 1080p frame's 66 MB of
-  // textures and a pass), so it is read where it was drawn.
   const ShadedImage image =
-      scene.block == 1 && shaded.blended ? std::move(shaded) : resolvePass(scene, shaded);
+      resolvePass(scene, shadingPass(scene, depth, opacity, out.hairFragments, out.timings.fragments));
   out.timings.shading = seconds(clock);
   passDone();
   std::optional<Texture> motion;
