@@ -295,7 +295,8 @@ RenderOptions renderOptionsOf(const RenderArgs& args) {
 // A --hair file as the render stage takes it: with --translate, converted (--units, --up-axis, --scale)
 // and moved here, since the move comes after the conversion.
 Strands readHair(const RenderArgs& args, const RenderOptions& renderOptions, const std::string& file) {
-  Strands h = readStrands(file);
+  // Where the file's pages lie: the render is done with it before the command ends (hair_io.h).
+  Strands h = readStrands(file, {}, ArrayStorage::kMapped);
   if (!args.translate.empty()) {
     conform(h, renderOptions.zUp, renderOptions.scale);
     const glm::vec3 offset(args.translate[0], args.translate[1], args.translate[2]);

@@ -120,6 +120,7 @@ void Stats::write(const CommonOptions& options) {
 
 int runCommand(const std::string& command, const CommonOptions& options, const std::function<void()>& body) {
   installInterruptCleanup();
+  installMappingGuard(command);
   forgetCommittedOutputs();
   gFailedStats = nullptr;
   gStatsWriteFailed = false;

@@ -1,7 +1,9 @@
 // The .hair cache: cyHair compatibility, byte-for-byte round trips, and hostile files.
 #include <gtest/gtest.h>
 
+#include <cstdio>
 #include <cstring>
+#include <fstream>
 
 #include <zlib.h>
 
@@ -9,6 +11,7 @@
 #include "libcore/util/error.h"
 #include "libcore/util/file_util.h"
 #include "libcore/util/huge_pages.h"
+#include "libcore/util/mapped_file.h"
 #include "tests/test_util.h"
 
 namespace hairgen {
@@ -203,6 +206,108 @@ TEST(HairFile, RealCyHairFilesRead) {
   EXPECT_EQ(straight.pointCount(), 160000u);
   Strands bangs = readHair(test::realData() / "hairutil" / "Bangs_100.hair");  // a segments array
   EXPECT_EQ(bangs.strandCount(), 100u);
+}
+
+// Large strands of `pointsEach` points each (plus one more on every other strand when `uneven`), with
+// tangents: past the 8 MB at which a mapped read holds point arrays where the file has them.
+Strands largeStrands(size_t strands, uint32_t pointsEach, bool uneven) {
+  Strands s;
+  for (size_t i = 0; i < strands; ++i) {
+    const uint32_t n = pointsEach + (uneven && i % 2 ? 1 : 0);
+    for (uint32_t k = 0; k < n; ++k)
+      s.points.push_back(glm::vec3(0.001f * float(i), 0.002f * float(k), 0.5f));
+    s.firstPoint.push_back(uint32_t(s.points.size()));
+  }
+  s.tangents = polylineTangents(s);
+  return s;
+}
+
+// What /proc/self/smaps says of the mapping that holds `address`: its file (empty for memory of the
+// process's own) and its resident KiB.
+struct MappedAt {
+  std::string file;
+  long residentKiB = 0;
+};
+MappedAt mappingAt(const void* address) {
+  std::ifstream smaps("/proc/self/smaps");
+  const uintptr_t at = reinterpret_cast<uintptr_t>(address);
+  std::string line;
+  bool inside = false;
+  MappedAt found;
+  while (std::getline(smaps, line)) {
+    unsigned long begin = 0, end = 0;  // a mapping's first line: "BEGIN-END perms offset dev inode path"
+    if (std::sscanf(line.c_str(), "%lx-%lx", &begin, &end) == 2 && line.find('-') < line.find(' ')) {
+      if (inside) break;
+      inside = at >= begin && at < end;
+      if (inside) {
+        const size_t slash = line.find('/');
+        found.file = slash == std::string::npos ? "" : line.substr(slash);
+      }
+      continue;
+    }
+    if (inside && line.rfind("Rss:", 0) == 0) found.residentKiB = std::atol(line.c_str() + 4);
+  }
+  return found;
+}
+
+// The render reads a coupe where the file's pages lie: the same strands as a copy, its points and
+// tangents the file's own pages, the tangents not the process's until they are read, and a write to
+// them the process's alone.
+TEST(HairFile, AMappedReadHoldsTheFilesPagesAndWritesNoneOfThem) {
+  test::TempDir dir("mapped");
+  const std::filesystem::path file = dir / "coupe.hair";
+  writeHair(file, largeStrands(20000, 50, false));  // 12 MB of points, 12 MB of tangents
+  const std::vector<uint8_t> bytes = readFileBytes(file);
+  const Strands copied = readHair(file);
+  Strands mapped = readHair(file, nullptr, ArrayStorage::kMapped);
+  // Resident: the points (validate() read them), not the tangents, until they are read.
+  const long arrayKiB = long(mapped.points.size() * sizeof(glm::vec3) / 1024);
+  const long before = mappingAt(mapped.points.data()).residentKiB;
+  EXPECT_LT(before, arrayKiB + arrayKiB / 4);
+  test::expectSameStrands(mapped, copied);
+  EXPECT_GT(mappingAt(mapped.points.data()).residentKiB, before + arrayKiB - arrayKiB / 4);
+  EXPECT_EQ(mappingAt(mapped.points.data()).file, file.string());
+  EXPECT_EQ(mappingAt(mapped.tangents.data()).file, file.string());
+  EXPECT_EQ(mappingAt(copied.points.data()).file, "");
+  // A copy is memory of its own; a write changes the process's page, never the file.
+  const Strands copy = mapped;
+  EXPECT_EQ(mappingAt(copy.points.data()).file, "");
+  mapped.points[0] = glm::vec3(9.0f);
+  mapped.tangents.back() = glm::vec3(0.0f, 0.0f, 1.0f);
+  EXPECT_EQ(readFileBytes(file), bytes);
+  EXPECT_EQ(copy.points[0], copied.points[0]);
+  mapped = Strands{};  // the mapping goes with its last array
+  EXPECT_EQ(readHair(file, nullptr, ArrayStorage::kMapped), copied);
+}
+
+// Where the points do not lie on a float's boundary (an odd number of strands of unequal lengths: a
+// 2-byte segment count each before them), a mapped read copies them, and reads the same strands.
+TEST(HairFile, AMappedReadCopiesArraysTheFileDoesNotAlign) {
+  test::TempDir dir("unaligned");
+  const std::filesystem::path file = dir / "uneven.hair";
+  writeHair(file, largeStrands(20001, 50, true));
+  const Strands mapped = readHair(file, nullptr, ArrayStorage::kMapped);
+  EXPECT_EQ(mapped, readHair(file));
+  EXPECT_EQ(mappingAt(mapped.points.data()).file, "");
+  EXPECT_EQ(mappingAt(mapped.tangents.data()).file, "");
+}
+
+// A mapped file that another process shrinks under the render: the read past its end is the error a
+// read would give, exit code 2, not a crash.
+TEST(HairFileDeathTest, AMappedFileThatShrinksEndsTheCommandWithExitCode2) {
+  GTEST_FLAG_SET(death_test_style, "threadsafe");
+  test::TempDir dir("shrinks");
+  const std::filesystem::path file = dir / "coupe.hair";
+  writeHair(file, largeStrands(20000, 50, false));
+  EXPECT_EXIT(
+      {
+        installMappingGuard("render");
+        const Strands mapped = readHair(file, nullptr, ArrayStorage::kMapped);
+        std::filesystem::resize_file(file, 4096);
+        volatile float last = mapped.tangents.back().z;
+        std::exit(last > 2.0f ? 3 : 0);
+      },
+      ::testing::ExitedWithCode(2), "hairgen render: error: .*coupe.hair: the file shrank while it was read");
 }
 
 // The large arrays a cache is read into grow as resize grows them: the old values kept, the new ones

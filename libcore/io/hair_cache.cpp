@@ -73,7 +73,8 @@ void noteSource(Strands& strands, const std::filesystem::path& file) {
     strands.provenance.source = file.filename().string();
 }
 
-Strands readStrands(const std::filesystem::path& file, const UnitConversion& conversion) {
+Strands readStrands(const std::filesystem::path& file, const UnitConversion& conversion,
+                    ArrayStorage storage) {
   Strands strands;
   const HairFormat format = hairFormatOf(file);
   if (!hairgenReads(format))
@@ -81,7 +82,7 @@ Strands readStrands(const std::filesystem::path& file, const UnitConversion& con
                                              " but does not read it; it reads " + readHairExtensionList());
   switch (format) {
     case HairFormat::kHair:
-      strands = readHair(file);
+      strands = readHair(file, nullptr, storage);
       break;
     case HairFormat::kGltf:
     case HairFormat::kGlb:

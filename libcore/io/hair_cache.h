@@ -11,6 +11,7 @@
 #include <optional>
 #include <string>
 
+#include "libcore/io/hair_io.h"
 #include "libcore/model/strands.h"
 #include "libcore/model/units.h"
 
@@ -37,8 +38,9 @@ const char* describe(HairFormat format);
 // `conversion` (convertToHairgenFrame). A file hairgen did not write (no hairgen provenance) gets its name
 // as Provenance::source, so what is made from it can say where it came from. PLY and .data files state
 // no default width: theirs is hairgen's default, in metres after the conversion (a cyHair header's own
-// default is scaled with the file).
-Strands readStrands(const std::filesystem::path& file, const UnitConversion& conversion = {});
+// default is scaled with the file). `storage`: how a .hair file's point arrays are held (hair_io.h).
+Strands readStrands(const std::filesystem::path& file, const UnitConversion& conversion = {},
+                    ArrayStorage storage = ArrayStorage::kCopied);
 
 // How formats with a choice are written.
 struct WriteOptions {

@@ -26,6 +26,8 @@ constexpr uint32_t kSegments = 1, kPoints = 2, kThickness = 4, kTransparency = 8
 constexpr size_t kHeaderSize = 128, kInfoSize = 88;
 constexpr uint32_t kBlockVersion = 1;
 constexpr uint32_t kMaxChunks = 1024;
+// A point array this large or larger is held where a mapped file has it (ArrayStorage::kMapped).
+constexpr size_t kMappedArray = size_t(8) << 20;
 // The arrays are the bytes of these types: packed floats and uint32s, as the layout says.
 static_assert(sizeof(glm::vec3) == 12 && sizeof(glm::vec2) == 8 && sizeof(glm::uvec3) == 12);
 
@@ -129,6 +131,10 @@ class Source {
   virtual ~Source() = default;
   virtual uint64_t remaining() const = 0;
   virtual void read(void* out, size_t bytes) = 0;  // after need(): the bytes are there
+  // The next `bytes` bytes where they lie in a mapped file, for an array to hold without a copy; null
+  // where the source maps nothing. The caller then skip()s them.
+  virtual std::shared_ptr<MappedRegion> region(size_t) { return nullptr; }
+  virtual void skip(size_t) {}
 };
 
 class MemorySource final : public Source {
@@ -147,12 +153,20 @@ class MemorySource final : public Source {
 
 class FileSource final : public Source {
  public:
-  explicit FileSource(const std::filesystem::path& path) : file_(path) {}
+  FileSource(const std::filesystem::path& path, ArrayStorage storage)
+      : file_(path), mapped_(storage == ArrayStorage::kMapped) {}
   uint64_t remaining() const override { return file_.remaining(); }
   void read(void* out, size_t bytes) override { file_.read(out, bytes); }
+  std::shared_ptr<MappedRegion> region(size_t bytes) override {
+    const std::shared_ptr<FileMapping> mapping = mapped_ ? file_.mapping() : nullptr;
+    if (!mapping) return nullptr;
+    return std::make_shared<MappedRegion>(MappedRegion{mapping, mapping->data() + file_.position(), bytes});
+  }
+  void skip(size_t bytes) override { file_.skip(bytes); }
 
  private:
   InputFile file_;
+  bool mapped_;
 };
 
 class Reader {
@@ -185,14 +199,51 @@ class Reader {
   template <size_t Word, typename T, class A>
   void array(std::vector<T, A>& v, uint64_t count, uint32_t* crc = nullptr) {
     static_assert(sizeof(T) % Word == 0);
-    resizeLarge(v, count);
     const size_t n = size_t(count) * sizeof(T);
+    if constexpr (kLittleEndian && std::is_same_v<A, MappableAllocator<T>>) {
+      if (n >= kMappedArray && mapped(v, count, crc)) return;
+    }
+    resizeLarge(v, count);
     bytes(v.data(), n);
     if (crc) *crc = crcOf(*crc, reinterpret_cast<const uint8_t*>(v.data()), n);
     if constexpr (!kLittleEndian) swapWords<Word>(v.data(), n);
   }
 
  private:
+  // A point array held where the source's mapping has it (the next count · 12 bytes), when it lies on
+  // a float's boundary there (the points of a file whose strands differ in length start 2 bytes past
+  // one when their number is odd: read as a copy). A chunk's, once the file is checked, leaves the
+  // process until what reads the array reads it (releaseChecked): the render's tangents are not the
+  // process's through the passes that do not shade.
+  template <typename T>
+  bool mapped(std::vector<T, MappableAllocator<T>>& v, uint64_t count, uint32_t* crc) {
+    const std::shared_ptr<MappedRegion> region = source_.region(size_t(count) * sizeof(T));
+    if (!region) return false;
+    std::vector<T, MappableAllocator<T>> held{MappableAllocator<T>(region)};
+    held.reserve(size_t(count));
+    if (held.data() != region->data) return false;  // not aligned: allocated, and freed here
+    held.resize(size_t(count));
+    source_.skip(region->bytes);
+    if (crc) {
+      *crc = crcOf(*crc, static_cast<const uint8_t*>(region->data), region->bytes);
+      checked_.push_back(region);
+    }
+    v = std::move(held);
+    return true;
+  }
+
+ public:
+  // The mapped chunks leave the process, once the file's checks have read them (a chunk's CRC, the
+  // strands' validate()): nothing has written them.
+  void releaseChecked() {
+    for (const std::shared_ptr<MappedRegion>& r : checked_)
+      r->file->release(uint64_t(static_cast<uint8_t*>(r->data) - r->file->data()), r->bytes);
+    checked_.clear();
+  }
+
+ private:
+  std::vector<std::shared_ptr<MappedRegion>> checked_;
+
   Source& source_;
   const std::string& name_;
 };
@@ -497,6 +548,7 @@ Strands decodeHairFrom(Source& source, const std::string& name, HairHeader* head
     s.provenance.sourceInfo = header.info;
   }
   s.validate(name);
+  r.releaseChecked();
   if (headerOut) *headerOut = std::move(header);
   return s;
 }
@@ -515,8 +567,8 @@ Strands decodeHair(const uint8_t* data, size_t size, const std::string& name, Ha
   return decodeHairFrom(source, name, header);
 }
 
-Strands readHair(const std::filesystem::path& file, HairHeader* header) {
-  FileSource source(file);
+Strands readHair(const std::filesystem::path& file, HairHeader* header, ArrayStorage storage) {
+  FileSource source(file, storage);
   return decodeHairFrom(source, file.string(), header);
 }
 

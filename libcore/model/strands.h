@@ -11,7 +11,7 @@
 
 #include <glm/glm.hpp>
 
-#include "libcore/util/uninitialised.h"
+#include "libcore/util/mapped_file.h"
 
 namespace hairgen {
 
@@ -55,9 +55,10 @@ struct Provenance {
 // The provenance of what this build of hairgen makes: producer "hairgen VERSION", no frame.
 Provenance madeByHairgen(std::string stage, uint64_t seed, std::string configDigest);
 
-// A coupe's points or tangents. Sizing one leaves its new elements unset (UninitialisedAllocator): whoever
-// resizes it writes every element it adds, so hundreds of MB are written once, not zeroed first.
-using PointArray = std::vector<glm::vec3, UninitialisedAllocator<glm::vec3>>;
+// A coupe's points or tangents. Sizing one leaves its new elements unset (MappableAllocator): whoever
+// resizes it writes every element it adds, so hundreds of MB are written once, not zeroed first. Read
+// from a .hair file for the render, its storage may be the file's own pages (hair_io.h: ArrayStorage).
+using PointArray = std::vector<glm::vec3, MappableAllocator<glm::vec3>>;
 
 // A set of polyline strands. Strand s owns points [firstPoint[s], firstPoint[s+1]).
 //

@@ -69,8 +69,7 @@ void releaseTemporary(int slot) {
 }
 
 extern "C" void removeTemporariesAndExit(int signal) {
-  for (TemporarySlot& slot : gTemporaries)
-    if (slot.state.load() == 2) ::unlink(slot.path);
+  removeTemporariesOfWritesInFlight();
   ::_exit(128 + signal);
 }
 
@@ -369,6 +368,21 @@ InputFile::~InputFile() {
   ::close(fd_);
 }
 
+std::shared_ptr<FileMapping> InputFile::mapping() {
+  if (!mapping_ && !mappingRefused_) {
+    mapping_ = FileMapping::map(fd_, size_, name_);
+    mappingRefused_ = !mapping_;
+  }
+  return mapping_;
+}
+
+void InputFile::skip(uint64_t bytes) {
+  if (bytes > size_ - position_) throw InputError({name_, 0}, "the file shrank while it was read");
+  if (::lseek(fd_, off_t(position_ + bytes), SEEK_SET) < 0)
+    throw IoError({name_, 0}, std::string("seek failed: ") + std::strerror(errno));
+  position_ += bytes;
+}
+
 void InputFile::read(void* out, size_t bytes) {
   if (bytes > size_ - position_) throw InputError({name_, 0}, "the file shrank while it was read");
   size_t done = 0;
@@ -591,6 +605,11 @@ void writeFileAtomic(const fs::path& target, const void* data, size_t size) {
   AtomicFile file(target);
   file.stream().write(static_cast<const char*>(data), static_cast<std::streamsize>(size));
   file.commit();
+}
+
+void removeTemporariesOfWritesInFlight() {
+  for (TemporarySlot& slot : gTemporaries)
+    if (slot.state.load() == 2) ::unlink(slot.path);
 }
 
 void installInterruptCleanup() {

@@ -31,6 +31,8 @@
 #include <string>
 #include <vector>
 
+#include "libcore/util/mapped_file.h"
+
 namespace hairgen {
 
 // Reads a whole input file. A missing, unreadable, non-regular or too large file is an InputError
@@ -50,13 +52,20 @@ class InputFile {
   InputFile& operator=(const InputFile&) = delete;
 
   uint64_t size() const { return size_; }
+  uint64_t position() const { return position_; }
   uint64_t remaining() const { return size_ - position_; }
   void read(void* out, size_t bytes);
+  // Moves on `bytes` without reading them (what remains is checked, as read() checks it).
+  void skip(uint64_t bytes);
+  // The whole file mapped (mapped_file.h), made on the first call; null where it cannot be.
+  std::shared_ptr<FileMapping> mapping();
 
  private:
   std::string name_;
   int fd_ = -1;
   uint64_t size_ = 0, position_ = 0;
+  std::shared_ptr<FileMapping> mapping_;
+  bool mappingRefused_ = false;
 };
 
 // A 64-bit digest of a file's bytes, 16 hex digits (XXH64's round over little-endian 8-byte words in
@@ -117,6 +126,9 @@ inline void writeFileAtomic(const std::filesystem::path& target, const std::stri
 // Installs the SIGINT, SIGTERM and SIGHUP handlers (once; a signal the parent set to be ignored stays
 // ignored).
 void installInterruptCleanup();
+// Removes the temporaries of the writes in flight, as those handlers do: only async-signal-safe calls,
+// for a handler that ends the process (mapped_file.h's SIGBUS).
+void removeTemporariesOfWritesInFlight();
 
 // discardCommittedOutputs: removes the files committed since the last keepCommittedOutputs() (or since
 // forgetCommittedOutputs()), each only while its name still holds the file this process made there
