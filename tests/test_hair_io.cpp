@@ -208,8 +208,8 @@ TEST(HairFile, RealCyHairFilesRead) {
   EXPECT_EQ(bangs.strandCount(), 100u);
 }
 
-// Large strands of `pointsEach` points each (plus one more on every other strand when `uneven`), with
-// tangents: past the 8 MB at which a mapped read holds point arrays where the file has them.
+// Strands of `pointsEach` points each (plus one more on every other strand when `uneven`), with
+// tangents.
 Strands largeStrands(size_t strands, uint32_t pointsEach, bool uneven) {
   Strands s;
   for (size_t i = 0; i < strands; ++i) {

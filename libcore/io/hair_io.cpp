@@ -26,8 +26,10 @@ constexpr uint32_t kSegments = 1, kPoints = 2, kThickness = 4, kTransparency = 8
 constexpr size_t kHeaderSize = 128, kInfoSize = 88;
 constexpr uint32_t kBlockVersion = 1;
 constexpr uint32_t kMaxChunks = 1024;
-// A point array this large or larger is held where a mapped file has it (ArrayStorage::kMapped).
-constexpr size_t kMappedArray = size_t(8) << 20;
+// A point array this large or larger is held where a mapped file has it (ArrayStorage::kMapped); a
+// smaller one is copied, cheaper than its own faults. Low enough that the renders of the test suite's
+// coupes map theirs.
+constexpr size_t kMappedArray = size_t(64) << 10;
 // The arrays are the bytes of these types: packed floats and uint32s, as the layout says.
 static_assert(sizeof(glm::vec3) == 12 && sizeof(glm::vec2) == 8 && sizeof(glm::uvec3) == 12);
 

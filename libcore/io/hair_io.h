@@ -40,7 +40,7 @@ std::vector<uint8_t> encodeHair(const Strands& strands);
 // truncated, corrupt or inconsistent file is an InputError naming `name`.
 Strands decodeHair(const uint8_t* data, size_t size, const std::string& name, HairHeader* header = nullptr);
 
-// How a read holds a file's large point arrays (points, tangents: 8 MB or more each): copied into
+// How a read holds a file's point arrays (points, tangents: 64 KiB or more each): copied into
 // memory of their own, or where the file's pages lie (mapped_file.h), neither copied nor, until read,
 // the process's. Mapped is for a reader that is done with the file in one command (the render): one
 // that rewrites the file in place meanwhile changes what it reads (hairgen's own writes never do).
