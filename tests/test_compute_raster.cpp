@@ -82,9 +82,6 @@ Strands tangle(int strands, unsigned seed) {
 
 constexpr glm::dvec4 kLayers{0.002, 0.006, 0.015, 0.04};
 
-// The device's prefix sums (the camera's lists' places) are the host's, modulo 2^32: for one word,
-// within one block, just past it, and over two levels of blocks; words past a word's range (the sums
-// wrap), a limit on each word, and the largest word found alongside.
 // Every pass compiles and links on this device, at the kept counts a pixel can have: where one does not,
 // a render on `auto` would quietly draw on the CPU (computePassesFailure), so CI says so here.
 TEST(ComputeRaster, EveryPassBuildsOnThisDevice) {
@@ -92,6 +89,9 @@ TEST(ComputeRaster, EveryPassBuildsOnThisDevice) {
   for (int kept : {1, kKeptFragments, 255}) EXPECT_EQ(computePassesFailure(kept), "") << kept << " kept";
 }
 
+// The device's prefix sums (the camera's lists' places) are the host's, modulo 2^32: for one word,
+// within one block, just past it, and over two levels of blocks; words past a word's range (the sums
+// wrap), a limit on each word, and the largest word found alongside.
 TEST(ComputeRaster, PrefixSumsAreTheHostsModulo2To32) {
   SKIP_WITHOUT_COMPUTE_RASTER();
   std::mt19937 random(5);
@@ -185,9 +185,6 @@ TEST(ComputeRaster, TheCamerasFragmentsAreTheCpusBits) {
   EXPECT_FALSE(computeCameraFragments(device, 8, nullptr, 64));
 }
 
-// A whole render, coupe 3 at a fifth of its density on its head at 320×240 with 4 samples, the light's
-// maps kept: the rasteriser on the device gives the image and maps the CPU's does, every channel to the
-// bit (on llvmpipe the shading around them is the same code too).
 // 70,000 strands 4 texels wide over the same few rows: each texel's sums pass 2^32 (65,536 whole
 // texels), which the CPU's sums saturate at and the device flags; the camera's tails saturate alike. A
 // software rasteriser cannot sort 70,000 fragments of a pixel within its loop budget (compute_raster.h:
@@ -224,6 +221,9 @@ TEST(ComputeRaster, SumsPastAWordSaturateAsTheCpusDo) {
   EXPECT_TRUE(gpuFragments.words == cpuFragments.words);
 }
 
+// A whole render, coupe 3 at a fifth of its density on its head at 320×240 with 4 samples, the light's
+// maps kept: the rasteriser on the device gives the image and maps the CPU's does, every channel to the
+// bit (on llvmpipe the shading around them is the same code too).
 TEST(ComputeRaster, ARenderIsTheSameBitsWhereverTheRasteriserRuns) {
   SKIP_WITHOUT_COMPUTE_RASTER();
   test::Job job = test::loadJob("thesis/coupe3/setup.txt", SetupUse::kRender);
