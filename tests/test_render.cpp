@@ -295,6 +295,39 @@ TEST(HairLightMaps, TheMapsAreTheSameBitsOnOneThreadAsOnAll) {
   EXPECT_TRUE(all.layers == single.layers && all.layers == again.layers);
 }
 
+// The maps are their definition's, every fragment counted, however near or far each arrives after those
+// before it: the rasteriser keeps only the fragments near enough to where its texel's hair begins so
+// far to fall in the first three layers. Strands at seven depths 10 mm apart (layers end 2, 8 and 23 mm
+// behind where the hair begins), sloping 30 mm along their length, in an order mixing near and far.
+TEST(HairLightMaps, TheLayersAreEveryFragmentsSumsWhateverOrderTheyArriveIn) {
+  Strands s = crossingEveryWay();
+  for (size_t p = 0; p < s.points.size(); ++p) s.points[p].z -= 0.03f * float(p % 12) / 11.0f;
+  const View view = texelView(256);
+  const HairLightMaps maps = rasteriseLightMaps(s, view, 0.7, kLayers);
+  const raster::Bands bands = raster::projectIntoBands(s, view, 0.7);
+  std::vector<int32_t> start(maps.start.size(), INT32_MAX);
+  std::vector<std::array<int64_t, 3>> fragments;  // texel, depth, coverage
+  for (int b = 0; b < bands.count; ++b)
+    bands.eachFragment<raster::Across::kTent>(
+        b, [&](size_t t, int32_t depth, uint32_t coverage, uint32_t, raster::Piece) {
+          start[t] = std::min(start[t], depth);
+          fragments.push_back({int64_t(t), depth, coverage});
+        });
+  const std::array<int64_t, 3> ends = layerEnds(kLayers);
+  std::vector<glm::uvec4> layers(maps.layers.size(), glm::uvec4(0));
+  size_t beyond = 0;
+  for (const auto& [t, depth, coverage] : fragments) {
+    const int64_t behind = depth - start[size_t(t)];
+    beyond += behind >= ends[2];
+    for (int k = 0; k < 3; ++k)
+      if (behind < ends[k]) raster::addSaturating(layers[size_t(t)][k], uint32_t(coverage));
+    raster::addSaturating(layers[size_t(t)][3], uint32_t(coverage));
+  }
+  EXPECT_GT(beyond, fragments.size() / 4) << "the test has fragments behind the first three layers";
+  EXPECT_TRUE(maps.start == start);
+  EXPECT_TRUE(maps.layers == layers);
+}
+
 // A strand moved by a hundredth of a texel moves a hundredth of its coverage: the maps are continuous
 // in the hair's position (each sample is splatted bilinearly), so shadows do not jump.
 TEST(HairLightMaps, AStrandMovedAHundredthOfATexelChangesTheMapsByAboutAHundredth) {

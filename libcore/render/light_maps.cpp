@@ -20,10 +20,11 @@ struct Fragment {
   uint32_t coverage;
 };
 
-// A band's fragments while it is drawn, in blocks of kBlock, kept from band to band. A band of the
-// 1080p coupe's light has millions (tens of MB); in a vector that doubled to hold them, its new storage
-// and its old were held at once as it grew, on each thread: the render's peak was 896 MB with it, 802 MB
-// with blocks (150,021 strands, 1920x1080, /usr/bin/time's maximum resident set; docs/performance.md).
+// The fragments a band keeps while it is drawn, in blocks of kBlock, kept from band to band. A band of
+// the 1080p coupe's light keeps up to 1.9 million (23 MB; it drew up to 90 MB's before only those near
+// where the hair begins were kept); in a vector that doubled to hold them, its new storage and its old
+// were held at once as it grew, on each thread: the render's peak was 896 MB with it, 802 MB with
+// blocks (150,021 strands, 1920x1080, /usr/bin/time's maximum resident set; docs/performance.md).
 class FragmentBlocks {
  public:
   void clear() { size_ = 0; }
@@ -82,23 +83,30 @@ HairLightMaps rasteriseLightMaps(const Strands& hair, const View& light, double 
   maps.start.assign(size_t(size) * size, kNoHair);
   maps.layers.assign(size_t(size) * size, glm::uvec4(0));
   const std::array<int64_t, 3> ends = layerEnds(layerSizes);
-  // Each band by one thread, its fragments kept while it is drawn (a band's, not the map's): first
-  // where the hair begins in its rows, then the layers' sums.
+  // The farthest behind where the hair begins that a fragment can lie and still be in one of the first
+  // three layers.
+  const int64_t reach = std::max({ends[0], ends[1], ends[2]});
+  // Each band by one thread: where the hair begins in its rows and the fourth layer (every fragment)
+  // as it is drawn, then the first three layers' sums from the fragments it kept. Only a fragment
+  // within `reach` of the nearest drawn before it in its texel is kept: where the hair begins is no
+  // deeper than that nearest, so one farther behind is behind every first three layers' far end (most
+  // of a thick coupe's fragments: 104 million drawn at 1080p, kept while their band is drawn).
   tbb::enumerable_thread_specific<FragmentBlocks> kept;
   tbb::parallel_for(0, bands.count, [&](int band) {
     FragmentBlocks& fragments = kept.local();
     fragments.clear();
     bands.eachFragment<raster::Across::kTent>(
         band, [&](size_t t, int32_t depth, uint32_t coverage, uint32_t, raster::Piece) {
-          maps.start[t] = std::min(maps.start[t], depth);
-          fragments.push({uint32_t(t), depth, coverage});
+          int32_t& start = maps.start[t];
+          start = std::min(start, depth);
+          raster::addSaturating(maps.layers[t][3], coverage);
+          if (int64_t(depth) - start < reach) fragments.push({uint32_t(t), depth, coverage});
         });
     fragments.forEach([&](const Fragment& f) {
       const int64_t behind = int64_t(f.depth) - maps.start[f.texel];
       glm::uvec4& sum = maps.layers[f.texel];
       for (int k = 0; k < 3; ++k)
         if (behind < ends[k]) raster::addSaturating(sum[k], f.coverage);
-      raster::addSaturating(sum[3], f.coverage);
     });
   });
   if (spent) *spent = std::move(bands);
