@@ -124,6 +124,7 @@ std::unique_ptr<GlContext> openDevice(const CommonOptions& common, const Config&
 
 void writeRenderOutputs(const Config& config, const RenderOutput& out, const std::string& exr,
                         const std::string& dom, const std::string& preview, std::optional<int> frame) {
+  requireMappingsWhole();  // nothing made from a mapped coupe's unreadable page is written
   ExrMetadata meta;
   if (frame) {
     meta.ints["hairgen:frame"] = *frame;

@@ -120,7 +120,7 @@ void Stats::write(const CommonOptions& options) {
 
 int runCommand(const std::string& command, const CommonOptions& options, const std::function<void()>& body) {
   installInterruptCleanup();
-  installMappingGuard(command);
+  installMappingGuard();
   forgetCommittedOutputs();
   gFailedStats = nullptr;
   gStatsWriteFailed = false;
@@ -150,6 +150,16 @@ int runCommand(const std::string& command, const CommonOptions& options, const s
     }
     return static_cast<int>(code);
   };
+  // A mapped input's page that could not be read made its arrays zeros (mapped_file.h): whatever that
+  // led to, the file's error is the command's.
+  auto failedUnlessAMappingFailed = [&](const std::string& message, ExitCode code) {
+    try {
+      requireMappingsWhole();
+    } catch (const Error& e) {
+      return failed(e.what(), e.code());
+    }
+    return failed(message, code);
+  };
   try {
     int threads = options.threads > 0 ? options.threads : static_cast<int>(tbb::info::default_concurrency());
     tbb::global_control limit(tbb::global_control::max_allowed_parallelism, static_cast<size_t>(threads));
@@ -163,14 +173,15 @@ int runCommand(const std::string& command, const CommonOptions& options, const s
       }
     }
     body();
+    requireMappingsWhole();  // a page read after the last check
     forgetCommittedOutputs();
     return static_cast<int>(ExitCode::kSuccess);
   } catch (const Error& e) {
-    return failed(e.what(), e.code());
+    return failedUnlessAMappingFailed(e.what(), e.code());
   } catch (const std::bad_alloc&) {
-    return failed("out of memory", ExitCode::kWorkFailed);
+    return failedUnlessAMappingFailed("out of memory", ExitCode::kWorkFailed);
   } catch (const std::exception& e) {
-    return failed(std::string("internal: ") + e.what(), ExitCode::kWorkFailed);
+    return failedUnlessAMappingFailed(std::string("internal: ") + e.what(), ExitCode::kWorkFailed);
   }
 }
 

@@ -1,6 +1,7 @@
 // The .hair cache: cyHair compatibility, byte-for-byte round trips, and hostile files.
 #include <gtest/gtest.h>
 
+#include <csignal>
 #include <cstdio>
 #include <cstring>
 #include <fstream>
@@ -266,8 +267,9 @@ TEST(HairFile, AMappedReadHoldsTheFilesPagesAndWritesNoneOfThem) {
   EXPECT_LT(before, arrayKiB + arrayKiB / 4);
   test::expectSameStrands(mapped, copied);
   EXPECT_GT(mappingAt(mapped.points.data()).residentKiB, before + arrayKiB - arrayKiB / 4);
-  EXPECT_EQ(mappingAt(mapped.points.data()).file, file.string());
-  EXPECT_EQ(mappingAt(mapped.tangents.data()).file, file.string());
+  const std::string mappedFile = std::filesystem::canonical(file).string();  // as smaps names it
+  EXPECT_EQ(mappingAt(mapped.points.data()).file, mappedFile);
+  EXPECT_EQ(mappingAt(mapped.tangents.data()).file, mappedFile);
   EXPECT_EQ(mappingAt(copied.points.data()).file, "");
   // A copy is memory of its own; a write changes the process's page, never the file.
   const Strands copy = mapped;
@@ -276,7 +278,9 @@ TEST(HairFile, AMappedReadHoldsTheFilesPagesAndWritesNoneOfThem) {
   mapped.tangents.back() = glm::vec3(0.0f, 0.0f, 1.0f);
   EXPECT_EQ(readFileBytes(file), bytes);
   EXPECT_EQ(copy.points[0], copied.points[0]);
+  const void* where = mapped.points.data();
   mapped = Strands{};  // the mapping goes with its last array
+  EXPECT_EQ(mappingAt(where).file, "");
   EXPECT_EQ(readHair(file, nullptr, ArrayStorage::kMapped), copied);
 }
 
@@ -292,22 +296,56 @@ TEST(HairFile, AMappedReadCopiesArraysTheFileDoesNotAlign) {
   EXPECT_EQ(mappingAt(mapped.tangents.data()).file, "");
 }
 
-// A mapped file that another process shrinks under the render: the read past its end is the error a
-// read would give, exit code 2, not a crash.
-TEST(HairFileDeathTest, AMappedFileThatShrinksEndsTheCommandWithExitCode2) {
-  GTEST_FLAG_SET(death_test_style, "threadsafe");
+// A mapped coupe another process shrinks under the render: its pages past the new end read as zeros (no
+// SIGBUS ends the process), and the command's check fails it with the file's error, exit 2, once.
+TEST(HairFile, AMappedFileThatShrinksIsTheFilesErrorNotACrash) {
+  installMappingGuard();
   test::TempDir dir("shrinks");
   const std::filesystem::path file = dir / "coupe.hair";
   writeHair(file, largeStrands(20000, 50, false));
+  const Strands mapped = readHair(file, nullptr, ArrayStorage::kMapped);
+  EXPECT_NO_THROW(requireMappingsWhole());
+  std::filesystem::resize_file(file, 4096);
+  EXPECT_EQ(mapped.tangents.back(), glm::vec3(0.0f)) << "past the end: a fault, then zeros";
+  EXPECT_EQ(mapped.points.front(), glm::vec3(0.0f)) << "the whole mapping is zeros, no value of the file";
+  try {
+    requireMappingsWhole();
+    ADD_FAILURE() << "no error";
+  } catch (const InputError& e) {
+    EXPECT_EQ(e.code(), ExitCode::kBadInput);
+    EXPECT_EQ(e.where().file, file.string());
+    EXPECT_NE(std::string(e.what()).find(kFileShrank), std::string::npos) << e.what();
+  }
+  EXPECT_NO_THROW(requireMappingsWhole()) << "said once";
+}
+
+// A page that cannot be read while the file is as long as it was mapped (an I/O error: here the file
+// shrank and grew back before the check) is an IoError, exit 1, not bad input.
+TEST(HairFile, AMappedPageThatCannotBeReadOtherwiseIsAnIoError) {
+  installMappingGuard();
+  test::TempDir dir("unreadable");
+  const std::filesystem::path file = dir / "coupe.hair";
+  writeHair(file, largeStrands(20000, 50, false));
+  const uintmax_t size = std::filesystem::file_size(file);
+  const Strands mapped = readHair(file, nullptr, ArrayStorage::kMapped);
+  std::filesystem::resize_file(file, 4096);
+  EXPECT_EQ(mapped.tangents.back(), glm::vec3(0.0f));
+  std::filesystem::resize_file(file, size);
+  EXPECT_THROW(requireMappingsWhole(), IoError);
+}
+
+// A SIGBUS that is no fault of a mapping (sent with kill) gets the default action: the process ends.
+TEST(HairFileDeathTest, ASigbusSentIsNotTakenForAMappingsFault) {
+  const std::string style = GTEST_FLAG_GET(death_test_style);
+  GTEST_FLAG_SET(death_test_style, "threadsafe");
   EXPECT_EXIT(
       {
-        installMappingGuard("render");
-        const Strands mapped = readHair(file, nullptr, ArrayStorage::kMapped);
-        std::filesystem::resize_file(file, 4096);
-        volatile float last = mapped.tangents.back().z;
-        std::exit(last > 2.0f ? 3 : 0);
+        installMappingGuard();
+        std::raise(SIGBUS);
+        std::exit(0);
       },
-      ::testing::ExitedWithCode(2), "hairgen render: error: .*coupe.hair: the file shrank while it was read");
+      ::testing::KilledBySignal(SIGBUS), "");
+  GTEST_FLAG_SET(death_test_style, style);
 }
 
 // The large arrays a cache is read into grow as resize grows them: the old values kept, the new ones

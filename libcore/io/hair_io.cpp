@@ -136,7 +136,7 @@ class Source {
   // The next `bytes` bytes where they lie in a mapped file, for an array to hold without a copy; null
   // where the source maps nothing. The caller then skip()s them.
   virtual std::shared_ptr<MappedRegion> region(size_t) { return nullptr; }
-  virtual void skip(size_t) {}
+  virtual void skip(size_t bytes) = 0;  // after need(): moves past the bytes
 };
 
 class MemorySource final : public Source {
@@ -147,6 +147,7 @@ class MemorySource final : public Source {
     if (bytes) std::memcpy(out, data_ + pos_, bytes);
     pos_ += bytes;
   }
+  void skip(size_t bytes) override { pos_ += bytes; }
 
  private:
   const uint8_t* data_;
@@ -220,10 +221,10 @@ class Reader {
   template <typename T>
   bool mapped(std::vector<T, MappableAllocator<T>>& v, uint64_t count, uint32_t* crc) {
     const std::shared_ptr<MappedRegion> region = source_.region(size_t(count) * sizeof(T));
-    if (!region) return false;
+    if (!region || reinterpret_cast<uintptr_t>(region->data) % alignof(T) != 0) return false;
     std::vector<T, MappableAllocator<T>> held{MappableAllocator<T>(region)};
     held.reserve(size_t(count));
-    if (held.data() != region->data) return false;  // not aligned: allocated, and freed here
+    if (held.data() != region->data) return false;
     held.resize(size_t(count));
     source_.skip(region->bytes);
     if (crc) {
@@ -549,6 +550,7 @@ Strands decodeHairFrom(Source& source, const std::string& name, HairHeader* head
     s.provenance.metres = s.provenance.yUp = false;
     s.provenance.sourceInfo = header.info;
   }
+  requireMappingsWhole();  // a mapped array's page that could not be read is zeros, no value of the file
   s.validate(name);
   r.releaseChecked();
   if (headerOut) *headerOut = std::move(header);
@@ -603,7 +605,7 @@ Provenance readHairProvenance(const std::filesystem::path& file) {
       if (!in_.read(static_cast<char*>(out), std::streamsize(bytes))) throw IoError("cannot read the file");
       position_ += bytes;
     }
-    void skip(uint64_t bytes) {  // after need(bytes)
+    void skip(size_t bytes) override {  // after need(bytes)
       position_ += bytes;
       in_.seekg(std::streamoff(position_));
     }

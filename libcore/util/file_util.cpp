@@ -69,7 +69,8 @@ void releaseTemporary(int slot) {
 }
 
 extern "C" void removeTemporariesAndExit(int signal) {
-  removeTemporariesOfWritesInFlight();
+  for (TemporarySlot& slot : gTemporaries)
+    if (slot.state.load() == 2) ::unlink(slot.path);
   ::_exit(128 + signal);
 }
 
@@ -377,20 +378,20 @@ std::shared_ptr<FileMapping> InputFile::mapping() {
 }
 
 void InputFile::skip(uint64_t bytes) {
-  if (bytes > size_ - position_) throw InputError({name_, 0}, "the file shrank while it was read");
+  if (bytes > size_ - position_) throw InputError({name_, 0}, kFileShrank);
   if (::lseek(fd_, off_t(position_ + bytes), SEEK_SET) < 0)
     throw IoError({name_, 0}, std::string("seek failed: ") + std::strerror(errno));
   position_ += bytes;
 }
 
 void InputFile::read(void* out, size_t bytes) {
-  if (bytes > size_ - position_) throw InputError({name_, 0}, "the file shrank while it was read");
+  if (bytes > size_ - position_) throw InputError({name_, 0}, kFileShrank);
   size_t done = 0;
   while (done < bytes) {
     const ssize_t n = ::read(fd_, static_cast<char*>(out) + done, bytes - done);
     if (n < 0 && errno == EINTR) continue;
     if (n < 0) throw IoError({name_, 0}, std::string("read failed: ") + std::strerror(errno));
-    if (n == 0) throw InputError({name_, 0}, "the file shrank while it was read");
+    if (n == 0) throw InputError({name_, 0}, kFileShrank);
     done += size_t(n);
   }
   position_ += bytes;
@@ -605,11 +606,6 @@ void writeFileAtomic(const fs::path& target, const void* data, size_t size) {
   AtomicFile file(target);
   file.stream().write(static_cast<const char*>(data), static_cast<std::streamsize>(size));
   file.commit();
-}
-
-void removeTemporariesOfWritesInFlight() {
-  for (TemporarySlot& slot : gTemporaries)
-    if (slot.state.load() == 2) ::unlink(slot.path);
 }
 
 void installInterruptCleanup() {

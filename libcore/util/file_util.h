@@ -42,7 +42,7 @@ std::vector<uint8_t> readFileBytes(const std::filesystem::path& path);
 
 // An input read piece by piece, with readFileBytes' rules checked when it is opened (a regular file
 // no larger than the memory budget, else an InputError naming it). read() fills exactly `bytes` bytes
-// or throws: a file that ends early ("shrank while it was read") is an InputError, a read error an
+// or throws: a file that ends early (kFileShrank) is an InputError, a read error an
 // IoError.
 class InputFile {
  public:
@@ -126,9 +126,6 @@ inline void writeFileAtomic(const std::filesystem::path& target, const std::stri
 // Installs the SIGINT, SIGTERM and SIGHUP handlers (once; a signal the parent set to be ignored stays
 // ignored).
 void installInterruptCleanup();
-// Removes the temporaries of the writes in flight, as those handlers do: only async-signal-safe calls,
-// for a handler that ends the process (mapped_file.h's SIGBUS).
-void removeTemporariesOfWritesInFlight();
 
 // discardCommittedOutputs: removes the files committed since the last keepCommittedOutputs() (or since
 // forgetCommittedOutputs()), each only while its name still holds the file this process made there

@@ -2,16 +2,17 @@
 
 #include <signal.h>
 #include <sys/mman.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <algorithm>
 #include <array>
 #include <atomic>
+#include <cerrno>
 #include <cstring>
 #include <mutex>
 
 #include "libcore/util/error.h"
-#include "libcore/util/file_util.h"
 
 namespace hairgen {
 
@@ -21,49 +22,65 @@ namespace {
 // being filled (1) or live (2), as the interrupt cleanup's temporaries are (file_util.cpp).
 struct GuardSlot {
   std::atomic<int> state{0};
+  std::atomic<bool> zeroed{false};  // its pages were made zeros after a fault
   uintptr_t begin = 0, end = 0;
-  char message[4352];  // "hairgen COMMAND: error: FILE: the file shrank while it was read\n"
-  size_t length = 0;
+  char name[4096];
 };
 std::array<GuardSlot, 64> gGuarded;
-char gCommand[64] = "";
 
-constexpr char kShrank[] = "the file shrank while it was read";
+// The first fault not yet reported (requireMappingsWhole): its file's name and the size it was mapped at.
+struct Fault {
+  std::atomic<int> state{0};  // 0 none, 1 being written, 2 recorded
+  char name[4096];
+  uint64_t size = 0;
+};
+Fault gFault;
 
 int guard(const uint8_t* data, uint64_t size, const std::string& name) {
-  const std::string line = std::string("hairgen ") + gCommand + ": error: " + name + ": " + kShrank + "\n";
-  if (line.size() > sizeof gGuarded[0].message) return -1;
+  if (name.size() >= sizeof gGuarded[0].name) return -1;
   for (size_t i = 0; i < gGuarded.size(); ++i) {
     int expected = 0;
     if (!gGuarded[i].state.compare_exchange_strong(expected, 1)) continue;
     GuardSlot& slot = gGuarded[i];
     slot.begin = reinterpret_cast<uintptr_t>(data);
     slot.end = slot.begin + size;
-    std::memcpy(slot.message, line.data(), line.size());
-    slot.length = line.size();
+    slot.zeroed.store(false);
+    std::memcpy(slot.name, name.c_str(), name.size() + 1);
     slot.state.store(2);
     return int(i);
   }
-  return -1;  // every slot taken: the mapping works, only a shrinking file ends the process by SIGBUS
+  return -1;  // every slot taken: the mapping works, only a fault in it is the default SIGBUS
 }
 
+// Async-signal-safe: atomics, memcpy, mmap, sigaction, raise.
 extern "C" void onBusError(int signal, siginfo_t* info, void*) {
+  const int savedErrno = errno;
   const uintptr_t at = reinterpret_cast<uintptr_t>(info->si_addr);
-  for (const GuardSlot& slot : gGuarded) {
+  for (GuardSlot& slot : gGuarded) {
+    if (info->si_code <= 0) break;  // sent, not a fault
     if (slot.state.load() != 2 || at < slot.begin || at >= slot.end) continue;
-    removeTemporariesOfWritesInFlight();
-    for (size_t done = 0; done < slot.length;) {
-      const ssize_t n = ::write(STDERR_FILENO, slot.message + done, slot.length - done);
-      if (n <= 0) break;
-      done += size_t(n);
+    int none = 0;
+    if (gFault.state.compare_exchange_strong(none, 1)) {
+      std::memcpy(gFault.name, slot.name, sizeof gFault.name);
+      gFault.size = slot.end - slot.begin;
+      gFault.state.store(2);
     }
-    ::_exit(int(ExitCode::kBadInput));
+    // The mapping's pages become zeros, at the same addresses: the faulting instruction runs again and
+    // reads them (as does any other thread that faulted there meanwhile).
+    if (!slot.zeroed.exchange(true)) {
+      void* zeros = ::mmap(reinterpret_cast<void*>(slot.begin), slot.end - slot.begin, PROT_READ | PROT_WRITE,
+                           MAP_PRIVATE | MAP_ANONYMOUS | MAP_FIXED, -1, 0);
+      if (zeros == MAP_FAILED) break;  // the default action, below
+    }
+    errno = savedErrno;
+    return;
   }
-  // Not a mapping's: the default action, when the instruction runs again.
   struct sigaction fallback {};
   fallback.sa_handler = SIG_DFL;
   sigemptyset(&fallback.sa_mask);
   ::sigaction(signal, &fallback, nullptr);
+  if (info->si_code <= 0) ::raise(signal);  // a fault instead runs again, and gets the default
+  errno = savedErrno;
 }
 
 }  // namespace
@@ -75,7 +92,12 @@ std::shared_ptr<FileMapping> FileMapping::map(int fd, uint64_t size, const std::
   // Read from the start on: the kernel reads ahead of the faults.
   ::madvise(data, size_t(size), MADV_WILLNEED);
   uint8_t* bytes = static_cast<uint8_t*>(data);
-  return std::shared_ptr<FileMapping>(new FileMapping(bytes, size, guard(bytes, size, name)));
+  try {
+    return std::shared_ptr<FileMapping>(new FileMapping(bytes, size, guard(bytes, size, name)));
+  } catch (...) {
+    ::munmap(data, size_t(size));
+    throw;
+  }
 }
 
 FileMapping::~FileMapping() {
@@ -90,11 +112,8 @@ void FileMapping::release(uint64_t offset, uint64_t bytes) const {
   if (end > begin) ::madvise(data_ + begin, size_t(end - begin), MADV_DONTNEED);
 }
 
-void installMappingGuard(const std::string& command) {
+void installMappingGuard() {
   static std::once_flag once;
-  const size_t n = std::min(command.size(), sizeof gCommand - 1);
-  std::memcpy(gCommand, command.data(), n);
-  gCommand[n] = '\0';
   std::call_once(once, [] {
     struct sigaction action {};
     action.sa_sigaction = onBusError;
@@ -102,6 +121,17 @@ void installMappingGuard(const std::string& command) {
     sigemptyset(&action.sa_mask);
     ::sigaction(SIGBUS, &action, nullptr);
   });
+}
+
+void requireMappingsWhole() {
+  if (gFault.state.load() != 2) return;
+  const std::string name = gFault.name;
+  const uint64_t mapped = gFault.size;
+  gFault.state.store(0);
+  struct stat st {};
+  if (::stat(name.c_str(), &st) != 0 || uint64_t(st.st_size) < mapped)
+    throw InputError({name, 0}, kFileShrank);
+  throw IoError({name, 0}, "a page of it could not be read while it was mapped (an I/O error)");
 }
 
 }  // namespace hairgen

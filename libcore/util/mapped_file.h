@@ -4,10 +4,11 @@
 //
 // A mapping is private and copy-on-write: an array in it reads the file's bytes, and a write changes
 // the process's copy of that page only, never the file. Another process that rewrites the file in
-// place while it is mapped (cp over it; hairgen's own writes rename a new file into place and never do)
-// changes what the pages it has not written read; one that shrinks it makes a read past its new end
-// raise SIGBUS, which installMappingGuard() turns into the error a read would give ("the file shrank
-// while it was read", exit 2).
+// place while it is mapped (cp over it; hairgen's own writes rename a new file into place) changes
+// what the pages this one has not written read. A page that cannot be read (the file shrank past it, or
+// the disk or the network failed) raises SIGBUS: installMappingGuard()'s handler turns that mapping's
+// pages into zeros, so the work goes on without crashing, and requireMappingsWhole() then fails the
+// command with the file's error before it writes anything made from them.
 #pragma once
 
 #include <cstddef>
@@ -20,11 +21,15 @@
 
 namespace hairgen {
 
+// What a read of a file that ends early says (InputFile::read, and a mapping's page past the end).
+inline constexpr char kFileShrank[] = "the file shrank while it was read";
+
 // A regular file's bytes, mapped private and writable (copy-on-write), unmapped with the last owner.
 class FileMapping {
  public:
-  // The open file `fd` of `size` bytes (named `name` in the error a shrinking file gives); null where
-  // the kernel refuses to map it (a file system without mmap) or size is 0: read it instead.
+  // The open file `fd` of `size` bytes, named `name` in the error a page that cannot be read gives;
+  // null where the kernel refuses to map it (a file system without mmap, no address space) or size is
+  // 0: read it instead.
   static std::shared_ptr<FileMapping> map(int fd, uint64_t size, const std::string& name);
   ~FileMapping();
   FileMapping(const FileMapping&) = delete;
@@ -33,8 +38,8 @@ class FileMapping {
   uint8_t* data() const { return data_; }
   uint64_t size() const { return size_; }
   // The whole pages of [offset, offset + bytes) leave the process (madvise MADV_DONTNEED): read again,
-  // they are mapped from the file anew. Only for pages nothing has written: a page written is the
-  // process's copy, and would read the file's bytes again.
+  // they are mapped from the file anew. Only for pages nothing has written: a written page is the
+  // process's copy, which this would drop for the file's bytes.
   void release(uint64_t offset, uint64_t bytes) const;
 
  private:
@@ -42,7 +47,7 @@ class FileMapping {
       : data_(data), size_(size), guardSlot_(guardSlot) {}
   uint8_t* data_;
   uint64_t size_;
-  int guardSlot_;  // the guard's table slot (installMappingGuard), −1 when it was full
+  int guardSlot_;  // the guard's table slot, −1 when it was full (a fault is then the default SIGBUS)
 };
 
 // Part of a mapping that an array's storage may be (MappableAllocator): taken by the one allocation of
@@ -71,8 +76,17 @@ class MappableAllocator {
 
   MappableAllocator() = default;
   explicit MappableAllocator(std::shared_ptr<MappedRegion> region) : region_(std::move(region)) {}
+  // A moved allocator stays equal to what it was (the allocator requirements): moves copy.
+  MappableAllocator(const MappableAllocator&) = default;
+  MappableAllocator(MappableAllocator&& other) noexcept : region_(other.region_) {}
+  MappableAllocator& operator=(const MappableAllocator&) = default;
+  MappableAllocator& operator=(MappableAllocator&& other) noexcept {
+    region_ = other.region_;
+    return *this;
+  }
+  // Rebound to another type, it allocates memory of its own: a region holds one array of T.
   template <class U>
-  MappableAllocator(const MappableAllocator<U>& other) noexcept : region_(other.region_) {}
+  MappableAllocator(const MappableAllocator<U>&) noexcept {}
 
   T* allocate(size_t n) {
     if (region_ && !region_->taken && n * sizeof(T) == region_->bytes &&
@@ -100,21 +114,21 @@ class MappableAllocator {
     ::new (static_cast<void*>(p)) U(std::forward<Args>(args)...);
   }
 
-  template <class U>
-  bool operator==(const MappableAllocator<U>& other) const {
-    return region_ == other.region_;
-  }
+  bool operator==(const MappableAllocator& other) const { return region_ == other.region_; }
 
  private:
-  template <class>
-  friend class MappableAllocator;
   std::shared_ptr<MappedRegion> region_;
 };
 
-// Installs the SIGBUS handler (once): a read of a mapping past its file's end (the file shrank) removes
-// the temporaries of writes in flight, says so in one line ("hairgen COMMAND: error: FILE: the file
-// shrank while it was read") and ends the process with exit code 2; a SIGBUS anywhere else is left to
-// the default action. `command`: the subcommand named in the line.
-void installMappingGuard(const std::string& command);
+// Installs the SIGBUS handler (once). A fault in one of hairgen's mappings (a page that cannot be read:
+// the file shrank, or an I/O error) records it, makes that mapping's pages zeros and lets the work go
+// on; a SIGBUS anywhere else, or one sent by kill, gets the default action.
+void installMappingGuard();
+
+// Throws, once, for a mapping whose page could not be read since the last call: InputError "FILE: the
+// file shrank while it was read" where the file is now shorter than it was mapped, else IoError "FILE:
+// a page of it could not be read (an I/O error)". Called before anything made from mapped arrays is
+// written, and by a failing command, whose error this one replaces.
+void requireMappingsWhole();
 
 }  // namespace hairgen
