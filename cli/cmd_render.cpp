@@ -53,6 +53,7 @@ RenderOutput renderStage(const CommonOptions& common, const Config& config, GlCo
   RenderOptions withForce = options;
   withForce.force = common.force;
   const size_t strands = hair.strandCount(), points = hair.pointCount();  // `uploaded` may free the hair
+  const bool mapped = hair.points.get_allocator().holdsMapping();
   RenderOutput out = render(gl, hair, head, config.visuality, config.render, shaders, withForce, before);
   stats.add("upload", out.timings.upload);
   stats.add("lightDepth", out.timings.lightDepth);
@@ -75,6 +76,7 @@ RenderOutput renderStage(const CommonOptions& common, const Config& config, GlCo
   stats.counts()["hairFragments"] = out.hairFragments;
   stats.json()["device"]["hairFragmentSeconds"] = out.timings.fragments;
   stats.json()["device"]["hairReadInPlace"] = out.hairReadInPlace;
+  stats.json()["device"]["hairMapped"] = mapped;
   // The rasteriser's passes on the device and its transfers, summed over a sequence's frames as the
   // phases' seconds are.
   auto addTimes = [&](const char* key, const std::vector<DeviceTime>& times, bool bytes) {

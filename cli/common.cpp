@@ -157,6 +157,7 @@ int runCommand(const std::string& command, const CommonOptions& options, const s
       requireMappingsWhole();
     } catch (const Error& e) {
       return failed(e.what(), e.code());
+    } catch (...) {  // out of memory while saying so: the command's own error stands
     }
     return failed(message, code);
   };

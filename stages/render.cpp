@@ -6,7 +6,6 @@
 #include "libcore/model/units.h"
 #include "libcore/render/views.h"
 #include "libcore/util/error.h"
-#include "libcore/util/mapped_file.h"
 #include "stages/preflight/estimate.h"
 #include "stages/preflight/scene.h"
 
@@ -136,7 +135,6 @@ RenderOutput render(GlContext& gl, const Strands& hair, const Mesh* head, const 
   requireFits(estimateRender(input.settings, *input.hair, head, gl.maxTextureSize(), input.keptFragments),
               options.force);
   RenderOutput out = renderHair(gl, input);
-  requireMappingsWhole();  // a mapped coupe's page that could not be read was drawn as zeros
   requireFinite(out.beauty);
   return out;
 }

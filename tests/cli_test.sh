@@ -150,6 +150,8 @@ run_equals_stages)
   cmp "$tmp/run/beauty.exr" "$tmp/beauty.exr" || fail "run's image differs from render's"
   # Who drew the light's maps: hairgen's integer rasteriser, on every device.
   grep -q '"lightMaps": *"cpu"' "$tmp/render.json" || fail "the light's maps not drawn by hairgen's rasteriser"
+  # The coupe read where the file's pages lie, and the same image as run's, which held it in memory.
+  grep -q '"hairMapped": *true' "$tmp/render.json" || fail "the coupe was not read where the file lies"
   # With the camera aimed by the stage (auto, as a real head's Setup leaves it), the same bytes too: the
   # EXR carries the Setup's digest, which a farm plan checks to take the render task for done.
   expect_rc 0 "$hairgen" run "$setup" -o "$tmp/auto" --quiet "${set_density[@]}" --set Render.CameraPosition=auto

@@ -135,7 +135,7 @@ class Source {
   virtual void read(void* out, size_t bytes) = 0;  // after need(): the bytes are there
   // The next `bytes` bytes where they lie in a mapped file, for an array to hold without a copy; null
   // where the source maps nothing. The caller then skip()s them.
-  virtual std::shared_ptr<MappedRegion> region(size_t) { return nullptr; }
+  virtual std::shared_ptr<MappedRegion> region(size_t /*bytes*/, size_t /*elementBytes*/) { return nullptr; }
   virtual void skip(size_t bytes) = 0;  // after need(): moves past the bytes
 };
 
@@ -160,10 +160,11 @@ class FileSource final : public Source {
       : file_(path), mapped_(storage == ArrayStorage::kMapped) {}
   uint64_t remaining() const override { return file_.remaining(); }
   void read(void* out, size_t bytes) override { file_.read(out, bytes); }
-  std::shared_ptr<MappedRegion> region(size_t bytes) override {
+  std::shared_ptr<MappedRegion> region(size_t bytes, size_t elementBytes) override {
     const std::shared_ptr<FileMapping> mapping = mapped_ ? file_.mapping() : nullptr;
     if (!mapping) return nullptr;
-    return std::make_shared<MappedRegion>(MappedRegion{mapping, mapping->data() + file_.position(), bytes});
+    return std::make_shared<MappedRegion>(
+        MappedRegion{mapping, mapping->data() + file_.position(), bytes, elementBytes});
   }
   void skip(size_t bytes) override { file_.skip(bytes); }
 
@@ -220,7 +221,7 @@ class Reader {
   // process's through the passes that do not shade.
   template <typename T>
   bool mapped(std::vector<T, MappableAllocator<T>>& v, uint64_t count, uint32_t* crc) {
-    const std::shared_ptr<MappedRegion> region = source_.region(size_t(count) * sizeof(T));
+    const std::shared_ptr<MappedRegion> region = source_.region(size_t(count) * sizeof(T), sizeof(T));
     if (!region || reinterpret_cast<uintptr_t>(region->data) % alignof(T) != 0) return false;
     std::vector<T, MappableAllocator<T>> held{MappableAllocator<T>(region)};
     held.reserve(size_t(count));

@@ -90,7 +90,7 @@ HairLightMaps rasteriseLightMaps(const Strands& hair, const View& light, double 
   // as it is drawn, then the first three layers' sums from the fragments it kept. Only a fragment
   // within `reach` of the nearest drawn before it in its texel is kept: where the hair begins is no
   // deeper than that nearest, so one farther behind is behind every first three layers' far end (most
-  // of a thick coupe's fragments: 104 million drawn at 1080p, kept while their band is drawn).
+  // of a thick coupe's fragments: the 1080p coupe keeps 26 million of its 109 million).
   tbb::enumerable_thread_specific<FragmentBlocks> kept;
   tbb::parallel_for(0, bands.count, [&](int band) {
     FragmentBlocks& fragments = kept.local();

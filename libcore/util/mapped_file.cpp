@@ -92,12 +92,15 @@ std::shared_ptr<FileMapping> FileMapping::map(int fd, uint64_t size, const std::
   // Read from the start on: the kernel reads ahead of the faults.
   ::madvise(data, size_t(size), MADV_WILLNEED);
   uint8_t* bytes = static_cast<uint8_t*>(data);
+  int slot = -1;
   try {
-    return std::shared_ptr<FileMapping>(new FileMapping(bytes, size, guard(bytes, size, name)));
+    slot = guard(bytes, size, name);
   } catch (...) {
     ::munmap(data, size_t(size));
     throw;
   }
+  // Owned from here on: where the shared_ptr cannot be made, it deletes the mapping (and frees its slot).
+  return std::shared_ptr<FileMapping>(new FileMapping(bytes, size, slot));
 }
 
 FileMapping::~FileMapping() {
@@ -131,7 +134,7 @@ void requireMappingsWhole() {
   struct stat st {};
   if (::stat(name.c_str(), &st) != 0 || uint64_t(st.st_size) < mapped)
     throw InputError({name, 0}, kFileShrank);
-  throw IoError({name, 0}, "a page of it could not be read while it was mapped (an I/O error)");
+  throw IoError({name, 0}, kPageUnreadable);
 }
 
 }  // namespace hairgen

@@ -23,6 +23,11 @@ namespace hairgen {
 
 // What a read of a file that ends early says (InputFile::read, and a mapping's page past the end).
 inline constexpr char kFileShrank[] = "the file shrank while it was read";
+// What a mapping's page that could not be read says where the file is no shorter now: another process
+// truncated and rewrote it (cp over it), or the disk or the network failed.
+inline constexpr char kPageUnreadable[] =
+    "a page of it could not be read while it was mapped: another process truncated or rewrote it, or the "
+    "disk or network failed";
 
 // A regular file's bytes, mapped private and writable (copy-on-write), unmapped with the last owner.
 class FileMapping {
@@ -56,6 +61,7 @@ struct MappedRegion {
   std::shared_ptr<FileMapping> file;
   void* data = nullptr;
   size_t bytes = 0;
+  size_t elementBytes = 0;  // the array's element's size: only an allocator of that size adopts it
   bool taken = false;
 };
 
@@ -84,12 +90,12 @@ class MappableAllocator {
     region_ = other.region_;
     return *this;
   }
-  // Rebound to another type, it allocates memory of its own: a region holds one array of T.
+  // Rebound to another type, it compares equal and adopts the region only for elements of its size.
   template <class U>
-  MappableAllocator(const MappableAllocator<U>&) noexcept {}
+  MappableAllocator(const MappableAllocator<U>& other) noexcept : region_(other.region_) {}
 
   T* allocate(size_t n) {
-    if (region_ && !region_->taken && n * sizeof(T) == region_->bytes &&
+    if (region_ && !region_->taken && region_->elementBytes == sizeof(T) && n * sizeof(T) == region_->bytes &&
         reinterpret_cast<uintptr_t>(region_->data) % alignof(T) == 0) {
       region_->taken = true;
       return static_cast<T*>(region_->data);
@@ -104,6 +110,8 @@ class MappableAllocator {
     std::allocator<T>().deallocate(p, n);
   }
   MappableAllocator select_on_container_copy_construction() const { return {}; }
+  // Whether its vector's storage is a mapped file's region (a copy of the allocator says so too).
+  bool holdsMapping() const { return region_ && region_->taken; }
 
   template <class U>
   void construct(U* p) noexcept {
@@ -114,9 +122,14 @@ class MappableAllocator {
     ::new (static_cast<void*>(p)) U(std::forward<Args>(args)...);
   }
 
-  bool operator==(const MappableAllocator& other) const { return region_ == other.region_; }
+  template <class U>
+  friend bool operator==(const MappableAllocator& a, const MappableAllocator<U>& b) {
+    return a.region_ == b.region_;
+  }
 
  private:
+  template <class>
+  friend class MappableAllocator;
   std::shared_ptr<MappedRegion> region_;
 };
 
@@ -125,10 +138,10 @@ class MappableAllocator {
 // on; a SIGBUS anywhere else, or one sent by kill, gets the default action.
 void installMappingGuard();
 
-// Throws, once, for a mapping whose page could not be read since the last call: InputError "FILE: the
-// file shrank while it was read" where the file is now shorter than it was mapped, else IoError "FILE:
-// a page of it could not be read (an I/O error)". Called before anything made from mapped arrays is
-// written, and by a failing command, whose error this one replaces.
+// Throws, once, for a mapping whose page could not be read since the last call: InputError (exit 2,
+// kFileShrank) where the file is now shorter than it was mapped, else IoError (exit 1,
+// kPageUnreadable), naming the file. Called before anything made from mapped arrays is written, and by
+// a failing command, whose error this one replaces.
 void requireMappingsWhole();
 
 }  // namespace hairgen
