@@ -19,6 +19,8 @@
 #include <type_traits>
 #include <utility>
 
+#include "libcore/util/uninitialised.h"
+
 namespace hairgen {
 
 // What a read of a file that ends early says (InputFile::read, and a mapping's page past the end).
@@ -71,7 +73,7 @@ struct MappedRegion {
 // the file's values without a copy, and keeps the mapping while it holds them. A copy of the vector
 // gets storage of its own; a move, or a swap, takes the region along.
 template <class T>
-class MappableAllocator {
+class MappableAllocator : public LeavesNewElementsUnset {
  public:
   static_assert(std::is_trivially_copyable_v<T> && std::is_trivially_default_constructible_v<T>);
   using value_type = T;
@@ -112,15 +114,6 @@ class MappableAllocator {
   MappableAllocator select_on_container_copy_construction() const { return {}; }
   // Whether its vector's storage is a mapped file's region (a copy of the allocator says so too).
   bool holdsMapping() const { return region_ && region_->taken; }
-
-  template <class U>
-  void construct(U* p) noexcept {
-    ::new (static_cast<void*>(p)) U;
-  }
-  template <class U, class... Args>
-  void construct(U* p, Args&&... args) {
-    ::new (static_cast<void*>(p)) U(std::forward<Args>(args)...);
-  }
 
   template <class U>
   friend bool operator==(const MappableAllocator& a, const MappableAllocator<U>& b) {

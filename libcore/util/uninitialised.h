@@ -9,17 +9,9 @@
 
 namespace hairgen {
 
-template <class T>
-struct UninitialisedAllocator : std::allocator<T> {
-  static_assert(std::is_trivially_default_constructible_v<T>);
-  template <class U>
-  struct rebind {
-    using other = UninitialisedAllocator<U>;
-  };
-  UninitialisedAllocator() = default;
-  template <class U>
-  UninitialisedAllocator(const UninitialisedAllocator<U>&) noexcept {}
-  // A new element with no value given: default-initialised, which for a trivial type writes nothing.
+// An allocator's construct: a new element with no value given is default-initialised, which for a
+// trivial type writes nothing (UninitialisedAllocator, MappableAllocator).
+struct LeavesNewElementsUnset {
   template <class U>
   void construct(U* p) noexcept {
     ::new (static_cast<void*>(p)) U;
@@ -28,6 +20,18 @@ struct UninitialisedAllocator : std::allocator<T> {
   void construct(U* p, Args&&... args) {
     ::new (static_cast<void*>(p)) U(std::forward<Args>(args)...);
   }
+};
+
+template <class T>
+struct UninitialisedAllocator : std::allocator<T>, LeavesNewElementsUnset {
+  static_assert(std::is_trivially_default_constructible_v<T>);
+  template <class U>
+  struct rebind {
+    using other = UninitialisedAllocator<U>;
+  };
+  UninitialisedAllocator() = default;
+  template <class U>
+  UninitialisedAllocator(const UninitialisedAllocator<U>&) noexcept {}
 };
 
 }  // namespace hairgen
