@@ -212,6 +212,13 @@ class Reader {
     if (crc) *crc = crcOf(*crc, reinterpret_cast<const uint8_t*>(v.data()), n);
     if constexpr (!kLittleEndian) swapWords<Word>(v.data(), n);
   }
+  // The mapped chunks leave the process, once the file's checks have read them (a chunk's CRC, the
+  // strands' validate()): nothing has written them.
+  void releaseChecked() {
+    for (const std::shared_ptr<MappedRegion>& r : checked_)
+      r->file->release(uint64_t(static_cast<uint8_t*>(r->data) - r->file->data()), r->bytes);
+    checked_.clear();
+  }
 
  private:
   // A point array held where the source's mapping has it (the next count · 12 bytes), when it lies on
@@ -236,20 +243,9 @@ class Reader {
     return true;
   }
 
- public:
-  // The mapped chunks leave the process, once the file's checks have read them (a chunk's CRC, the
-  // strands' validate()): nothing has written them.
-  void releaseChecked() {
-    for (const std::shared_ptr<MappedRegion>& r : checked_)
-      r->file->release(uint64_t(static_cast<uint8_t*>(r->data) - r->file->data()), r->bytes);
-    checked_.clear();
-  }
-
- private:
-  std::vector<std::shared_ptr<MappedRegion>> checked_;
-
   Source& source_;
   const std::string& name_;
+  std::vector<std::shared_ptr<MappedRegion>> checked_;  // mapped chunks whose CRC was taken
 };
 
 // "shard=K/N" and "range=FIRST-END/TOTAL", checked for sense: 1 <= K <= N, FIRST <= END <= TOTAL.
