@@ -436,6 +436,22 @@ TEST(CameraFragments, APixelKeepsItsNearestFragmentsInDepthOrderAndTheRestInItsT
   }
 }
 
+// Twelve strands over the same pixels at the same depth: a pixel keeps the eight drawn first (equal
+// depths are ordered by the first point of the fragment's first segment), and the four after add their
+// coverage to its tail.
+TEST(CameraFragments, AtEqualDepthsAPixelKeepsTheStrandsDrawnFirst) {
+  Strands s;
+  for (int i = 0; i < 12; ++i) s.addStrand({{4.0f, 10.0f, -1.0f}, {60.0f, 10.0f, -1.0f}});
+  const CameraFragments f = rasteriseCameraFragments(s, texelView(64), 0.5, 8);
+  for (int x = 10; x < 54; ++x) {
+    const size_t p = 9 * 64 + size_t(x);
+    ASSERT_EQ(f.first[p + 1] - f.first[p], 8u) << x;
+    for (uint32_t k = 0; k < 8; ++k)
+      EXPECT_EQ(f.words[3 * (f.first[p] + k)], 2 * k) << x << ", fragment " << k;
+    EXPECT_NEAR(double(f.tail[p]) / kCoverageOne, 4 * 0.25, 1e-3) << x;  // half of each width in this row
+  }
+}
+
 // What hides the hair hides it pixel by pixel, though the rasteriser skips a segment whose nearest point
 // is as deep as the deepest of the head near it: a strand at 2 m over a head at 1 m, but for one pixel
 // and a stretch on the right at 10 m, keeps fragments in those pixels only, at their full coverage, and

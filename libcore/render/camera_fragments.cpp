@@ -47,17 +47,32 @@ uint32_t spanOf(raster::Piece piece) {
   return uint32_t(piece.twice * int64_t(kSpanUnit) / (2 * piece.length));
 }
 
-// One pixel's kept fragments, `n` of `kept`, nearest first; `tail` its coverage behind them.
-void keep(Slot* list, uint8_t& n, uint32_t& tail, uint32_t& touched, int kept, int32_t depth,
-          uint32_t coverage, uint32_t point, raster::Piece piece) {
+// What a pixel's keep() reads for every piece, apart from its kept fragments: a band's pixels' records
+// hold in the cache where their fragments do not (28 bytes × kept a pixel: 14 MB a band at 1920 pixels
+// a row).
+struct Pixel {
+  // The depth of the farthest kept fragment when the pixel keeps all it can, INT32_MAX before: a piece
+  // farther than that goes to the tail without a look at the fragments (most pieces in thick hair: 36
+  // million of the 1080p coupe's 51 million; looking cost a cache miss each).
+  int32_t farthest;
+  uint32_t touched;  // the last segment whose piece reached the pixel
+  uint32_t tail;     // the coverage behind the kept fragments
+  uint32_t n;        // fragments kept
+};
+
+// One pixel's kept fragments, `pixel.n` of `kept`, nearest first.
+void keep(Slot* list, Pixel& pixel, int kept, int32_t depth, uint32_t coverage, uint32_t point,
+          raster::Piece piece) {
   // Segments come in the order of their first point, so a piece of the same strand from the same
   // segment or the one before merges into its fragment (points are one strand's when one apart: a
   // segment joins a point to the next of its strand). No fragment's last segment is later than
   // `touched`, the last whose piece reached the pixel, so when that is older than the one before this
   // one, none is looked at (most pieces in thick hair: 8% of the camera's fragments' time).
-  const bool mergeable = point - touched <= 1;
-  touched = point;
-  for (int k = 0; mergeable && k < n; ++k) {
+  const bool mergeable = point - pixel.touched <= 1;
+  pixel.touched = point;
+  uint32_t n = pixel.n;
+  auto farthestKept = [&] { return n == uint32_t(kept) ? list[n - 1].depth : INT32_MAX; };
+  for (uint32_t k = 0; mergeable && k < n; ++k) {
     Slot& s = list[k];
     if (point - s.last > 1) continue;
     raster::addSaturating(s.coverage, coverage);
@@ -69,22 +84,26 @@ void keep(Slot* list, uint8_t& n, uint32_t& tail, uint32_t& touched, int kept, i
     }
     if (depth < s.depth) {
       s.depth = depth;
-      for (int j = k; j > 0 && list[j].nearer(list[j - 1]); --j) std::swap(list[j], list[j - 1]);
+      for (uint32_t j = k; j > 0 && list[j].nearer(list[j - 1]); --j) std::swap(list[j], list[j - 1]);
+      pixel.farthest = farthestKept();
     }
     return;
   }
   const Slot fresh{depth, point, point, point, coverage, coverage, 0};
-  if (n == kept) {
-    if (!fresh.nearer(list[n - 1])) {
-      raster::addSaturating(tail, coverage);
+  if (n == uint32_t(kept)) {
+    // Not nearer than the farthest kept (Slot::nearer, its origin read only for a tie).
+    if (depth > pixel.farthest || (depth == pixel.farthest && !fresh.nearer(list[n - 1]))) {
+      raster::addSaturating(pixel.tail, coverage);
       return;
     }
-    raster::addSaturating(tail, list[--n].coverage);
+    raster::addSaturating(pixel.tail, list[--n].coverage);
   }
-  int j = n++;
+  uint32_t j = n++;
   for (; j > 0 && fresh.nearer(list[j - 1]); --j) list[j] = list[j - 1];
   list[j] = fresh;
   list[j].span = spanOf(piece);
+  pixel.n = n;
+  pixel.farthest = farthestKept();
 }
 
 // What hides the hair, by tiles of kTile × kTile pixels: a segment all of whose fragments are as deep
@@ -161,8 +180,7 @@ CameraFragments cameraFragments(const raster::Bands& bands, int kept, const floa
   // pixels a row: allocated for each band, their pages were cleared again each time).
   struct BandSlots {
     std::vector<Slot> slots;
-    std::vector<uint8_t> used;
-    std::vector<uint32_t> touched;  // per pixel, the last segment that reached it (keep())
+    std::vector<Pixel> pixels;
   };
   tbb::enumerable_thread_specific<BandSlots> perThread;
   const Hidden hidden(opaque, bands.width, bands.height);
@@ -173,28 +191,28 @@ CameraFragments cameraFragments(const raster::Bands& bands, int kept, const floa
     const size_t end = std::min(pixels, base + raster::kBandRows * width);
     BandSlots& mine = perThread.local();
     mine.slots.resize((end - base) * size_t(kept));
-    mine.used.assign(end - base, 0);
-    mine.touched.resize(end - base);  // set by a pixel's first keep() in the band, which merges nothing
+    // `touched` is set by a pixel's first keep() in the band, which merges nothing.
+    mine.pixels.assign(end - base, Pixel{INT32_MAX, 0, 0, 0});
     std::vector<Slot>& slots = mine.slots;
-    std::vector<uint8_t>& used = mine.used;
+    std::vector<Pixel>& records = mine.pixels;
     bands.eachFragment<raster::Across::kBox>(
         band,
         [&](size_t texel, int32_t depth, uint32_t coverage, uint32_t point, raster::Piece piece) {
           // Compared as the blend compares them: the fragment's depth as the float it is stored as.
           if (opaque && metresOf(depth) >= opaque[texel]) return;
           const size_t local = texel - base;
-          keep(&slots[local * size_t(kept)], used[local], out.tail[texel], mine.touched[local], kept, depth,
-               coverage, point, piece);
+          keep(&slots[local * size_t(kept)], records[local], kept, depth, coverage, point, piece);
         },
         [&](const raster::Vertex& a, const raster::Vertex& b) { return hidden.behind(a, b); });
     size_t count = 0;
-    for (const uint8_t n : used) count += n;
+    for (const Pixel& p : records) count += p.n;
     requireShadable(keptSoFar.fetch_add(count) + count, limit);
     auto words = std::make_unique<Words>(3 * count);
     uint32_t* word = words->data();
     for (size_t p = 0; p < end - base; ++p) {
-      out.first[base + p] = used[p];
-      for (int k = 0; k < used[p]; ++k, word += 3) {
+      out.first[base + p] = records[p].n;
+      out.tail[base + p] = records[p].tail;
+      for (uint32_t k = 0; k < records[p].n; ++k, word += 3) {
         const Slot& s = slots[p * size_t(kept) + size_t(k)];
         word[0] = s.point;
         word[1] = std::bit_cast<uint32_t>(metresOf(s.depth));
