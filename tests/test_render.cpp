@@ -283,6 +283,39 @@ Strands crossingEveryWay() {
   return s;
 }
 
+// Bands sorted straight from the points are those of the projection's list of segments, whatever
+// storage is reused: strands crossing every way, some with points behind the view (their segments are
+// not drawn) and some reaching past its edges, and strands of one point, which have no segment.
+TEST(HairRaster, BandsFromThePointsAreTheProjectionsBands) {
+  Strands s = crossingEveryWay();
+  s.addStrand({{10.0f, 10.0f, -1.0f}, {20.0f, 30.0f, 1.0f}, {30.0f, 40.0f, -1.0f}, {40.0f, 45.0f, -1.0f}});
+  s.addStrand({{-40.0f, 100.0f, -1.0f}, {300.0f, 120.0f, -1.0f}});
+  s.addStrand({{50.0f, 50.0f, -1.0f}});
+  s.addStrand({{100.0f, -30.0f, -1.0f}, {110.0f, 290.0f, -1.0f}});
+  auto same = [](const raster::Bands& a, const raster::Bands& b) {
+    return a.width == b.width && a.height == b.height && a.count == b.count && a.bandFirst == b.bandFirst &&
+           a.bandSegments == b.bandSegments &&
+           std::equal(a.vertices.begin(), a.vertices.end(), b.vertices.begin(), b.vertices.end(),
+                      [](const raster::Vertex& u, const raster::Vertex& v) {
+                        return u.x == v.x && u.y == v.y && u.depth == v.depth && u.width == v.width;
+                      });
+  };
+  for (const int size : {256, 100}) {
+    const View view = texelView(size);
+    const raster::Bands listed = raster::intoBands(raster::project(s, view, 0.7));
+    EXPECT_GT(listed.bandSegments.size(), size_t(size) * 100) << size;
+    EXPECT_TRUE(same(raster::projectIntoBands(s, view, 0.7), listed)) << size;
+    // Reusing a larger projection's storage, and a smaller one's.
+    EXPECT_TRUE(same(raster::projectIntoBands(s, view, 0.7, raster::projectIntoBands(s, texelView(512), 3.0)),
+                     listed))
+        << size;
+    EXPECT_TRUE(same(raster::projectIntoBands(
+                         s, view, 0.7, raster::projectIntoBands(strip({{1, 1, -1}, {5, 5, -1}}), view, 0.7)),
+                     listed))
+        << size;
+  }
+}
+
 // Many strands crossing in every direction at equal depths: integer minima and sums, the same bits
 // on one thread as on all, and on a second run.
 TEST(HairLightMaps, TheMapsAreTheSameBitsOnOneThreadAsOnAll) {
