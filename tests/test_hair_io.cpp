@@ -374,5 +374,23 @@ TEST(HugePages, ResizeLargeKeepsValuesAndZeroesTheRest) {
   EXPECT_EQ(v[n - 1], glm::vec3(0.0f));
 }
 
+// Storage grown with room to spare holds that many more, so a reuse that needs a little more keeps it:
+// the values kept, the new ones zero.
+TEST(HugePages, ResizeLargeWithRoomToSpareKeepsItsStorageForALittleMore) {
+  std::vector<uint32_t> v = {5, 6};
+  const size_t n = (size_t(12) << 20) / sizeof(uint32_t) + 3;
+  resizeLarge(v, n, n / 8);
+  ASSERT_EQ(v.size(), n);
+  EXPECT_GE(v.capacity(), n + n / 8);
+  EXPECT_EQ(v[1], 6u);
+  const uint32_t* storage = v.data();
+  v[n - 1] = 9;
+  v.clear();
+  resizeLarge(v, n + n / 10);
+  EXPECT_EQ(v.data(), storage);
+  EXPECT_EQ(v[n - 1], 0u);
+  EXPECT_EQ(v.back(), 0u);
+}
+
 }  // namespace
 }  // namespace hairgen

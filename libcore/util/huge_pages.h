@@ -29,14 +29,16 @@ inline void adviseHugePages(void* data, size_t bytes) {
 // (madvise; only advice: where transparent huge pages are off, it has 4 KiB ones) and faulted in by
 // every core at once before resize makes the elements. The values are resize's: the old ones kept,
 // new ones as the allocator makes them (zeros for std::allocator, unset for UninitialisedAllocator).
+// `spare`: elements more that new storage holds, untouched (address space, not memory, until used), for
+// storage handed on to be reused for a little more.
 template <class T, class A>
-void resizeLarge(std::vector<T, A>& v, size_t n) {
+void resizeLarge(std::vector<T, A>& v, size_t n, size_t spare = 0) {
   static_assert(std::is_trivially_copyable_v<T>, "its storage is touched before it holds elements");
   constexpr size_t kLarge = size_t(8) << 20;
   if (n > v.capacity() && n * sizeof(T) >= kLarge) {
     std::vector<T, A> fresh;
-    fresh.reserve(n);
-    adviseHugePages(fresh.data(), n * sizeof(T));
+    fresh.reserve(n + spare);
+    adviseHugePages(fresh.data(), (n + spare) * sizeof(T));
     // A zero byte in every 4 KiB page of the storage not yet holding elements: its faults (the kernel
     // clears each page) on every core. This writes past size() into reserved storage, which holds no
     // objects yet: fine for a trivially copyable T, whose bytes assign and resize then write whole (a
