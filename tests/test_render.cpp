@@ -265,6 +265,13 @@ TEST(HairLightMaps, OpacityFallsInTheLayersBehindWhereTheHairBegins) {
     EXPECT_EQ(opacity[t].y, opacity[t].z);
     EXPECT_EQ(opacity[t].z, opacity[t].w);
   }
+  // Written over the integers' storage for an upload, the same floats.
+  HairLightMaps spent = maps;
+  const void* startInPlace = spent.startMetresInPlace(1e10f);
+  const void* opacityInPlace = spent.opacityInPlace(0.8);
+  EXPECT_EQ(std::memcmp(startInPlace, start.data(), start.size() * sizeof(float)), 0);
+  EXPECT_EQ(std::memcmp(opacityInPlace, opacity.data(), opacity.size() * sizeof(glm::vec4)), 0);
+  EXPECT_EQ(start[0], 1e10f) << "the test has texels without hair";
 }
 
 // 3,000 strands of 12 points crossing in every direction over a 256-texel view, at 7 depths.

@@ -1,10 +1,12 @@
 #include "libcore/render/light_maps.h"
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
 #include <limits>
 #include <memory>
 
+#include <tbb/blocked_range.h>
 #include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
 
@@ -50,18 +52,50 @@ class FragmentBlocks {
 
 }  // namespace
 
+namespace {
+
+float metres(int32_t start, float background) {
+  return start == kNoHair ? background : float(double(start) * kDepthUnit);
+}
+
+glm::vec4 opacityOf(const glm::uvec4& coverage, double scale) {
+  return glm::vec4(glm::dvec4(coverage) * scale);
+}
+
+// f(i) for every texel, on every thread.
+template <class F>
+void eachTexel(size_t texels, F&& f) {
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, texels, size_t(1) << 16),
+                    [&](const tbb::blocked_range<size_t>& r) {
+                      for (size_t i = r.begin(); i < r.end(); ++i) f(i);
+                    });
+}
+
+}  // namespace
+
 std::vector<float> HairLightMaps::startMetres(float background) const {
   std::vector<float> out(start.size());
-  for (size_t i = 0; i < start.size(); ++i)
-    out[i] = start[i] == kNoHair ? background : float(double(start[i]) * kDepthUnit);
+  eachTexel(start.size(), [&](size_t i) { out[i] = metres(start[i], background); });
   return out;
 }
 
 std::vector<glm::vec4> HairLightMaps::opacity(double strandOpacity) const {
   std::vector<glm::vec4> out(layers.size());
   const double scale = strandOpacity / double(kCoverageOne);
-  for (size_t i = 0; i < layers.size(); ++i) out[i] = glm::vec4(glm::dvec4(layers[i]) * scale);
+  eachTexel(layers.size(), [&](size_t i) { out[i] = opacityOf(layers[i], scale); });
   return out;
+}
+
+const void* HairLightMaps::startMetresInPlace(float background) {
+  eachTexel(start.size(), [&](size_t i) { start[i] = std::bit_cast<int32_t>(metres(start[i], background)); });
+  return start.data();
+}
+
+const void* HairLightMaps::opacityInPlace(double strandOpacity) {
+  const double scale = strandOpacity / double(kCoverageOne);
+  eachTexel(layers.size(),
+            [&](size_t i) { layers[i] = std::bit_cast<glm::uvec4>(opacityOf(layers[i], scale)); });
+  return layers.data();
 }
 
 std::array<int64_t, 3> layerEnds(const glm::dvec4& layerSizes) {

@@ -30,6 +30,11 @@ struct HairLightMaps {
   std::vector<float> startMetres(float background) const;
   // Each layer's opacity: coverage × `strandOpacity` (a texel covered once by a strand is that opaque).
   std::vector<glm::vec4> opacity(double strandOpacity) const;
+  // The same floats written over the integers' own storage, each float's bits in its integer's place,
+  // for an upload that needs no second copy of a map (the 1080p coupe's two: 49 MB of fresh pages,
+  // which the kernel clears first). For a map's last use: its integers are gone after.
+  const void* startMetresInPlace(float background);
+  const void* opacityInPlace(double strandOpacity);
 };
 
 // The first three layers' far ends behind where the hair begins, in kDepthUnit: `layerSizes` (metres)

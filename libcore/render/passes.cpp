@@ -360,8 +360,8 @@ LightDepth lightDepthPass(const Scene& scene) {
     computeLightMaps(*scene.lightOnDevice, r.layerSizes, r.strandOpacity, kBackgroundZ, depth.hairStart,
                      *depth.opacity, nullptr, &scene.timer);
   } else if (scene.lightMaps) {
-    const std::vector<float> start = scene.lightMaps->startMetres(kBackgroundZ);
-    glTextureSubImage2D(depth.hairStart.id, 0, 0, 0, n, n, GL_RED, GL_FLOAT, start.data());
+    glTextureSubImage2D(depth.hairStart.id, 0, 0, 0, n, n, GL_RED, GL_FLOAT,
+                        scene.lightMaps->startMetresInPlace(kBackgroundZ));
   } else {
     Framebuffer fb({&depth.hairStart}, n, n, true);
     fb.bind();
@@ -386,8 +386,8 @@ Texture deepOpacityPass(const Scene& scene, LightDepth& depth) {
   const int n = scene.light.width;
   Texture opacity(GL_RGBA32F, n, n);
   if (scene.lightMaps) {
-    const std::vector<glm::vec4> sums = scene.lightMaps->opacity(scene.settings.strandOpacity);
-    glTextureSubImage2D(opacity.id, 0, 0, 0, n, n, GL_RGBA, GL_FLOAT, sums.data());
+    glTextureSubImage2D(opacity.id, 0, 0, 0, n, n, GL_RGBA, GL_FLOAT,
+                        scene.lightMaps->opacityInPlace(scene.settings.strandOpacity));
     checkGl("the deep opacity map's upload");
     return opacity;
   }
