@@ -59,6 +59,7 @@ struct Pixel {
   uint32_t tail;     // the coverage behind the kept fragments
   uint32_t n;        // fragments kept
 };
+static_assert(sizeof(Pixel) == kPixelRecordBytes);
 
 // One pixel's kept fragments, `pixel.n` of `kept`, nearest first.
 void keep(Slot* list, Pixel& pixel, int kept, int32_t depth, uint32_t coverage, uint32_t point,

@@ -33,6 +33,8 @@ inline constexpr int kReferenceFragments = 64;
 // The bytes a pixel's kept slot takes while its band is drawn (camera_fragments.cpp's Slot), for
 // preflight's estimate of what the rasteriser holds.
 inline constexpr size_t kSlotBytes = 28;
+// The bytes of a pixel's record beside its slots while its band is drawn (camera_fragments.cpp's Pixel).
+inline constexpr size_t kPixelRecordBytes = 16;
 // Where a fragment lies along its segment, in 1/kSpanUnit of it (15 bits).
 inline constexpr uint32_t kSpanUnit = (1u << 15) - 1;
 // A fragment's third word: its coverage in kCoverageOne per pixel (hair_raster.h) in the low 17 bits,

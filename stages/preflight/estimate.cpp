@@ -181,8 +181,8 @@ constexpr double kSheetShare = 0.25;
 // keeping `kept` fragments a sub-pixel, F of them in all (hairCoverage's KeptFragments), on `threads`
 // threads, bytes; `points`, `segments`: the hair's. Each term is a buffer of camera_fragments.cpp
 // or hair_raster.h:
-//   slots       threads × kBandRows × W × (kept × kSlotBytes + 5): each thread's slots for a band's
-//               sub-pixels, their counts and last segments (W the sub-pixel image's width), alive until
+//   slots       threads × kBandRows × W × (kept × kSlotBytes + kPixelRecordBytes): each thread's slots
+//               for a band's sub-pixels and their records (W the sub-pixel image's width), alive until
 //               the end;
 //   words       2 × 12 × F: three words a fragment, gathered per band and then copied into one array
 //               while the bands' are alive;
@@ -197,7 +197,8 @@ double rasteriserBytes(const RenderSettings& r, int block, int kept, double frag
                        size_t segments, size_t threads) {
   const double width = double(r.resolution.x) * block;
   const double fine = width * double(r.resolution.y) * block;
-  const double slots = double(threads) * raster::kBandRows * width * (double(kept) * kSlotBytes + 5.0);
+  const double slots =
+      double(threads) * raster::kBandRows * width * (double(kept) * kSlotBytes + double(kPixelRecordBytes));
   return slots + fragments * (2.0 * 12.0 + 16.0) + fine * 16.0 + double(points) * 16.0 +
          double(segments) * 4.0;
 }
