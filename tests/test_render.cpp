@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <bit>
+#include <cstring>
 #include <limits>
 
 #include <tbb/global_control.h>
@@ -272,6 +273,9 @@ TEST(HairLightMaps, OpacityFallsInTheLayersBehindWhereTheHairBegins) {
   EXPECT_EQ(std::memcmp(startInPlace, start.data(), start.size() * sizeof(float)), 0);
   EXPECT_EQ(std::memcmp(opacityInPlace, opacity.data(), opacity.size() * sizeof(glm::vec4)), 0);
   EXPECT_EQ(start[0], 1e10f) << "the test has texels without hair";
+  // Their integers are gone: asked for again, they are refused.
+  EXPECT_THROW(spent.startMetresInPlace(1e10f), std::logic_error);
+  EXPECT_THROW((void)spent.opacity(0.8), std::logic_error);
 }
 
 // 3,000 strands of 12 points crossing in every direction over a 256-texel view, at 7 depths.

@@ -167,7 +167,7 @@ void requireShadable(uint64_t fragments, uint64_t limit) {
 }
 
 CameraFragments cameraFragments(const raster::Bands& bands, int kept, const float* opaque, uint64_t limit) {
-  kept = std::clamp(kept, 1, 255);                // a pixel counts its fragments in a byte
+  kept = std::clamp(kept, 1, 255);                // as the device's passes take it (compute_raster.cpp)
   limit = std::min<uint64_t>(limit, UINT32_MAX);  // what `first` indexes
   std::atomic<uint64_t> keptSoFar{0};             // the fragments of the bands drawn so far
   const size_t width = size_t(bands.width), pixels = width * size_t(bands.height);

@@ -5,6 +5,8 @@
 #include <cmath>
 #include <limits>
 #include <memory>
+#include <stdexcept>
+#include <string>
 
 #include <tbb/blocked_range.h>
 #include <tbb/enumerable_thread_specific.h>
@@ -50,10 +52,6 @@ class FragmentBlocks {
   size_t size_ = 0;
 };
 
-}  // namespace
-
-namespace {
-
 float metres(int32_t start, float background) {
   return start == kNoHair ? background : float(double(start) * kDepthUnit);
 }
@@ -71,15 +69,23 @@ void eachTexel(size_t texels, F&& f) {
                     });
 }
 
+// Throws when a map's integers were written over for its upload.
+void requireIntegers(bool spent, const char* map) {
+  if (spent)
+    throw std::logic_error(std::string("the light's ") + map + " map was already converted in place");
+}
+
 }  // namespace
 
 std::vector<float> HairLightMaps::startMetres(float background) const {
+  requireIntegers(startSpent_, "start");
   std::vector<float> out(start.size());
   eachTexel(start.size(), [&](size_t i) { out[i] = metres(start[i], background); });
   return out;
 }
 
 std::vector<glm::vec4> HairLightMaps::opacity(double strandOpacity) const {
+  requireIntegers(layersSpent_, "opacity");
   std::vector<glm::vec4> out(layers.size());
   const double scale = strandOpacity / double(kCoverageOne);
   eachTexel(layers.size(), [&](size_t i) { out[i] = opacityOf(layers[i], scale); });
@@ -87,11 +93,15 @@ std::vector<glm::vec4> HairLightMaps::opacity(double strandOpacity) const {
 }
 
 const void* HairLightMaps::startMetresInPlace(float background) {
+  requireIntegers(startSpent_, "start");
+  startSpent_ = true;
   eachTexel(start.size(), [&](size_t i) { start[i] = std::bit_cast<int32_t>(metres(start[i], background)); });
   return start.data();
 }
 
 const void* HairLightMaps::opacityInPlace(double strandOpacity) {
+  requireIntegers(layersSpent_, "opacity");
+  layersSpent_ = true;
   const double scale = strandOpacity / double(kCoverageOne);
   eachTexel(layers.size(),
             [&](size_t i) { layers[i] = std::bit_cast<glm::uvec4>(opacityOf(layers[i], scale)); });

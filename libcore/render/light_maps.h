@@ -32,9 +32,13 @@ struct HairLightMaps {
   std::vector<glm::vec4> opacity(double strandOpacity) const;
   // The same floats written over the integers' own storage, each float's bits in its integer's place,
   // for an upload that needs no second copy of a map (the 1080p coupe's two: 49 MB of fresh pages,
-  // which the kernel clears first). For a map's last use: its integers are gone after.
+  // which the kernel clears first). For a map's last use: its integers are gone after, and a second
+  // call, or startMetres() or opacity() after one, throws std::logic_error.
   const void* startMetresInPlace(float background);
   const void* opacityInPlace(double strandOpacity);
+
+ private:
+  bool startSpent_ = false, layersSpent_ = false;  // written over by the calls above
 };
 
 // The first three layers' far ends behind where the hair begins, in kDepthUnit: `layerSizes` (metres)
