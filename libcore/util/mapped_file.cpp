@@ -36,7 +36,7 @@ struct Fault {
 };
 Fault gFault;
 
-int guard(const uint8_t* data, uint64_t size, const std::string& name) {
+int guard(const uint8_t* data, uint64_t size, const std::string& name) noexcept {
   if (name.size() >= sizeof gGuarded[0].name) return -1;
   for (size_t i = 0; i < gGuarded.size(); ++i) {
     int expected = 0;
@@ -56,8 +56,9 @@ int guard(const uint8_t* data, uint64_t size, const std::string& name) {
 extern "C" void onBusError(int signal, siginfo_t* info, void*) {
   const int savedErrno = errno;
   const uintptr_t at = reinterpret_cast<uintptr_t>(info->si_addr);
+  const bool fault = info->si_code > 0;  // not sent by kill or raise
   for (GuardSlot& slot : gGuarded) {
-    if (info->si_code <= 0) break;  // sent, not a fault
+    if (!fault) break;
     if (slot.state.load() != 2 || at < slot.begin || at >= slot.end) continue;
     int none = 0;
     if (gFault.state.compare_exchange_strong(none, 1)) {
@@ -79,7 +80,7 @@ extern "C" void onBusError(int signal, siginfo_t* info, void*) {
   fallback.sa_handler = SIG_DFL;
   sigemptyset(&fallback.sa_mask);
   ::sigaction(signal, &fallback, nullptr);
-  if (info->si_code <= 0) ::raise(signal);  // a fault instead runs again, and gets the default
+  if (!fault) ::raise(signal);  // a fault instead runs again, and gets the default
   errno = savedErrno;
 }
 
@@ -92,13 +93,7 @@ std::shared_ptr<FileMapping> FileMapping::map(int fd, uint64_t size, const std::
   // Read from the start on: the kernel reads ahead of the faults.
   ::madvise(data, size_t(size), MADV_WILLNEED);
   uint8_t* bytes = static_cast<uint8_t*>(data);
-  int slot = -1;
-  try {
-    slot = guard(bytes, size, name);
-  } catch (...) {
-    ::munmap(data, size_t(size));
-    throw;
-  }
+  const int slot = guard(bytes, size, name);
   // Owned from here on: where the shared_ptr cannot be made, it deletes the mapping (and frees its slot).
   return std::shared_ptr<FileMapping>(new FileMapping(bytes, size, slot));
 }

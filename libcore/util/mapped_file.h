@@ -83,14 +83,10 @@ class MappableAllocator : public LeavesNewElementsUnset {
 
   MappableAllocator() = default;
   explicit MappableAllocator(std::shared_ptr<MappedRegion> region) : region_(std::move(region)) {}
-  // A moved allocator stays equal to what it was (the allocator requirements): moves copy.
+  // A moved allocator stays equal to what it was (the allocator requirements): moves copy (with the
+  // copies declared, no move is).
   MappableAllocator(const MappableAllocator&) = default;
-  MappableAllocator(MappableAllocator&& other) noexcept : region_(other.region_) {}
   MappableAllocator& operator=(const MappableAllocator&) = default;
-  MappableAllocator& operator=(MappableAllocator&& other) noexcept {
-    region_ = other.region_;
-    return *this;
-  }
   // Rebound to another type, it compares equal and adopts the region only for elements of its size.
   template <class U>
   MappableAllocator(const MappableAllocator<U>& other) noexcept : region_(other.region_) {}
