@@ -6,7 +6,6 @@
 #include <unistd.h>
 
 #include <algorithm>
-#include <array>
 #include <atomic>
 #include <bit>
 #include <cerrno>
@@ -19,6 +18,7 @@
 
 #include "libcore/util/error.h"
 #include "libcore/util/resources.h"
+#include "libcore/util/signal_slots.h"
 #include "libcore/util/text.h"
 
 namespace hairgen {
@@ -37,40 +37,34 @@ Container readWhole(const fs::path& path) {
 
 // ------------------------------------------------------------------------- the interrupt cleanup table
 
-// Temporaries of writes in flight, readable from a signal handler: a fixed table of paths, each slot
-// free (0), being filled (1) or live (2). A handler unlinks only live slots.
-struct TemporarySlot {
-  std::atomic<int> state{0};
+// Temporaries of writes in flight, for the interrupt cleanup to remove: only live ones, whose file
+// this process made (signal_slots.h).
+struct TemporaryPath {
   char path[4096];
 };
-std::array<TemporarySlot, 256> gTemporaries;
+SignalSlots<TemporaryPath, 256> gTemporaries;
 
-// Reserves a slot for `path` (being filled: a handler leaves it alone until markLive); −1 when every
+// Reserves a slot for `path` (being filled: the cleanup leaves it alone until markLive); −1 when every
 // slot is taken (the write still happens, only a signal does not clean it).
 int reserveTemporary(const fs::path& path) {
   const std::string text = path.string();
-  if (text.size() >= sizeof gTemporaries[0].path) return -1;
-  for (size_t i = 0; i < gTemporaries.size(); ++i) {
-    int expected = 0;
-    if (!gTemporaries[i].state.compare_exchange_strong(expected, 1)) continue;
-    std::memcpy(gTemporaries[i].path, text.c_str(), text.size() + 1);
-    return int(i);
-  }
-  return -1;
+  if (text.size() >= sizeof(TemporaryPath::path)) return -1;
+  const int slot = gTemporaries.claim();
+  if (slot >= 0) std::memcpy(gTemporaries[slot].path, text.c_str(), text.size() + 1);
+  return slot;
 }
 
 // The slot's file exists now, made by this process: a signal removes it.
 void markLive(int slot) {
-  if (slot >= 0) gTemporaries[size_t(slot)].state.store(2);
+  gTemporaries.markLive(slot);
 }
 
 void releaseTemporary(int slot) {
-  if (slot >= 0) gTemporaries[size_t(slot)].state.store(0);
+  gTemporaries.release(slot);
 }
 
 extern "C" void removeTemporariesAndExit(int signal) {
-  for (TemporarySlot& slot : gTemporaries)
-    if (slot.state.load() == 2) ::unlink(slot.path);
+  gTemporaries.forEachLive([](const TemporaryPath& t) { ::unlink(t.path); });
   ::_exit(128 + signal);
 }
 

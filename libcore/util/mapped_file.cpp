@@ -6,27 +6,25 @@
 #include <unistd.h>
 
 #include <algorithm>
-#include <array>
 #include <atomic>
 #include <cerrno>
 #include <cstring>
 #include <mutex>
 
 #include "libcore/util/error.h"
+#include "libcore/util/signal_slots.h"
 
 namespace hairgen {
 
 namespace {
 
-// The mappings a SIGBUS may come from, readable from the handler: a fixed table, each slot free (0),
-// being filled (1) or live (2), as the interrupt cleanup's temporaries are (file_util.cpp).
-struct GuardSlot {
-  std::atomic<int> state{0};
+// The mappings a SIGBUS may come from, for the handler to find (signal_slots.h).
+struct Guarded {
   std::atomic<bool> zeroed{false};  // its pages were made zeros after a fault
   uintptr_t begin = 0, end = 0;
   char name[4096];
 };
-std::array<GuardSlot, 64> gGuarded;
+SignalSlots<Guarded, 64> gGuarded;
 
 // The first fault not yet reported (requireMappingsWhole): its file's name and the size it was mapped at.
 struct Fault {
@@ -37,19 +35,16 @@ struct Fault {
 Fault gFault;
 
 int guard(const uint8_t* data, uint64_t size, const std::string& name) noexcept {
-  if (name.size() >= sizeof gGuarded[0].name) return -1;
-  for (size_t i = 0; i < gGuarded.size(); ++i) {
-    int expected = 0;
-    if (!gGuarded[i].state.compare_exchange_strong(expected, 1)) continue;
-    GuardSlot& slot = gGuarded[i];
-    slot.begin = reinterpret_cast<uintptr_t>(data);
-    slot.end = slot.begin + size;
-    slot.zeroed.store(false);
-    std::memcpy(slot.name, name.c_str(), name.size() + 1);
-    slot.state.store(2);
-    return int(i);
-  }
-  return -1;  // every slot taken: the mapping works, only a fault in it is the default SIGBUS
+  if (name.size() >= sizeof(Guarded::name)) return -1;
+  const int slot = gGuarded.claim();
+  if (slot < 0) return -1;  // every slot taken: the mapping works, only a fault in it is the default SIGBUS
+  Guarded& g = gGuarded[slot];
+  g.begin = reinterpret_cast<uintptr_t>(data);
+  g.end = g.begin + size;
+  g.zeroed.store(false);
+  std::memcpy(g.name, name.c_str(), name.size() + 1);
+  gGuarded.markLive(slot);
+  return slot;
 }
 
 // Async-signal-safe: atomics, memcpy, mmap, sigaction, raise.
@@ -57,24 +52,24 @@ extern "C" void onBusError(int signal, siginfo_t* info, void*) {
   const int savedErrno = errno;
   const uintptr_t at = reinterpret_cast<uintptr_t>(info->si_addr);
   const bool fault = info->si_code > 0;  // not sent by kill or raise
-  for (GuardSlot& slot : gGuarded) {
-    if (!fault) break;
-    if (slot.state.load() != 2 || at < slot.begin || at >= slot.end) continue;
+  Guarded* slot =
+      fault ? gGuarded.findLive([&](const Guarded& g) { return at >= g.begin && at < g.end; }) : nullptr;
+  if (slot) {
     int none = 0;
     if (gFault.state.compare_exchange_strong(none, 1)) {
-      std::memcpy(gFault.name, slot.name, sizeof gFault.name);
-      gFault.size = slot.end - slot.begin;
+      std::memcpy(gFault.name, slot->name, sizeof gFault.name);
+      gFault.size = slot->end - slot->begin;
       gFault.state.store(2);
     }
     // The mapping's pages become zeros, at the same addresses: the faulting instruction runs again and
-    // reads them (as does any other thread that faulted there meanwhile).
-    if (!slot.zeroed.exchange(true)) {
-      void* zeros = ::mmap(reinterpret_cast<void*>(slot.begin), slot.end - slot.begin, PROT_READ | PROT_WRITE,
-                           MAP_PRIVATE | MAP_ANONYMOUS | MAP_FIXED, -1, 0);
-      if (zeros == MAP_FAILED) break;  // the default action, below
+    // reads them (as does any other thread that faulted there meanwhile). Where they cannot be made
+    // zeros, the default action, below.
+    if (slot->zeroed.exchange(true) ||
+        ::mmap(reinterpret_cast<void*>(slot->begin), slot->end - slot->begin, PROT_READ | PROT_WRITE,
+               MAP_PRIVATE | MAP_ANONYMOUS | MAP_FIXED, -1, 0) != MAP_FAILED) {
+      errno = savedErrno;
+      return;
     }
-    errno = savedErrno;
-    return;
   }
   struct sigaction fallback {};
   fallback.sa_handler = SIG_DFL;
@@ -99,7 +94,7 @@ std::shared_ptr<FileMapping> FileMapping::map(int fd, uint64_t size, const std::
 }
 
 FileMapping::~FileMapping() {
-  if (guardSlot_ >= 0) gGuarded[size_t(guardSlot_)].state.store(0);  // before the pages go
+  gGuarded.release(guardSlot_);  // before the pages go
   ::munmap(data_, size_t(size_));
 }
 
