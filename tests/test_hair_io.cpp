@@ -319,6 +319,26 @@ TEST(HairFile, AMappedFileThatShrinksIsTheFilesErrorNotACrash) {
   EXPECT_NO_THROW(requireMappingsWhole()) << "said once";
 }
 
+// A sequence keeps each frame it finishes (keepCommittedOutputs), but not one made after a mapped input's
+// page could not be read: that frame was made from zeros, and the failed command removes it.
+TEST(HairFile, AFrameMadeFromAMappedFileThatShrankIsNotKept) {
+  installMappingGuard();
+  test::TempDir dir("shrinks-kept");
+  const std::filesystem::path file = dir / "coupe.hair";
+  writeHair(file, largeStrands(20000, 50, false));
+  const Strands mapped = readHair(file, nullptr, ArrayStorage::kMapped);
+  forgetCommittedOutputs();
+  writeFileAtomic(dir / "beauty.0001.exr", std::string("made from the file"));
+  keepCommittedOutputs();
+  std::filesystem::resize_file(file, 4096);
+  ASSERT_EQ(mapped.tangents.back(), glm::vec3(0.0f));
+  writeFileAtomic(dir / "beauty.0002.exr", std::string("made from zeros"));
+  EXPECT_THROW(keepCommittedOutputs(), InputError);
+  discardCommittedOutputs();  // as a failed command does
+  EXPECT_TRUE(std::filesystem::exists(dir / "beauty.0001.exr"));
+  EXPECT_FALSE(std::filesystem::exists(dir / "beauty.0002.exr"));
+}
+
 // A page that cannot be read where the file is no shorter by the check (here truncated and written back
 // to its length, as cp over it does; or an I/O error) is an IoError, exit 1, which a retry may mend.
 TEST(HairFile, AMappedPageThatCannotBeReadOtherwiseIsAnIoError) {

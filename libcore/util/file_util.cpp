@@ -17,6 +17,7 @@
 #include <vector>
 
 #include "libcore/util/error.h"
+#include "libcore/util/mapped_file.h"
 #include "libcore/util/resources.h"
 #include "libcore/util/signal_slots.h"
 #include "libcore/util/text.h"
@@ -631,6 +632,7 @@ void discardCommittedOutputs() {
 }
 
 void keepCommittedOutputs() {
+  requireMappingsWhole();  // a frame made from a mapped input's unreadable page (zeros) is not kept
   std::lock_guard<std::mutex> lock(gCommittedMutex);
   gKept = gCommitted.size();
 }

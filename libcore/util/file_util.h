@@ -130,7 +130,9 @@ void installInterruptCleanup();
 // discardCommittedOutputs: removes the files committed since the last keepCommittedOutputs() (or since
 // forgetCommittedOutputs()), each only while its name still holds the file this process made there
 // (a failed command's outputs). keepCommittedOutputs: the files committed so far are finished and stay
-// whatever happens later (a sequence's frames: a failed frame never costs the frames before it).
+// whatever happens later (a sequence's frames: a failed frame never costs the frames before it), unless
+// a mapped input's page could not be read since the last check: then it keeps none and throws
+// requireMappingsWhole()'s error (mapped_file.h), for what was made from its zeros.
 // forgetCommittedOutputs: forgets every file (a command that succeeded, or one that starts).
 void discardCommittedOutputs();
 void keepCommittedOutputs();
