@@ -25,6 +25,7 @@ if [ "$mode" != --program-only ]; then
     clang libclang-rt-14-dev llvm  # the fuzz build (scripts/fuzz.sh): libFuzzer, ASan, UBSan, llvm-symbolizer
     ffmpeg  # a shot's preview movie (beauty.mp4, beauty.gif); without it `run` writes the frames alone
     slurm-wlm munge  # the farm's scheduler: a one-node Slurm for the tests (scripts/slurm-local.sh)
+    glslang-tools  # the Khronos reference compiler checks every shader stage (tests/glsl_reference_test.sh)
   )
   # Node.js with npm runs the glTF validator; the image may ship its own Node (then Debian's npm conflicts).
   command -v npm >/dev/null 2>&1 || packages+=(nodejs npm)

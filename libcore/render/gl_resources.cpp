@@ -61,7 +61,10 @@ std::string origin(const StageSource& s) {
   return text;
 }
 
+std::function<void(GLenum, const StageSource&, const char*)> gWatchStages;
+
 GLuint compileStage(GLenum type, const StageSource& source, const char* program) {
+  if (gWatchStages) gWatchStages(type, source, program);
   GLuint s = glCreateShader(type);
   const char* text = source.text.c_str();
   glShaderSource(s, 1, &text, nullptr);
@@ -133,6 +136,10 @@ GLuint linkedOnce(const std::string& key, Link&& link, bool& owned) {
 }  // namespace
 
 // (In the body: owned_ is initialised after id.)
+void watchStages(std::function<void(GLenum, const StageSource&, const char*)> watch) {
+  gWatchStages = std::move(watch);
+}
+
 Program::Program(const StageSource& vertex, const StageSource& fragment, const char* name) {
   id = linkedOnce(
       vertex.text + '\0' + fragment.text, [&] { return link(vertex, fragment, name); }, owned_);

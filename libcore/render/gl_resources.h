@@ -3,6 +3,7 @@
 // that are hairgen's own throw Error with exit code 1 ("rendering: ...").
 #pragma once
 
+#include <functional>
 #include <initializer_list>
 #include <string>
 #include <vector>
@@ -34,6 +35,13 @@ struct StageSource {
   const char* key = "";                 // "HairFrag"
   const char* variant = "";             // what the prelude made of it, e.g. "for ribbons"; may be empty
 };
+
+// Hands each stage to `watch` as it is handed to OpenGL (once per context and GLSL text, as Program
+// compiles it): its type (GL_VERTEX_SHADER, ...), its text and its program's name, a program's stages one
+// after the other (vertex, then fragment). An empty function, the default, watches none. For
+// tests/write_stages.cpp, which has every stage and program checked by the Khronos reference compiler:
+// GLSL one driver accepts may be GLSL another refuses.
+void watchStages(std::function<void(GLenum type, const StageSource& stage, const char* program)> watch);
 
 // A linked program of a vertex and a fragment stage. `name` ("hair shading") is for messages. A custom
 // stage that fails to compile, or a program with one that fails to link, throws InputError at the
