@@ -73,6 +73,11 @@ RenderOutput renderStage(const CommonOptions& common, const Config& config, GlCo
       note(common, "render: hairgen's rasteriser runs on the CPU, the same image: " + out.deviceRefused);
     stats.json()["device"]["deviceRefused"] = out.deviceRefused;
   }
+  if (!out.note.empty()) {
+    // Once a render: a sequence's frames are all in the same units.
+    if (!stats.json().contains("note")) note(common, "render: " + out.note);
+    stats.json()["note"] = out.note;
+  }
   stats.counts()["hairFragments"] = out.hairFragments;
   stats.json()["device"]["hairFragmentSeconds"] = out.timings.fragments;
   stats.json()["device"]["hairReadInPlace"] = out.hairReadInPlace;

@@ -132,9 +132,11 @@ RenderOutput render(GlContext& gl, const Strands& hair, const Mesh* head, const 
     copyFraming.reset();
     if (options.uploaded) options.uploaded();
   };
-  requireFits(estimateRender(input.settings, *input.hair, head, gl.maxTextureSize(), input.keptFragments),
-              options.force);
+  const WorkEstimate estimate =
+      estimateRender(input.settings, *input.hair, head, gl.maxTextureSize(), input.keptFragments);
+  requireFits(estimate, options.force);
   RenderOutput out = renderHair(gl, input);
+  out.note = estimate.note;
   requireFinite(out.beauty);
   return out;
 }

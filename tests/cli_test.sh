@@ -104,6 +104,23 @@ render_units_head)
     --up-axis z "${on_head[@]}" -o "$tmp/both.exr" "${small[@]}" --set Setup.MeshUnits=cm --set Setup.MeshUpAxis=z
   expect_rc 4 "$hairgen" diff "$tmp/metres.exr" "$tmp/both.exr"
   ;;
+render_units_note)
+  # A coupe in centimetres read as metres (here, one in metres made 100 times larger) renders, framed, as
+  # strands drawn a hundredth of their width: a nearly empty image. The render says why and what to give,
+  # on stderr and in --stats; a coupe in metres hears nothing of it.
+  expect_rc 0 "$hairgen" grow "$src/configs/default/setup.txt" -o "$tmp/g.hair" --quiet --set Hairstyle.HairDensity=5
+  expect_rc 0 "$hairgen" convert "$tmp/g.hair" "$tmp/large.hair" --units 100 --quiet
+  framed=(--frame --set "Render.Resolution=48 48")
+  expect_rc 0 "$hairgen" render "$src/configs/default/setup.txt" --hair "$tmp/large.hair" -o "$tmp/large.exr" \
+    "${framed[@]}" --stats "$tmp/large.json"
+  expect_err "if the hair file is not in metres, give its unit (--units cm, mm or in)"
+  grep -q '"note": "the longest strand is [0-9.]* m, and the strands are drawn' "$tmp/large.json" ||
+    fail "no note in --stats: $(cat "$tmp/large.json")"
+  expect_rc 0 "$hairgen" render "$src/configs/default/setup.txt" --hair "$tmp/g.hair" -o "$tmp/metres.exr" \
+    "${framed[@]}" --stats "$tmp/metres.json"
+  ! grep -q "give its unit" "$tmp/err" || fail "a coupe in metres was told of units: $(cat "$tmp/err")"
+  ! grep -q '"note"' "$tmp/metres.json" || fail "a coupe in metres has a note: $(cat "$tmp/metres.json")"
+  ;;
 real_cyhair)
   [ -f "$real/luxcore/straight.hair" ] || skip "shared/testdata/real is absent"
   expect_rc 0 "$hairgen" info "$real/luxcore/straight.hair"

@@ -74,6 +74,7 @@ struct RenderOutput {
       false;                  // whether hairgen's rasteriser ran on the device (RenderInput::rasteriser)
   std::string deviceRefused;  // why it ran on the CPU where `auto` would have put it on the device, or empty
   size_t hairFragments = 0;   // the camera's kept hair fragments (camera_fragments.h), at the sub-pixels
+  std::string note;           // what the user should hear of the input (WorkEstimate::note), or empty
   RenderSettings settings;    // what was rendered: the input's, with the camera and light the render stage
                               // aimed when asked to frame the hair
 };

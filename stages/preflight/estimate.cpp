@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <thread>
 
 #include <tbb/blocked_range.h>
@@ -248,7 +249,7 @@ WorkEstimate renderCost(const RenderSettings& r, size_t strands, size_t points, 
 // Strands metres long are a file in other units (a groom in centimetres read as metres): say so, since
 // no render setting is what is wrong.
 void blameUnits(WorkEstimate& e, double hairLength) {
-  if (hairLength > 3.0)
+  if (hairLength > kLongestHairMetres)
     e.timeKey = "the hair's units: its strands are " + formatReal(std::round(hairLength * 10.0) / 10.0) +
                 " m long, so the file is in other units (render it with --units cm or mm, or --frame)";
 }
@@ -385,6 +386,18 @@ WorkEstimate estimateRender(const RenderSettings& r, const Strands& hair, const 
       },
       [](double x, double y) { return std::max(x, y); });
   blameUnits(e, longest);
+  if (longest > kLongestHairMetres) {
+    // How wide a strand is drawn at the hair's centre, in pixels (the sub-pixel view's focal length over
+    // its k).
+    const double widthPx = r.strandWidth * fine.focalPx / double(block) /
+                           std::max(glm::length(sphere.centre - r.cameraPosition), 1e-9);
+    char width[32];
+    std::snprintf(width, sizeof width, "%.2g", widthPx);
+    e.note = "the longest strand is " + formatReal(std::round(longest * 10.0) / 10.0) +
+             " m, and the strands are drawn " + width + " pixels wide (Render.StrandWidth " +
+             formatReal(r.strandWidth) +
+             " m): if the hair file is not in metres, give its unit (--units cm, mm or in)";
+  }
   return e;
 }
 

@@ -28,7 +28,13 @@ struct WorkEstimate {
   std::string detail;     // what the figures come from: "759 guides x 65 points"
   std::string refusal;    // work that is wrong whatever it costs, naming the key; --force overrides it
   int frames = 0;         // a shot's work: the frames it covers (`seconds` is all of them, `bytes` one's)
+  std::string note;       // what the user should hear that is no refusal (hair that looks to be in other
+                          // units); empty: nothing
 };
+
+// No hair grows longer: a strand past it says the file is in other units (a groom in centimetres read as
+// metres).
+inline constexpr double kLongestHairMetres = 3.0;
 
 // Beyond this a stage is stopped before it starts unless --force: an hour is far past any coupe or
 // frame hairgen's bundled configs make (the slowest takes seconds).
@@ -65,7 +71,9 @@ double hairCoverage(const View& view, const Strands& hair, double strandWidth, d
 // The render of `hair` (and `head`, may be null) with `render`'s camera as framed, its time from
 // hairCoverage, its memory with what the rasteriser holds for `keptFragments` a sub-pixel (render
 // --reference keeps kReferenceFragments) on this process's threads. A strand drawn wider than a quarter
-// of the image is a refusal naming Render.StrandWidth.
+// of the image is a refusal naming Render.StrandWidth. A strand longer than kLongestHairMetres is a
+// note: how thin the strands are drawn, and --units (framed, a coupe in centimetres read as metres is
+// a nearly empty image: its strands drawn a hundredth of their width).
 WorkEstimate estimateRender(const RenderSettings& render, const Strands& hair, const Mesh* head,
                             int maxTextureSize, int keptFragments = kKeptFragments);
 // The same predicted before there is hair: `distance` from the camera to the scene's centre, `radius`
