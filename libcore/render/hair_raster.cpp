@@ -105,9 +105,49 @@ class SegmentChunks {
   const std::vector<uint32_t> segments_;
 };
 
-// Segments sorted into bands by counting, chunk by chunk on every thread: `chunks` lists them
-// (count(), eachSegment(c, segment), in order), so each band's are in their order. `out`: its width,
-// height and vertices set; its bands are made, reusing its bandSegments' storage.
+// Every segment `chunks` lists (count(), eachSegment(c, segment), in order) sorted by counting into
+// `groups` groups, each group's in that order: groupsOf(first point, lo, hi) gives the groups [lo, hi] a
+// segment goes in (none when lo > hi). Counted chunk by chunk on every thread, then each chunk's written
+// in its place, so the order does not depend on the thread count. `sorted` gets them, its storage
+// reused (with an eighth to spare when it grows, where `spare`); returns where each group begins in it,
+// and the total last.
+template <class Chunks, class GroupsOf>
+std::vector<size_t> sortByCounting(const Chunks& chunks, int groups, const GroupsOf& groupsOf,
+                                   std::vector<uint32_t>& sorted, bool spare) {
+  const size_t count = chunks.count();
+  std::vector<uint32_t> counts(count * size_t(groups), 0);
+  tbb::parallel_for(size_t(0), count, [&](size_t c) {
+    chunks.eachSegment(c, [&](uint32_t first) {
+      int lo, hi;
+      groupsOf(first, lo, hi);
+      for (int g = lo; g <= hi; ++g) ++counts[c * groups + g];
+    });
+  });
+  std::vector<size_t> groupFirst(size_t(groups) + 1, 0);
+  size_t total = 0;
+  for (int g = 0; g < groups; ++g) {
+    groupFirst[size_t(g)] = total;
+    for (size_t c = 0; c < count; ++c) {
+      const uint32_t n = counts[c * groups + g];
+      counts[c * groups + g] = uint32_t(total);
+      total += n;
+    }
+  }
+  groupFirst[size_t(groups)] = total;
+  sorted.clear();  // what it held is not copied when the storage grows
+  resizeLarge(sorted, total, spare ? total / 8 : 0);
+  tbb::parallel_for(size_t(0), count, [&](size_t c) {
+    chunks.eachSegment(c, [&](uint32_t first) {
+      int lo, hi;
+      groupsOf(first, lo, hi);
+      for (int g = lo; g <= hi; ++g) sorted[counts[c * groups + g]++] = first;
+    });
+  });
+  return groupFirst;
+}
+
+// Segments sorted into bands: `chunks` lists them (sortByCounting). `out`: its width, height and
+// vertices set; its bands are made, reusing its bandSegments' storage.
 template <class Chunks>
 void sortIntoBands(const Chunks& chunks, Bands& out) {
   const std::vector<Vertex>& vertices = out.vertices;
@@ -125,38 +165,10 @@ void sortIntoBands(const Chunks& chunks, Bands& out) {
     lo = int(std::max<int64_t>(low, 0)) / kBandRows;
     hi = int(std::min<int64_t>(high, height - 1)) / kBandRows;
   };
-  const size_t count = chunks.count();
-  std::vector<uint32_t> counts(count * size_t(bands), 0);
-  tbb::parallel_for(size_t(0), count, [&](size_t c) {
-    chunks.eachSegment(c, [&](uint32_t first) {
-      int lo, hi;
-      bandsOf(first, lo, hi);
-      for (int b = lo; b <= hi; ++b) ++counts[c * bands + b];
-    });
-  });
-  out.bandFirst.assign(size_t(bands) + 1, 0);
-  size_t total = 0;
-  for (int b = 0; b < bands; ++b) {
-    out.bandFirst[size_t(b)] = total;
-    for (size_t c = 0; c < count; ++c) {
-      const uint32_t n = counts[c * bands + b];
-      counts[c * bands + b] = uint32_t(total);
-      total += n;
-    }
-  }
-  out.bandFirst[size_t(bands)] = total;
-  out.bandSegments.clear();  // what it held is not copied when the storage grows
-  // New storage with an eighth to spare, so the next view's bands fit when it is handed on: the 1080p
-  // coupe's camera has 3% more than its light, and fresh storage for them cost a third of its
-  // projection (the kernel clears every page).
-  resizeLarge(out.bandSegments, total, total / 8);
-  tbb::parallel_for(size_t(0), count, [&](size_t c) {
-    chunks.eachSegment(c, [&](uint32_t first) {
-      int lo, hi;
-      bandsOf(first, lo, hi);
-      for (int b = lo; b <= hi; ++b) out.bandSegments[counts[c * bands + b]++] = first;
-    });
-  });
+  // With an eighth to spare, so the next view's bands fit when it is handed on: the 1080p coupe's
+  // camera has 3% more than its light, and fresh storage for them cost a third of its projection (the
+  // kernel clears every page).
+  out.bandFirst = sortByCounting(chunks, bands, bandsOf, out.bandSegments, true);
 }
 
 }  // namespace
@@ -168,20 +180,9 @@ Projection project(const Strands& hair, const View& v, double strandWidth, Bands
   out.width = v.width;
   out.height = v.height;
   projectPoints(hair, v, strandWidth, out.vertices);
-  // The segments, counted chunk by chunk first, then each chunk's written in its place.
-  const PointChunks pointChunks(hair, out.vertices);
-  const size_t chunks = pointChunks.count();
-  std::vector<size_t> chunkFirst(chunks + 1, 0);
-  tbb::parallel_for(size_t(0), chunks,
-                    [&](size_t c) { pointChunks.eachSegment(c, [&](uint32_t) { ++chunkFirst[c + 1]; }); });
-  for (size_t c = 0; c < chunks; ++c) chunkFirst[c + 1] += chunkFirst[c];
-  std::vector<uint32_t>& segments = out.segments;
-  segments.clear();  // what `reuse` held is not copied when the storage grows
-  resizeLarge(segments, chunkFirst[chunks]);
-  tbb::parallel_for(size_t(0), chunks, [&](size_t c) {
-    size_t at = chunkFirst[c];
-    pointChunks.eachSegment(c, [&](uint32_t i) { segments[at++] = i; });
-  });
+  sortByCounting(
+      PointChunks(hair, out.vertices), 1, [](uint32_t, int& lo, int& hi) { lo = hi = 0; }, out.segments,
+      false);
   return out;
 }
 
