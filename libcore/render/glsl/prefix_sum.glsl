@@ -62,7 +62,7 @@ void main() {
   barrier();
   for (uint k = 0u; k < kScanPerInvocation; ++k)
     if (first + k < uSums) outData[first + k] = partial[lane] + before[k];
-  atomicMax(groupDeepest, deepest);
+  if (uDeepest != 0) atomicMax(groupDeepest, deepest);  // uniform: every invocation or none
   barrier();
   if (lane == 0u && uDeepest != 0) atomicMax(deepestData[0], groupDeepest);
 }
