@@ -14,6 +14,7 @@
 #include "libcore/io/hair_io.h"
 #include "libcore/model/shards.h"
 #include "libcore/util/error.h"
+#include "libcore/util/resources.h"
 #include "stages/interpolate.h"
 #include "tests/test_util.h"
 
@@ -124,6 +125,20 @@ TEST(Shards, ProvenanceAloneIsReadWithoutTheArrays) {
   writeHair(dir.path() / "p.hair", part);
   EXPECT_EQ(readHairProvenance(dir.path() / "p.hair"), part.provenance);
   EXPECT_EQ(readHairProvenance(dir.path() / "p.hair"), readHair(dir.path() / "p.hair").provenance);
+}
+
+// A farm asks whether a task's coupe is done by its provenance alone (farm/done.cpp), so a file larger
+// than the memory free for reading it whole is no reason to redo the task. (Here the file grows with a
+// hole past its chunks: nothing is written, and the reader stops at the PROV chunk.)
+TEST(Shards, ProvenanceIsReadFromAFileLargerThanTheMemoryBudget) {
+  test::TempDir dir("shards");
+  const Coupe c;
+  Strands part = c.shards(2)[1].strands;
+  const std::filesystem::path file = dir.path() / "p.hair";
+  writeHair(file, part);
+  std::filesystem::resize_file(file, memoryBudget() + (uint64_t(1) << 20));
+  EXPECT_THROW(readHair(file), InputError) << "read whole, it is refused";
+  EXPECT_EQ(readHairProvenance(file), part.provenance);
 }
 
 TEST(FarmPlan, EveryTaskComesAfterWhatItReads) {

@@ -7,7 +7,6 @@
 #include <cmath>
 #include <cstdio>
 #include <cstring>
-#include <fstream>
 #include <functional>
 #include <limits>
 
@@ -156,8 +155,9 @@ class MemorySource final : public Source {
 
 class FileSource final : public Source {
  public:
-  FileSource(const std::filesystem::path& path, ArrayStorage storage)
-      : file_(path), mapped_(storage == ArrayStorage::kMapped) {}
+  // `whole`: InputFile's; false for a reader of the header and a chunk.
+  FileSource(const std::filesystem::path& path, ArrayStorage storage, bool whole = true)
+      : file_(path, whole), mapped_(storage == ArrayStorage::kMapped) {}
   uint64_t remaining() const override { return file_.remaining(); }
   void read(void* out, size_t bytes) override { file_.read(out, bytes); }
   std::shared_ptr<MappedRegion> region(size_t bytes, size_t elementBytes) override {
@@ -585,34 +585,11 @@ void writeHair(const std::filesystem::path& file, const Strands& strands) {
 }
 
 Provenance readHairProvenance(const std::filesystem::path& file) {
-  // The file read from its start with seeks over the arrays and the other chunks; every read and every
-  // seek is first checked against what remains of the file (Reader::need), as decodeHair's are, so no
-  // length a header declares moves past its end.
-  class SeekingSource final : public Source {
-   public:
-    explicit SeekingSource(const std::filesystem::path& path) : in_(path, std::ios::binary) {
-      requireRegularFile(path);
-      if (!in_) throw IoError("cannot open " + path.string());
-      std::error_code ec;
-      size_ = std::filesystem::file_size(path, ec);
-      if (ec) throw IoError("cannot read the size of " + path.string() + ": " + ec.message());
-    }
-    uint64_t remaining() const override { return size_ - position_; }
-    void read(void* out, size_t bytes) override {
-      if (!in_.read(static_cast<char*>(out), std::streamsize(bytes))) throw IoError("cannot read the file");
-      position_ += bytes;
-    }
-    void skip(size_t bytes) override {  // after need(bytes)
-      position_ += bytes;
-      in_.seekg(std::streamoff(position_));
-    }
-
-   private:
-    std::ifstream in_;
-    uint64_t size_ = 0, position_ = 0;
-  };
+  // The file read from its start with seeks over the arrays and the other chunks, whatever its size;
+  // every read and every seek is first checked against what remains of the file (Reader::need), as
+  // decodeHair's are, so no length a header declares moves past its end.
   const std::string name = file.string();
-  SeekingSource source(file);
+  FileSource source(file, ArrayStorage::kCopied, false);
   Reader r(source, name);
   r.need(kHeaderSize, "the 128-byte header");
   char magic[4];
