@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <limits>
 #include <thread>
 
 #include <tbb/blocked_range.h>
@@ -295,34 +296,60 @@ double hairCoverage(const View& view, const Strands& hair, double strandWidth, d
     double fragments = 0.0;
     std::vector<double> given;  // the fragments given in each tile of kFootprintTile² pixels
   };
+  // A point in the view: where it lies (x, y, and its depth along the view's −z), and where it is drawn
+  // when it is in front of the near plane (each point's once, for both its segments).
+  struct Seen {
+    glm::dvec3 at;
+    double depth;
+    glm::dvec2 pixel{std::numeric_limits<double>::quiet_NaN()};   // on the image
+    double trueWidth = std::numeric_limits<double>::quiet_NaN();  // the strand's width there, pixels
+  };
+  const glm::dmat4& m = view.view;
+  auto seen = [&](uint32_t i) {
+    const glm::dvec3 p(hair.points[i]);
+    Seen q;
+    q.at = glm::dvec3(m[0]) * p.x + glm::dvec3(m[1]) * p.y + glm::dvec3(m[2]) * p.z + glm::dvec3(m[3]);
+    q.depth = -q.at.z;
+    if (q.depth >= nearDepth) {
+      const double perDepth = view.focalPx / q.depth;
+      q.pixel = 0.5 * size + perDepth * glm::dvec2(q.at.x, q.at.y);
+      q.trueWidth = strandWidth * perDepth;
+    }
+    return q;
+  };
+  // The segment a → b's part in front of the near plane, drawn: a point behind it moved onto it.
+  auto onNearPlane = [&](const Seen& behind, const Seen& front) {
+    Seen q;
+    q.at = behind.at + (front.at - behind.at) * ((nearDepth - behind.depth) / (front.depth - behind.depth));
+    q.depth = nearDepth;
+    const double perDepth = view.focalPx / q.depth;
+    q.pixel = 0.5 * size + perDepth * glm::dvec2(q.at.x, q.at.y);
+    q.trueWidth = strandWidth * perDepth;
+    return q;
+  };
   // Strand s's segments added to `sums`.
   auto addStrand = [&](size_t s, Sums& sums) {
     if (hair.firstPoint[s] == hair.firstPoint[s + 1]) return;
-    auto inView = [&](uint32_t i) {
-      return glm::dvec3(view.view * glm::dvec4(glm::dvec3(hair.points[i]), 1.0));
-    };
-    glm::dvec3 next = inView(hair.firstPoint[s]);
+    Seen next = seen(hair.firstPoint[s]);
     for (uint32_t i = hair.firstPoint[s]; i + 1 < hair.firstPoint[s + 1]; ++i) {
-      glm::dvec3 a = next, b = inView(i + 1);
+      Seen a = next, b = seen(i + 1);
       next = b;
-      // Depth along the view's −z; the part of the segment in front of the eye.
-      double da = -a.z, db = -b.z;
-      if (da < nearDepth && db < nearDepth) continue;
-      if (da < nearDepth) {
-        a += (b - a) * ((nearDepth - da) / (db - da));
-        da = nearDepth;
-      } else if (db < nearDepth) {
-        b += (a - b) * ((nearDepth - db) / (da - db));
-        db = nearDepth;
-      }
-      const double trueA = strandWidth * view.focalPx / da, trueB = strandWidth * view.focalPx / db;
+      // The part of the segment in front of the eye.
+      if (a.depth < nearDepth && b.depth < nearDepth) continue;
+      if (a.depth < nearDepth)
+        a = onNearPlane(a, b);
+      else if (b.depth < nearDepth)
+        b = onNearPlane(b, a);
+      const double trueA = a.trueWidth, trueB = b.trueWidth;
       const double wa = std::max(trueA, minWidthPx), wb = std::max(trueB, minWidthPx);
-      const glm::dvec2 pa = 0.5 * size + view.focalPx * glm::dvec2(a.x, a.y) / da,
-                       pb = 0.5 * size + view.focalPx * glm::dvec2(b.x, b.y) / db;
+      const glm::dvec2 pa = a.pixel, pb = b.pixel;
       // The ribbon reaches half its width beyond its centre line.
       const double reach = 0.5 * std::max(wa, wb);
+      const glm::dvec2 lo(-reach), hi = size + reach;
       double t0 = 0.0, t1 = 1.0;
-      if (!clipToBox(pa, pb, glm::dvec2(-reach), size + reach, t0, t1)) continue;
+      const bool inside = glm::all(glm::greaterThanEqual(glm::min(pa, pb), lo)) &&
+                          glm::all(glm::lessThanEqual(glm::max(pa, pb), hi));
+      if (!inside && !clipToBox(pa, pb, lo, hi, t0, t1)) continue;
       const double length = glm::length(pb - pa) * (t1 - t0);
       const double width = wa + (wb - wa) * 0.5 * (t0 + t1);
       // A quad at least its width long (the joins), and never more than the image.
