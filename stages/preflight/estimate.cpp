@@ -247,12 +247,23 @@ WorkEstimate renderCost(const RenderSettings& r, size_t strands, size_t points, 
   return e;
 }
 
+// Metres to a tenth, for a strand's length in a message.
+std::string tenths(double metres) {
+  return formatReal(std::round(metres * 10.0) / 10.0);
+}
+
+// What a user with hair in other units is told to do, wherever the file is read: `render` reads a hair
+// file in any unit it is told, `run` reads its Setup's LoadFile in metres.
+constexpr const char* kGiveTheUnit =
+    "give its unit (render --units cm, mm or in; for run's LoadFile, convert it first with "
+    "convert --units)";
+
 // Strands metres long are a file in other units (a groom in centimetres read as metres): say so, since
 // no render setting is what is wrong.
 void blameUnits(WorkEstimate& e, double hairLength) {
   if (hairLength > kLongestHairMetres)
-    e.timeKey = "the hair's units: its strands are " + formatReal(std::round(hairLength * 10.0) / 10.0) +
-                " m long, so the file is in other units (render it with --units cm or mm, or --frame)";
+    e.timeKey = "the hair's units: its strands are " + tenths(hairLength) +
+                " m long, so the file is in other units: " + kGiveTheUnit;
 }
 
 // Liang-Barsky: clips the segment a + t (b − a), t in [t0, t1], to lo <= x, y <= hi; false when nothing
@@ -415,15 +426,16 @@ WorkEstimate estimateRender(const RenderSettings& r, const Strands& hair, const 
   blameUnits(e, longest);
   if (longest > kLongestHairMetres) {
     // How wide a strand is drawn at the hair's centre, in pixels (the sub-pixel view's focal length over
-    // its k).
-    const double widthPx = r.strandWidth * fine.focalPx / double(block) /
-                           std::max(glm::length(sphere.centre - r.cameraPosition), 1e-9);
-    char width[32];
-    std::snprintf(width, sizeof width, "%.2g", widthPx);
-    e.note = "the longest strand is " + formatReal(std::round(longest * 10.0) / 10.0) +
-             " m, and the strands are drawn " + width + " pixels wide (Render.StrandWidth " +
-             formatReal(r.strandWidth) +
-             " m): if the hair file is not in metres, give its unit (--units cm, mm or in)";
+    // its k): said only where the camera is outside the hair, as the nearest strands are far wider.
+    const double distance = glm::length(sphere.centre - r.cameraPosition);
+    const std::string drawn =
+        distance > sphere.radius
+            ? ", and the strands are drawn " +
+                  formatSignificant(r.strandWidth * fine.focalPx / double(block) / distance, 2) +
+                  " pixels wide at the hair's centre (Render.StrandWidth " + formatReal(r.strandWidth) + " m)"
+            : "";
+    e.note = "the longest strand is " + tenths(longest) + " m" + drawn +
+             ": if the hair file is not in metres, " + kGiveTheUnit;
   }
   return e;
 }
