@@ -6,9 +6,11 @@
 // custom ones (a Setup's take their place with the same prelude), and the compute passes at every kept
 // count the renderer builds them for.
 //
-// write_stages DIR: DIR/NNN.{vert,frag,comp}, a file a distinct stage, and DIR/programs.txt, a line a
+// write_stages DIR: DIR/NNNN.{vert,frag,comp}, a file a distinct stage, and DIR/programs.txt, a line a
 // distinct program: its stages' files, then its name. Exits 1, naming them, when a file of
-// libcore/render/glsl/ is in none of the stages (a program this does not build); 3 with no OpenGL.
+// libcore/render/glsl/ is in none of the stages (a program this does not build); 3, saying why, where
+// this machine's OpenGL cannot build them all (no context, or no GL_ARB_gpu_shader_int64 for the
+// compute passes: the renderer draws with the CPU's rasteriser there).
 #include <cstdio>
 #include <exception>
 #include <filesystem>
@@ -67,7 +69,9 @@ int run(const fs::path& dir) {
   watchStages([&](GLenum type, const StageSource& s, const char* program) {
     auto [at, added] = stages.try_emplace({type, s.text});
     if (added) {
-      at->second = std::to_string(stages.size() + 1000).substr(1) + "." + extension(type);
+      char name[32];
+      std::snprintf(name, sizeof name, "%04zu.%s", stages.size(), extension(type));
+      at->second = name;
       std::ofstream(dir / at->second, std::ios::binary) << s.text;
     }
     // A vertex stage, or a compute one, begins a program; a fragment stage ends the one its vertex began.
@@ -80,7 +84,7 @@ int run(const fs::path& dir) {
   if (!computeRasterAvailable()) {
     std::fprintf(stderr,
                  "write_stages: this OpenGL has no GL_ARB_gpu_shader_int64: no compute passes to write\n");
-    return 1;
+    return 3;
   }
   const CustomShaders none, custom = ownAsCustom();
   for (const CustomShaders* shaders : {&none, &custom})

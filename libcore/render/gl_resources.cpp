@@ -135,11 +135,11 @@ GLuint linkedOnce(const std::string& key, Link&& link, bool& owned) {
 
 }  // namespace
 
-// (In the body: owned_ is initialised after id.)
 void watchStages(std::function<void(GLenum, const StageSource&, const char*)> watch) {
   gWatchStages = std::move(watch);
 }
 
+// (In the body: owned_ is initialised after id.)
 Program::Program(const StageSource& vertex, const StageSource& fragment, const char* name) {
   id = linkedOnce(
       vertex.text + '\0' + fragment.text, [&] { return link(vertex, fragment, name); }, owned_);

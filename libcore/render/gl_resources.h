@@ -38,7 +38,8 @@ struct StageSource {
 
 // Hands each stage to `watch` as it is handed to OpenGL (once per context and GLSL text, as Program
 // compiles it): its type (GL_VERTEX_SHADER, ...), its text and its program's name, a program's stages one
-// after the other (vertex, then fragment). An empty function, the default, watches none. For
+// after the other (vertex, then fragment). An empty function, the default, watches none. Set it before
+// any program is made, on the thread that makes them (it is read unguarded). For
 // tests/write_stages.cpp, which has every stage and program checked by the Khronos reference compiler:
 // GLSL one driver accepts may be GLSL another refuses.
 void watchStages(std::function<void(GLenum type, const StageSource& stage, const char* program)> watch);
