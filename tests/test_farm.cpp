@@ -137,7 +137,12 @@ TEST(Shards, ProvenanceIsReadFromAFileLargerThanTheMemoryBudget) {
   const std::filesystem::path file = dir.path() / "p.hair";
   writeHair(file, part);
   std::filesystem::resize_file(file, memoryBudget() + (uint64_t(1) << 20));
-  EXPECT_THROW(readHair(file), InputError) << "read whole, it is refused";
+  try {
+    (void)readHair(file);
+    ADD_FAILURE() << "read whole, it is not refused";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("of memory this machine has free"), std::string::npos) << e.what();
+  }
   EXPECT_EQ(readHairProvenance(file), part.provenance);
 }
 

@@ -155,9 +155,9 @@ class MemorySource final : public Source {
 
 class FileSource final : public Source {
  public:
-  // `whole`: InputFile's; false for a reader of the header and a chunk.
-  FileSource(const std::filesystem::path& path, ArrayStorage storage, bool whole = true)
-      : file_(path, whole), mapped_(storage == ArrayStorage::kMapped) {}
+  FileSource(const std::filesystem::path& path, ArrayStorage storage,
+             InputFile::Reading reading = InputFile::Reading::kWhole)
+      : file_(path, reading), mapped_(storage == ArrayStorage::kMapped) {}
   uint64_t remaining() const override { return file_.remaining(); }
   void read(void* out, size_t bytes) override { file_.read(out, bytes); }
   std::shared_ptr<MappedRegion> region(size_t bytes, size_t elementBytes) override {
@@ -589,7 +589,7 @@ Provenance readHairProvenance(const std::filesystem::path& file) {
   // every read and every seek is first checked against what remains of the file (Reader::need), as
   // decodeHair's are, so no length a header declares moves past its end.
   const std::string name = file.string();
-  FileSource source(file, ArrayStorage::kCopied, false);
+  FileSource source(file, ArrayStorage::kCopied, InputFile::Reading::kParts);
   Reader r(source, name);
   r.need(kHeaderSize, "the 128-byte header");
   char magic[4];

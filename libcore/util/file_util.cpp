@@ -337,7 +337,7 @@ void requireRegularFile(const fs::path& path) {
     throw InputError(where, "is not a regular file (a FIFO, device or socket); name a file, not a stream");
 }
 
-InputFile::InputFile(const fs::path& path, bool whole) : name_(path.string()) {
+InputFile::InputFile(const fs::path& path, Reading reading) : name_(path.string()) {
   const FileLoc where{name_, 0};
   // O_NONBLOCK: opening a FIFO must not wait for a writer; fstat then refuses it.
   fd_ = ::open(path.c_str(), O_RDONLY | O_NONBLOCK | O_CLOEXEC);
@@ -350,7 +350,7 @@ InputFile::InputFile(const fs::path& path, bool whole) : name_(path.string()) {
     refusal = "is a directory, expected a file";
   else if (!S_ISREG(st.st_mode))
     refusal = "is not a regular file (a FIFO, device or socket); name a file, not a stream";
-  else if (whole && uint64_t(st.st_size) > memoryBudget())
+  else if (reading == Reading::kWhole && uint64_t(st.st_size) > memoryBudget())
     refusal = "is " + formatBytes(uint64_t(st.st_size)) + ", more than the " + formatBytes(memoryBudget()) +
               " of memory this machine has free for it";
   if (!refusal.empty()) {

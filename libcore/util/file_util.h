@@ -46,9 +46,10 @@ std::vector<uint8_t> readFileBytes(const std::filesystem::path& path);
 // IoError.
 class InputFile {
  public:
-  // `whole`: the file is to be read whole, so one larger than the memory budget is refused; false for a
-  // reader that takes a few parts of it (a header), which a file of any size allows.
-  explicit InputFile(const std::filesystem::path& path, bool whole = true);
+  // kWhole: the file is to be read whole, so one larger than the memory budget is refused; kParts: a
+  // reader takes a few parts of it (a header), which a file of any size allows.
+  enum class Reading { kWhole, kParts };
+  explicit InputFile(const std::filesystem::path& path, Reading reading = Reading::kWhole);
   ~InputFile();
   InputFile(const InputFile&) = delete;
   InputFile& operator=(const InputFile&) = delete;
