@@ -10,6 +10,7 @@
 #include "libcore/util/error.h"
 #include "libcore/util/file_util.h"
 #include "libcore/util/frames.h"
+#include "libcore/util/signal_slots.h"
 #include "tests/test_util.h"
 
 namespace hairgen {
@@ -124,6 +125,29 @@ TEST(Outputs, AFailedWriteRemovesOnlyItsOwnTemporary) {
                IoError);
   EXPECT_EQ(readText(dir / "g.hair"), "before");
   for (const fs::path& left : fs::directory_iterator(dir.path())) EXPECT_EQ(left.filename(), "g.hair");
+}
+
+// The table a signal handler reads (signal_slots.h): a slot being filled is passed by until it is live,
+// a released one is free again, and a full table says so rather than growing.
+TEST(SignalSlots, OnlyLiveSlotsAreReadAndAFullTableSaysSo) {
+  SignalSlots<int, 3> table;
+  const int a = table.claim(), b = table.claim(), c = table.claim();
+  ASSERT_TRUE(a >= 0 && b >= 0 && c >= 0);
+  EXPECT_EQ(table.claim(), -1) << "full";
+  table[a] = 1, table[b] = 2, table[c] = 3;
+  table.markLive(a);
+  table.markLive(c);
+  int sum = 0;
+  table.forEachLive([&](int v) { sum += v; });
+  EXPECT_EQ(sum, 4) << "the slot being filled is passed by";
+  EXPECT_EQ(table.findLive([](int v) { return v == 2; }), nullptr);
+  table.markLive(b);
+  ASSERT_NE(table.findLive([](int v) { return v == 2; }), nullptr);
+  table.release(b);
+  EXPECT_EQ(table.findLive([](int v) { return v == 2; }), nullptr) << "released";
+  EXPECT_EQ(table.claim(), b) << "a released slot is free again";
+  table.release(-1);  // a table that was full gave −1: releasing it does nothing
+  table.markLive(-1);
 }
 
 }  // namespace
