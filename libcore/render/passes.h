@@ -66,7 +66,8 @@ struct Scene {
   bool rasterised;        // the camera's hair comes from hairgen's rasteriser (not a custom HairVert)
   int kept;               // the fragments kept per sub-pixel (RenderInput::keptFragments)
   // Why hairgen's rasteriser runs on the CPU where `auto` would have put it on the device: the device's
-  // compiler rejects one of its passes (computePassesFailure); empty otherwise.
+  // compiler rejects one of its passes (computePassesFailure); empty otherwise. Declared before
+  // onDevice, whose initialiser writes it.
   std::string deviceRefused;
   bool onDevice;  // hairgen's rasteriser runs on the device (RenderInput::rasteriser)
   glm::dmat4 viewProj{1.0}, previousViewProj{1.0};  // world to clip: this frame's camera, the previous one's
