@@ -296,14 +296,25 @@ TEST(HairFile, AMappedReadCopiesArraysTheFileDoesNotAlign) {
   EXPECT_EQ(mappingAt(mapped.tangents.data()).file, "");
 }
 
+// A coupe of 20,000 strands written in `dir` and read back where its file's pages lie, with the
+// mapping guard a command installs: its file, and its strands.
+struct MappedCoupe {
+  std::filesystem::path file;
+  Strands strands;
+};
+MappedCoupe mapCoupe(const test::TempDir& dir) {
+  installMappingGuard();
+  MappedCoupe c{dir / "coupe.hair", {}};
+  writeHair(c.file, largeStrands(20000, 50, false));
+  c.strands = readHair(c.file, nullptr, ArrayStorage::kMapped);
+  return c;
+}
+
 // A mapped coupe another process shrinks under the render: its pages past the new end read as zeros (no
 // SIGBUS ends the process), and the command's check fails it with the file's error, exit 2, once.
 TEST(HairFile, AMappedFileThatShrinksIsTheFilesErrorNotACrash) {
-  installMappingGuard();
   test::TempDir dir("shrinks");
-  const std::filesystem::path file = dir / "coupe.hair";
-  writeHair(file, largeStrands(20000, 50, false));
-  const Strands mapped = readHair(file, nullptr, ArrayStorage::kMapped);
+  const auto [file, mapped] = mapCoupe(dir);
   EXPECT_NO_THROW(requireMappingsWhole());
   std::filesystem::resize_file(file, 4096);
   EXPECT_EQ(mapped.tangents.back(), glm::vec3(0.0f)) << "past the end: a fault, then zeros";
@@ -322,11 +333,8 @@ TEST(HairFile, AMappedFileThatShrinksIsTheFilesErrorNotACrash) {
 // A sequence keeps each frame it finishes (keepCommittedOutputs), but not one made after a mapped input's
 // page could not be read: that frame was made from zeros, and the failed command removes it.
 TEST(HairFile, AFrameMadeFromAMappedFileThatShrankIsNotKept) {
-  installMappingGuard();
   test::TempDir dir("shrinks-kept");
-  const std::filesystem::path file = dir / "coupe.hair";
-  writeHair(file, largeStrands(20000, 50, false));
-  const Strands mapped = readHair(file, nullptr, ArrayStorage::kMapped);
+  const auto [file, mapped] = mapCoupe(dir);
   forgetCommittedOutputs();
   writeFileAtomic(dir / "beauty.0001.exr", std::string("made from the file"));
   keepCommittedOutputs();
@@ -342,12 +350,9 @@ TEST(HairFile, AFrameMadeFromAMappedFileThatShrankIsNotKept) {
 // A page that cannot be read where the file is no shorter by the check (here truncated and written back
 // to its length, as cp over it does; or an I/O error) is an IoError, exit 1, which a retry may mend.
 TEST(HairFile, AMappedPageThatCannotBeReadOtherwiseIsAnIoError) {
-  installMappingGuard();
   test::TempDir dir("unreadable");
-  const std::filesystem::path file = dir / "coupe.hair";
-  writeHair(file, largeStrands(20000, 50, false));
+  const auto [file, mapped] = mapCoupe(dir);
   const uintmax_t size = std::filesystem::file_size(file);
-  const Strands mapped = readHair(file, nullptr, ArrayStorage::kMapped);
   std::filesystem::resize_file(file, 4096);
   EXPECT_EQ(mapped.tangents.back(), glm::vec3(0.0f));
   std::filesystem::resize_file(file, size);
