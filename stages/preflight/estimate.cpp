@@ -315,17 +315,19 @@ double hairCoverage(const View& view, const Strands& hair, double strandWidth, d
     glm::dvec2 pixel{std::numeric_limits<double>::quiet_NaN()};   // on the image
     double trueWidth = std::numeric_limits<double>::quiet_NaN();  // the strand's width there, pixels
   };
+  // Where a point in front of the near plane is drawn, from where it lies and its depth.
+  auto draw = [&](Seen& q) {
+    const double perDepth = view.focalPx / q.depth;
+    q.pixel = 0.5 * size + perDepth * glm::dvec2(q.at.x, q.at.y);
+    q.trueWidth = strandWidth * perDepth;
+  };
   const glm::dmat4& m = view.view;
   auto seen = [&](uint32_t i) {
     const glm::dvec3 p(hair.points[i]);
     Seen q;
     q.at = glm::dvec3(m[0]) * p.x + glm::dvec3(m[1]) * p.y + glm::dvec3(m[2]) * p.z + glm::dvec3(m[3]);
     q.depth = -q.at.z;
-    if (q.depth >= nearDepth) {
-      const double perDepth = view.focalPx / q.depth;
-      q.pixel = 0.5 * size + perDepth * glm::dvec2(q.at.x, q.at.y);
-      q.trueWidth = strandWidth * perDepth;
-    }
+    if (q.depth >= nearDepth) draw(q);
     return q;
   };
   // The segment a → b's part in front of the near plane, drawn: a point behind it moved onto it.
@@ -333,9 +335,7 @@ double hairCoverage(const View& view, const Strands& hair, double strandWidth, d
     Seen q;
     q.at = behind.at + (front.at - behind.at) * ((nearDepth - behind.depth) / (front.depth - behind.depth));
     q.depth = nearDepth;
-    const double perDepth = view.focalPx / q.depth;
-    q.pixel = 0.5 * size + perDepth * glm::dvec2(q.at.x, q.at.y);
-    q.trueWidth = strandWidth * perDepth;
+    draw(q);
     return q;
   };
   // Strand s's segments added to `sums`.
