@@ -166,6 +166,7 @@ void registerConvert(CLI::App& app, int& exitCode) {
       } else if (sequence) {
         what = convertFrames(o, frames, stats, report);
       } else {
+        requireWritableOutput(o.output);  // before the read: a bad output is bad usage (exit 2)
         const Strands strands = readForConvert(o.input, o.units);
         stats.time("read", clock.lap());
         report = writeStrands(o.output, strands, WriteOptions{o.ascii});

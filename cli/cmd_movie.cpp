@@ -1,5 +1,10 @@
 // hairgen movie PATTERN --frames A-B -o beauty.mp4 [--gif beauty.gif] [--fps R]: a shot's preview movie
 // from its PNG frames, as `hairgen run` makes it; the last task of a farm plan for a shot.
+#include <filesystem>
+#include <string>
+#include <system_error>
+#include <vector>
+
 #include "cli/commands.h"
 #include "cli/common.h"
 #include "libcore/io/movie.h"
@@ -38,7 +43,21 @@ void registerMovie(CLI::App& app, int& exitCode) {
       if (!isFramePattern(options->pattern))
         throw InputError(options->pattern + ": write #### where the frame number goes");
       const FrameRange frames = parseFrameRange(options->frames, "--frames");
-      for (int f = frames.first; f <= frames.last; ++f) requireRegularFile(framePath(options->pattern, f));
+      // The movie (and GIF) checked before ffmpeg runs, and never one of the frames it encodes.
+      std::vector<std::string> outputs = {options->output};
+      if (!options->gif.empty()) outputs.push_back(options->gif);
+      for (const std::string& o : outputs) requireWritableOutput(o);
+      for (int f = frames.first; f <= frames.last; ++f) {
+        const std::string frame = framePath(options->pattern, f);
+        requireRegularFile(frame);
+        std::error_code ec;
+        for (const std::string& o : outputs)
+          if (std::filesystem::equivalent(o, frame, ec))
+            throw InputError({o, 0}, "is frame " + std::to_string(f) + " of the movie; name another file");
+      }
+      if (outputs.size() == 2 && std::filesystem::path(outputs[0]).lexically_normal() ==
+                                     std::filesystem::path(outputs[1]).lexically_normal())
+        throw InputError({options->gif, 0}, "is also the movie (-o); name another file for the GIF");
       Stopwatch clock;
       MovieOptions movie;
       movie.frameRate = options->fps;

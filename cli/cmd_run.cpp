@@ -6,6 +6,7 @@
 #include <tbb/task_arena.h>
 #include <iostream>
 #include <optional>
+#include <vector>
 
 #include "cli/commands.h"
 #include "cli/common.h"
@@ -160,14 +161,19 @@ void runShot(const CommonOptions& common, const Config& config, const Mesh& wick
 
 // DIR made, and writable: a name that is already something else (or a link to nothing) is bad usage;
 // a folder that cannot be made (read-only file system, permissions) is the work failing to write.
-void makeOutputFolder(const fs::path& out) {
+void makeOutputFolder(const fs::path& out, bool shot) {
   try {
     createOutputFolder(out);
   } catch (const Error& e) {
     throw Error(e.code(), {}, "-o " + out.string() + ": cannot create the output folder: " + e.what());
   }
-  // The first file it writes, before minutes of growing: a folder it cannot write in is found now.
-  requireWritableOutput(out / "guides.hair");
+  // Before minutes of growing: a folder it cannot write in, or a name it writes that is taken by a folder
+  // (or, for the shot's sim/, by a file), is found now.
+  std::vector<fs::path> names = {"guides.hair", "coupe.hair", "shaded.hair", "beauty.exr", "beauty.png"};
+  if (shot)
+    names.insert(names.end(),
+                 {fs::path("sim") / "guides.0001.hair", "shot.usda", "beauty.mp4", "beauty.gif"});
+  for (const fs::path& name : names) requireWritableOutput(out / name);
 }
 
 // What a run renders: the wick and the guides grown on it (none when the Setup Loads a coupe), and the
@@ -299,7 +305,7 @@ void registerRun(CLI::App& app, int& exitCode) {
         throw InputError(setup.string() + ": --motion renders motion vectors of a shot, and " +
                          (options->noRender ? "--no-render renders nothing"
                                             : "this Setup names no Dynamics Info (DynamicsInfo FILE)"));
-      makeOutputFolder(out);
+      makeOutputFolder(out, config.dynamics.given);
       const RunCoupe made = runCoupe(options->common, config, out, !options->noRender, stats, clock);
       if (config.dynamics.given)
         runShot(options->common, config, made.wick, made.guides, made.coupe, out, frames, !options->noRender,

@@ -178,6 +178,55 @@ movie_paths)
   [ -s "$tmp/%03d/take:1.gif" ] || fail "no take:1.gif"
   no_temporaries "$tmp"
   ;;
+failed_command_restores)
+  # A command that fails after writing over a file (its own input, a link) puts back what was there: a
+  # failed command never costs a file that existed. And a FIFO no one reads, or a long name, as outputs.
+  default="$src/configs/default/setup.txt"
+  expect_rc 0 "$hairgen" grow "$default" -o "$tmp/g.hair" "${small[@]}"
+  cp "$tmp/g.hair" "$tmp/g.orig"
+  # convert in place, then its --stats cannot be written.
+  expect_rc 1 "$hairgen" convert "$tmp/g.hair" "$tmp/g.hair" --quiet --stats /dev/full
+  cmp "$tmp/g.hair" "$tmp/g.orig" || fail "a failed convert in place lost its input"
+  # run that Loads and Saves the same coupe, then refuses its render.
+  expect_rc 0 "$hairgen" interpolate "$default" --guides "$tmp/g.hair" -o "$tmp/mine.hair" "${small[@]}"
+  cp "$tmp/mine.hair" "$tmp/mine.orig"
+  expect_rc 2 "$hairgen" run "$default" -o "$tmp/run" --quiet --set Setup.Load=true \
+    --set "Setup.LoadFile=$tmp/mine.hair" --set Setup.Save=true --set "Setup.SaveFile=$tmp/mine.hair" \
+    --set "Render.Resolution=16384 16384"
+  cmp "$tmp/mine.hair" "$tmp/mine.orig" || fail "a failed run lost the coupe it loaded and saved over"
+  # A sequence converted in place whose second frame is bad: the first is put back (convert keeps no
+  # frame of a failed sequence).
+  expect_rc 0 "$hairgen" convert "$tmp/g.hair" "$tmp/f.0001.ply" --quiet
+  cp "$tmp/f.0001.ply" "$tmp/f.orig"
+  head -c 100 "$tmp/f.0001.ply" >"$tmp/f.0002.ply"
+  expect_rc 2 "$hairgen" convert "$tmp/f.####.ply" "$tmp/f.####.ply" --frames 1-2 --ascii --quiet
+  cmp "$tmp/f.0001.ply" "$tmp/f.orig" || fail "a failed convert in place lost frame 1"
+  # An output name that is a link: the link is put back, pointing where it did; its file untouched.
+  plant_links "$tmp/l" c.hair c2.hair
+  expect_rc 1 "$hairgen" convert "$tmp/g.hair" "$tmp/l/c.hair" --quiet --stats /dev/full
+  [ "$(readlink "$tmp/l/c.hair")" = "$tmp/keep/notes.txt" ] || fail "the link named as the output was not put back"
+  user_file_intact
+  # movie onto one of its frames, or a GIF that is a folder: refused before ffmpeg runs.
+  expect_rc 0 "$hairgen" render "$default" --hair "$tmp/mine.hair" -o "$tmp/b.0001.exr" --preview "$tmp/b.0001.png" "${small[@]}"
+  cp "$tmp/b.0001.png" "$tmp/b.0002.png"
+  cp "$tmp/b.0001.png" "$tmp/b.orig"
+  expect_rc 2 "$hairgen" movie "$tmp/b.####.png" --frames 1-2 -o "$tmp/b.0001.png" --quiet
+  expect_err "is frame 1 of the movie"
+  mkdir "$tmp/adir"
+  expect_rc 2 "$hairgen" movie "$tmp/b.####.png" --frames 1-2 -o "$tmp/m.mp4" --gif "$tmp/adir" --quiet
+  expect_err "is a directory"
+  cmp "$tmp/b.0001.png" "$tmp/b.orig" || fail "movie wrote over its frame"
+  [ ! -e "$tmp/m.mp4" ] || fail "a refused movie was written"
+  # A FIFO that no process opens to read: an error after 10 s, not a wait for ever.
+  mkfifo "$tmp/fifo.ply"
+  expect_rc 1 timeout 60 "$hairgen" convert "$tmp/g.hair" "$tmp/fifo.ply" --quiet
+  expect_err "a FIFO (a named pipe) that no process opened to read within 10 s"
+  # A name of 250 bytes (the folder entry's limit is 255): written as any other.
+  long="$tmp/$(printf 'x%.0s' $(seq 1 245)).hair"
+  expect_rc 0 "$hairgen" convert "$tmp/g.hair" "$long" --quiet
+  cmp "$long" "$tmp/g.hair" || fail "the long-named output differs"
+  no_temporaries "$tmp"
+  ;;
 *) fail "unknown case" ;;
 esac
 echo "ok ($case)"

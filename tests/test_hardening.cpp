@@ -8,6 +8,7 @@
 
 #include <fstream>
 #include <random>
+#include <set>
 #include <thread>
 
 #include <nlohmann/json.hpp>
@@ -213,6 +214,71 @@ TEST(Hardening, AFailedCommandsCommittedOutputsCanBeDiscarded) {
   discardCommittedOutputs();
   EXPECT_FALSE(fs::exists(dir.path() / "image.exr"));
   EXPECT_FALSE(fs::exists(dir.path() / "guides.json"));
+}
+
+// What a failed command wrote over is put back, whatever it was: a file (its own input), a link; what
+// it wrote under a new name is removed; a command that keeps its outputs leaves no backup behind.
+TEST(Hardening, AFailedCommandPutsBackWhatItWroteOver) {
+  test::TempDir dir("hardening");
+  const fs::path input = dir.path() / "coupe.hair", link = dir.path() / "link.json",
+                 fresh = dir.path() / "new.exr", notes = dir.path() / "notes.txt";
+  spit(input, "the user's coupe");
+  spit(notes, "notes");
+  ASSERT_EQ(::symlink("notes.txt", link.c_str()), 0);
+  struct stat before {};
+  ASSERT_EQ(::stat(input.c_str(), &before), 0);
+  forgetCommittedOutputs();
+  writeFileAtomic(input, std::string("written over"));
+  writeFileAtomic(link, std::string("{}"));
+  writeThroughTemporary(fresh, [](const fs::path& file) { spit(file, "pixels"); });
+  EXPECT_EQ(slurp(input), "written over");
+  discardCommittedOutputs();
+  EXPECT_EQ(slurp(input), "the user's coupe");
+  struct stat after {};
+  ASSERT_EQ(::stat(input.c_str(), &after), 0);
+  EXPECT_EQ(after.st_ino, before.st_ino);  // the very file, renamed back
+  EXPECT_TRUE(fs::is_symlink(link));
+  EXPECT_EQ(fs::read_symlink(link), "notes.txt");
+  EXPECT_EQ(slurp(notes), "notes");
+  EXPECT_FALSE(fs::exists(fresh));
+  std::set<std::string> left;
+  for (const fs::path& p : fs::directory_iterator(dir.path())) left.insert(p.filename().string());
+  EXPECT_EQ(left, (std::set<std::string>{"coupe.hair", "link.json", "notes.txt"}));
+  // Kept: the new file stays and no backup is left beside it.
+  writeFileAtomic(input, std::string("kept"));
+  keepCommittedOutputs();
+  discardCommittedOutputs();
+  EXPECT_EQ(slurp(input), "kept");
+  left.clear();
+  for (const fs::path& p : fs::directory_iterator(dir.path())) left.insert(p.filename().string());
+  EXPECT_EQ(left, (std::set<std::string>{"coupe.hair", "link.json", "notes.txt"}));
+  forgetCommittedOutputs();
+}
+
+// A library opens its file by name: the file lies in a folder of this process's own (mode 0700), so no
+// one else can swap it for a link between its creation and the library's opening it; the folder is gone
+// after, and a name near the 255-byte limit of a folder entry is written as any other.
+TEST(Hardening, AWriteByNameIsInAPrivateFolder) {
+  test::TempDir dir("hardening");
+  const fs::path target = dir.path() / (std::string(250, 'x') + ".exr");
+  fs::path seen;
+  writeThroughTemporary(target, [&](const fs::path& file) {
+    seen = file;
+    struct stat st {};
+    ASSERT_EQ(::lstat(file.parent_path().c_str(), &st), 0);
+    EXPECT_TRUE(S_ISDIR(st.st_mode));
+    EXPECT_EQ(st.st_mode & 0777, 0700u);
+    EXPECT_EQ(st.st_uid, ::getuid());
+    EXPECT_EQ(file.parent_path().parent_path(), dir.path());
+    EXPECT_EQ(file.filename(), target.filename());  // the extension a library may choose its format by
+    spit(file, "pixels");
+  });
+  EXPECT_EQ(slurp(target), "pixels");
+  EXPECT_FALSE(fs::exists(seen.parent_path()));
+  writeFileAtomic(dir.path() / (std::string(248, 'y') + ".hair"), std::string("strands"));
+  size_t entries = 0;
+  for ([[maybe_unused]] const fs::path& p : fs::directory_iterator(dir.path())) ++entries;
+  EXPECT_EQ(entries, 2u);
 }
 
 // ---------------------------------------------------------------------------------------------- inputs

@@ -9,11 +9,13 @@
 #include <atomic>
 #include <bit>
 #include <cerrno>
+#include <chrono>
 #include <cstdio>
 #include <cstring>
 #include <iostream>
 #include <mutex>
 #include <system_error>
+#include <thread>
 #include <vector>
 
 #include "libcore/util/error.h"
@@ -42,16 +44,21 @@ Container readWhole(const fs::path& path) {
 // this process made (signal_slots.h).
 struct TemporaryPath {
   char path[4096];
+  bool inFolder;  // the file lies in a private folder of this process's, removed with it
 };
 SignalSlots<TemporaryPath, 256> gTemporaries;
 
 // Reserves a slot for `path` (being filled: the cleanup leaves it alone until markLive); −1 when every
-// slot is taken (the write still happens, only a signal does not clean it).
-int reserveTemporary(const fs::path& path) {
+// slot is taken (the write still happens, only a signal does not clean it). `inFolder`: the path's folder
+// is a private one (createPrivateTemporary), removed after the file.
+int reserveTemporary(const fs::path& path, bool inFolder = false) {
   const std::string text = path.string();
   if (text.size() >= sizeof(TemporaryPath::path)) return -1;
   const int slot = gTemporaries.claim();
-  if (slot >= 0) std::memcpy(gTemporaries[slot].path, text.c_str(), text.size() + 1);
+  if (slot >= 0) {
+    std::memcpy(gTemporaries[slot].path, text.c_str(), text.size() + 1);
+    gTemporaries[slot].inFolder = inFolder;
+  }
   return slot;
 }
 
@@ -65,16 +72,30 @@ void releaseTemporary(int slot) {
 }
 
 extern "C" void removeTemporariesAndExit(int signal) {
-  gTemporaries.forEachLive([](const TemporaryPath& t) { ::unlink(t.path); });
+  gTemporaries.forEachLive([](const TemporaryPath& t) {
+    ::unlink(t.path);
+    if (!t.inFolder) return;
+    char folder[sizeof t.path];
+    std::memcpy(folder, t.path, sizeof folder);
+    char* slash = std::strrchr(folder, '/');
+    if (slash == nullptr) return;
+    *slash = '\0';
+    ::rmdir(folder);  // empty now, unless the library left more there: then a later write sweeps it
+  });
   ::_exit(128 + signal);
 }
 
 // A file this process made and renamed into place: its name, and the device and inode of the file it
-// created there, so that a cleanup removes that file and nothing that has taken its name since.
+// created there, so that a cleanup removes that file and nothing that has taken its name since. What the
+// name held before (a user's file, the command's own input) is kept under `backup`, a hard link beside
+// it, until the command keeps its outputs or fails: then it is put back.
 struct Committed {
   fs::path path;
   dev_t device = 0;
   ino_t inode = 0;
+  fs::path backup;        // empty: the name held nothing, or no link could be made (`replaced`)
+  int backupSlot = -1;    // the backup's entry in the interrupt cleanup table
+  bool replaced = false;  // the name held a file that could not be kept: a failure leaves the new one
 };
 
 // Files committed by this command, in commit order; those from gKept on are removed if it fails.
@@ -218,8 +239,28 @@ fs::path walkFolders(const fs::path& file, const std::string& target, bool creat
   return deepest;
 }
 
+// A temporary's name beside `target` begins NAME.tmp-HOST- (PID-N follows): NAME cut so that the whole
+// name fits a folder entry (255 bytes), so an output with a long name is written as any other.
+std::string temporaryPrefix(const fs::path& target) {
+  static const std::string host = hostName();
+  const std::string name = target.filename().string();
+  const std::string tail = ".tmp-" + host + "-";
+  constexpr size_t kEntry = 255, kPidAndCounter = 2 * 20 + 2;  // "PID-N" and a spare byte
+  const size_t room = kEntry > tail.size() + kPidAndCounter ? kEntry - tail.size() - kPidAndCounter : 0;
+  return name.substr(0, std::min(name.size(), room)) + tail;
+}
+
+// The next name of the form temporaryPrefix() + PID-N beside `target`.
+fs::path nextTemporaryName(const fs::path& target, const std::string& prefix) {
+  static std::atomic<unsigned> counter{0};
+  fs::path path = target;
+  path.replace_filename(prefix + std::to_string(::getpid()) + "-" + std::to_string(counter++));
+  return path;
+}
+
 // Removes temporaries beside `target` that a process of this host left when it died (a kill -9, a
-// lost node): regular files named NAME.tmp-HOST-PID-N whose PID no longer runs.
+// lost node): regular files, and the private folders of writes by name (createPrivateTemporary), named
+// NAME.tmp-HOST-PID-N whose PID no longer runs.
 void sweepStaleTemporaries(const fs::path& target, const std::string& prefix) {
   std::error_code ec;
   const fs::path dir = target.parent_path().empty() ? fs::path(".") : target.parent_path();
@@ -234,8 +275,15 @@ void sweepStaleTemporaries(const fs::path& target, const std::string& prefix) {
     if (parsed != rest.c_str() + dash || pid <= 0) continue;
     if (::kill(pid_t(pid), 0) == 0 || errno != ESRCH) continue;  // alive, or not ours to judge
     std::error_code ignored;
-    if (!fs::is_regular_file(it->symlink_status(ignored))) continue;  // never one of ours
-    fs::remove(it->path(), ignored);
+    const fs::file_status status = it->symlink_status(ignored);
+    if (fs::is_regular_file(status)) {
+      fs::remove(it->path(), ignored);
+    } else if (fs::is_directory(status)) {  // a private folder: its entries (never followed), then it
+      for (fs::directory_iterator inside(it->path(), ignored), last; !ignored && inside != last;
+           inside.increment(ignored))
+        fs::remove(inside->path(), ignored);
+      fs::remove(it->path(), ignored);
+    }
   }
 }
 
@@ -249,9 +297,9 @@ struct Temporary {
 // Creates a fresh temporary beside `target` (the folders on the way made, never through a dangling
 // link): O_CREAT | O_EXCL | O_NOFOLLOW, so it is a new file of this process and never a name someone
 // had put there (a link, a file); registered for cleanup on a signal.
-Temporary createTemporaryBeside(const fs::path& target) {
-  static std::atomic<unsigned> counter{0};
-  static const std::string host = hostName();
+// The folders on the way to `target` made for a write, and the stale temporaries beside it swept; the
+// temporaries' prefix.
+std::string prepareTemporaryBeside(const fs::path& target) {
   try {
     walkFolders(target, target.string(), true);
   } catch (const InputError& e) {
@@ -259,12 +307,16 @@ Temporary createTemporaryBeside(const fs::path& target) {
     // failed, as a folder that cannot be made fails it.
     throw IoError(e.where(), e.message());
   }
-  const std::string prefix = target.filename().string() + ".tmp-" + host + "-";
+  const std::string prefix = temporaryPrefix(target);
   sweepStaleTemporaries(target, prefix);
+  return prefix;
+}
+
+Temporary createTemporaryBeside(const fs::path& target) {
+  const std::string prefix = prepareTemporaryBeside(target);
   for (int attempt = 0;; ++attempt) {
     Temporary t;
-    t.path = target;
-    t.path.replace_filename(prefix + std::to_string(::getpid()) + "-" + std::to_string(counter++));
+    t.path = nextTemporaryName(target, prefix);
     t.slot = reserveTemporary(t.path);
     t.fd = ::open(t.path.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_NOFOLLOW | O_CLOEXEC, 0666);
     if (t.fd >= 0) {
@@ -278,18 +330,116 @@ Temporary createTemporaryBeside(const fs::path& target) {
   }
 }
 
+// For a library that opens the file by name (writeThroughTemporary): a private folder beside `target`
+// (mode 0700, a fresh name made by mkdir, which never follows or reuses a name someone put there) and a
+// new file in it named as the target (the library may choose its format by the name's extension). No
+// other user can swap the file for a link between its creation and the library's opening it by name, as
+// they could beside the target in a folder they may write in (a farm's shared shot folder).
+Temporary createPrivateTemporary(const fs::path& target) {
+  const std::string prefix = prepareTemporaryBeside(target);
+  for (int attempt = 0;; ++attempt) {
+    const fs::path folder = nextTemporaryName(target, prefix);
+    if (::mkdir(folder.c_str(), 0700) != 0) {
+      const int error = errno;
+      if (error != EEXIST || attempt == 100)
+        throw IoError({target.string(), 0}, std::string("cannot write: ") + std::strerror(error));
+      continue;
+    }
+    Temporary t;
+    t.path = folder / target.filename();
+    t.slot = reserveTemporary(t.path, true);
+    t.fd = ::open(t.path.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_NOFOLLOW | O_CLOEXEC, 0666);
+    if (t.fd >= 0) {
+      markLive(t.slot);
+      return t;
+    }
+    const int error = errno;
+    releaseTemporary(t.slot);
+    ::rmdir(folder.c_str());
+    throw IoError({target.string(), 0}, std::string("cannot write: ") + std::strerror(error));
+  }
+}
+
+// Removes a private temporary's file and its folder (what the library left there too, never followed).
+void removePrivateTemporary(const Temporary& t) {
+  ::unlink(t.path.c_str());
+  std::error_code ignored;
+  const fs::path folder = t.path.parent_path();
+  for (fs::directory_iterator it(folder, ignored), end; !ignored && it != end; it.increment(ignored))
+    fs::remove(it->path(), ignored);
+  ::rmdir(folder.c_str());
+}
+
+// A committed file named `target` that is the file `st` describes.
+Committed committedAs(const fs::path& target, const struct stat& st) {
+  Committed c;
+  c.path = target;
+  c.device = st.st_dev;
+  c.inode = st.st_ino;
+  return c;
+}
+
 // The device and inode of a file this process holds open; throws IoError when it cannot tell.
 Committed identityOf(int fd, const fs::path& target) {
   struct stat st {};
   if (::fstat(fd, &st) != 0)
     throw IoError({target.string(), 0}, std::string("cannot write: ") + std::strerror(errno));
-  return {target, st.st_dev, st.st_ino};
+  return committedAs(target, st);
 }
 
 void renameInto(const fs::path& temporary, const fs::path& target) {
   std::error_code ec;
   fs::rename(temporary, target, ec);
   if (ec) throw IoError({target.string(), 0}, "cannot rename into place: " + ec.message());
+}
+
+// What `target` holds before a commit replaces it (a regular file, or a symbolic link itself, never
+// followed), kept as a hard link beside it under a temporary's name, so a command that fails later puts
+// it back: a failed command never costs a file that was there (its own input, written over in place).
+// Sets `backup` and `backupSlot`, or `replaced` where the name holds a file no link could be made to (a
+// file system without hard links).
+void keepWhatIsThere(const fs::path& target, Committed& c) {
+  struct stat st {};
+  if (::lstat(target.c_str(), &st) != 0) return;  // a new name
+  if (!S_ISREG(st.st_mode) && !S_ISLNK(st.st_mode)) return;
+  const std::string prefix = temporaryPrefix(target);
+  for (int attempt = 0; attempt <= 100; ++attempt) {
+    const fs::path backup = nextTemporaryName(target, prefix);
+    const int slot = reserveTemporary(backup);
+    // linkat without AT_SYMLINK_FOLLOW: a link to the link itself, as rename replaces the link itself.
+    if (::linkat(AT_FDCWD, target.c_str(), AT_FDCWD, backup.c_str(), 0) == 0) {
+      markLive(slot);
+      c.backup = backup;
+      c.backupSlot = slot;
+      return;
+    }
+    const int error = errno;
+    releaseTemporary(slot);
+    if (error != EEXIST) break;
+  }
+  c.replaced = true;
+}
+
+// Drops a committed file's backup: the new file stays.
+void dropBackup(Committed& c) {
+  if (!c.backup.empty()) ::unlink(c.backup.c_str());
+  releaseTemporary(c.backupSlot);
+  c.backup.clear();
+  c.backupSlot = -1;
+}
+
+// Renames a finished temporary over `target` (a link there replaced, not followed), keeping what was
+// there until the command keeps or discards its outputs; `identity`: the temporary's device and inode,
+// named as the target.
+void commitInto(const fs::path& temporary, const fs::path& target, Committed identity) {
+  keepWhatIsThere(target, identity);
+  try {
+    renameInto(temporary, target);
+  } catch (...) {
+    dropBackup(identity);
+    throw;
+  }
+  recordCommitted(identity);
 }
 
 // Copies a finished file to an open descriptor, at its offset, after whatever the command had already
@@ -312,10 +462,39 @@ void copyToDescriptor(const fs::path& from, int fd, const fs::path& name) {
   if (in.bad()) throw IoError({name.string(), 0}, "write failed: cannot read back what was written");
 }
 
+// How long a write to a FIFO waits for a process to open it for reading (a reader started beside the
+// command, `hairgen ... -o pipe & consumer < pipe`), before it fails rather than waiting for ever.
+constexpr auto kFifoReaderWait = std::chrono::seconds(10);
+
+// Opens a device or FIFO to write. A FIFO that no process opens to read within kFifoReaderWait is an
+// IoError, not a wait for a reader that may never come; what is open is then written with blocking
+// writes.
+int openDirect(const fs::path& device, const fs::path& name) {
+  const auto giveUp = std::chrono::steady_clock::now() + kFifoReaderWait;
+  int fd = -1;
+  while ((fd = ::open(device.c_str(), O_WRONLY | O_NONBLOCK | O_CLOEXEC)) < 0 && errno == ENXIO &&
+         std::chrono::steady_clock::now() < giveUp)
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));  // ENXIO: a FIFO with no reader yet
+  if (fd < 0) {
+    if (errno == ENXIO)
+      throw IoError({name.string(), 0},
+                    "cannot write: it is a FIFO (a named pipe) that no process opened to read "
+                    "within " +
+                        std::to_string(kFifoReaderWait.count()) + " s");
+    throw IoError({name.string(), 0}, std::string("cannot write: ") + std::strerror(errno));
+  }
+  const int flags = ::fcntl(fd, F_GETFL);
+  if (flags == -1 || ::fcntl(fd, F_SETFL, flags & ~O_NONBLOCK) == -1) {
+    const int error = errno;
+    ::close(fd);
+    throw IoError({name.string(), 0}, std::string("cannot write: ") + std::strerror(error));
+  }
+  return fd;
+}
+
 // Copies a finished file into a device or FIFO.
 void copyInto(const fs::path& from, const fs::path& device) {
-  const int fd = ::open(device.c_str(), O_WRONLY | O_CLOEXEC);
-  if (fd < 0) throw IoError({device.string(), 0}, std::string("cannot write: ") + std::strerror(errno));
+  const int fd = openDirect(device, device);
   try {
     copyToDescriptor(from, fd, device);
   } catch (...) {
@@ -395,6 +574,11 @@ void InputFile::read(void* out, size_t bytes) {
 void requireWritableOutput(const fs::path& target) {
   const Destination destination = destinationOf(target);  // a directory, a closed descriptor: refused
   if (destination.direct) return;
+  constexpr size_t kLongestName = 255;  // a folder entry's bytes on Linux's file systems
+  if (const size_t bytes = destination.path.filename().string().size(); bytes > kLongestName)
+    throw InputError({target.string(), 0}, "its name is " + std::to_string(bytes) +
+                                               " bytes long; a file's name holds at most " +
+                                               std::to_string(kLongestName));
   // The deepest folder that exists on the way to the file's: the one a write creates folders in (or
   // renames in).
   const fs::path folder = walkFolders(destination.path, target.string(), false);
@@ -522,8 +706,7 @@ AtomicFile::AtomicFile(fs::path target) : stream_(nullptr) {
   descriptor_ = destination.descriptor;
   if (destination.direct && descriptor_ < 0) {
     // A device or FIFO, written in place (it exists: nothing is created here).
-    fd_ = ::open(target_.c_str(), O_WRONLY | O_CLOEXEC);
-    if (fd_ < 0) throw IoError({target.string(), 0}, std::string("cannot write: ") + std::strerror(errno));
+    fd_ = openDirect(target_, target);
   } else {
     // A descriptor's file is written whole at the end, from a temporary in the system's folder.
     Temporary t =
@@ -558,8 +741,7 @@ void AtomicFile::commit() {
     copyToDescriptor(temporary_, descriptor_, target_);
     ::unlink(temporary_.c_str());
   } else if (!temporary_.empty()) {
-    renameInto(temporary_, target_);
-    recordCommitted(identity);
+    commitInto(temporary_, target_, identity);
   }
   releaseTemporary(slot_);
   committed_ = true;
@@ -568,17 +750,15 @@ void AtomicFile::commit() {
 void writeThroughTemporary(const fs::path& target, const std::function<void(const fs::path&)>& write) {
   const Destination destination = destinationOf(target);
   // A device's folder (/dev) is no place for a temporary: the system's temporary folder is.
-  const Temporary temporary = createTemporaryBeside(
+  const Temporary temporary = createPrivateTemporary(
       destination.direct ? fs::temp_directory_path() / target.filename() : destination.path);
-  ::close(temporary.fd);  // the library opens it by name
+  ::close(temporary.fd);  // the library opens it by name, in this process's private folder
   try {
     write(temporary.path);
     if (destination.descriptor >= 0) {
       copyToDescriptor(temporary.path, destination.descriptor, destination.path);
-      ::unlink(temporary.path.c_str());
     } else if (destination.direct) {
       copyInto(temporary.path, destination.path);
-      ::unlink(temporary.path.c_str());
     } else {
       // The file the library left at the temporary's name (it may have made it anew) is what is
       // renamed, and what a cleanup may remove.
@@ -586,14 +766,14 @@ void writeThroughTemporary(const fs::path& target, const std::function<void(cons
       if (::lstat(temporary.path.c_str(), &st) != 0 || !S_ISREG(st.st_mode))
         throw IoError({target.string(), 0},
                       "write failed: the temporary " + temporary.path.string() + " is gone");
-      renameInto(temporary.path, destination.path);
-      recordCommitted({destination.path, st.st_dev, st.st_ino});
+      commitInto(temporary.path, destination.path, committedAs(destination.path, st));
     }
   } catch (...) {
-    ::unlink(temporary.path.c_str());
+    removePrivateTemporary(temporary);
     releaseTemporary(temporary.slot);
     throw;
   }
+  removePrivateTemporary(temporary);  // the folder, now empty (the file was renamed or copied)
   releaseTemporary(temporary.slot);
 }
 
@@ -621,12 +801,21 @@ void discardCommittedOutputs() {
   std::lock_guard<std::mutex> lock(gCommittedMutex);
   // Newest first, each only while its name still holds the very file this process made there: never a
   // file that replaced it since, and never what a link there points to (unlink removes a link itself).
+  // What the name held before is put back (rename: atomically, the name never missing); a name that
+  // held a file that could not be kept keeps the new one, the only one there is.
   for (size_t i = gCommitted.size(); i > gKept; --i) {
-    const Committed& file = gCommitted[i - 1];
+    Committed& file = gCommitted[i - 1];
     struct stat st {};
-    if (::lstat(file.path.c_str(), &st) == 0 && S_ISREG(st.st_mode) && st.st_dev == file.device &&
-        st.st_ino == file.inode)
-      ::unlink(file.path.c_str());
+    const bool ours = ::lstat(file.path.c_str(), &st) == 0 && S_ISREG(st.st_mode) &&
+                      st.st_dev == file.device && st.st_ino == file.inode;
+    if (ours && !file.backup.empty()) {
+      // Put back; should the rename fail, the old file stays under the backup's name, never removed.
+      ::rename(file.backup.c_str(), file.path.c_str());
+      releaseTemporary(file.backupSlot);
+      continue;
+    }
+    if (ours && !file.replaced) ::unlink(file.path.c_str());
+    dropBackup(file);
   }
   gCommitted.resize(gKept);
 }
@@ -634,6 +823,7 @@ void discardCommittedOutputs() {
 void keepCommittedOutputs() {
   requireMappingsWhole();  // a frame made from a mapped input's unreadable page (zeros) is not kept
   std::lock_guard<std::mutex> lock(gCommittedMutex);
+  for (size_t i = gKept; i < gCommitted.size(); ++i) dropBackup(gCommitted[i]);
   gKept = gCommitted.size();
 }
 
@@ -646,6 +836,7 @@ std::vector<fs::path> committedOutputs() {
 
 void forgetCommittedOutputs() {
   std::lock_guard<std::mutex> lock(gCommittedMutex);
+  for (Committed& file : gCommitted) dropBackup(file);
   gCommitted.clear();
   gKept = 0;
 }

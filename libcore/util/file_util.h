@@ -3,23 +3,30 @@
 // Inputs: only regular files are read (a FIFO, device or directory named as an input is refused before
 // it is opened, so nothing waits on a pipe), and a file larger than the memory budget is refused.
 //
-// Outputs: a regular file (or a new name) is written to a temporary beside it, NAME.tmp-HOST-PID-N, that
-// this process creates itself (O_CREAT | O_EXCL | O_NOFOLLOW: never a name someone put there), and
-// renamed over the name on commit. A symbolic link named as an output is replaced by the file, as mv
-// replaces it: nothing is written through the link into the file it points to, and no folder is made
-// for a link that points nowhere. Folders on the way are made as needed, one by one, but never through
-// a dangling link: requireWritableOutput refuses one before the work (an InputError, exit 2), a write
-// that finds one fails (an IoError, exit 1), as it does where something on the way is not a folder.
-// A device, FIFO or socket (`--stats /dev/stdout`, a pipe), reached directly or through links, is
-// written directly and never replaced. A directory is refused.
-// Write errors (a full disk, /dev/full) are IoErrors (exit 1).
+// Outputs: a regular file (or a new name) is written to a temporary beside it, NAME.tmp-HOST-PID-N (NAME
+// cut so the whole fits a folder entry), that this process creates itself (O_CREAT | O_EXCL |
+// O_NOFOLLOW: never a name someone put there), and renamed over the name on commit. A library that opens
+// its file by name (OpenEXR, ffmpeg, OpenVDB) gets one in a private folder of that name instead (mode
+// 0700), so no one can swap it for a link before the library opens it. A symbolic link named as an
+// output is replaced by the file, as mv replaces it: nothing is written through the link into the file
+// it points to, and no folder is made for a link that points nowhere. Folders on the way are made as
+// needed, one by one, but never through a dangling link: requireWritableOutput refuses one before the
+// work (an InputError, exit 2), as it refuses a name longer than a folder entry holds; a write that
+// finds one fails (an IoError, exit 1), as it does where something on the way is not a folder. A device,
+// FIFO or socket (`--stats /dev/stdout`, a pipe), reached directly or through links, is written directly
+// and never replaced; a FIFO that no process opens to read within 10 s is an IoError, not a wait for
+// ever. A directory is refused. Write errors (a full disk, /dev/full) are IoErrors (exit 1).
 //
 // Interruptions and failures: installInterruptCleanup() makes SIGINT, SIGTERM and SIGHUP remove the
 // temporaries of writes in flight and end the process with 128 + the signal; a later write beside the
-// same target removes temporaries (regular files) that dead processes of this host left. A command that
-// fails calls discardCommittedOutputs(), which removes the files it committed since the last
-// keepCommittedOutputs(): each only while its name still holds the file this process made there
-// (checked by device and inode), so a cleanup never removes a file it did not make.
+// same target removes temporaries (regular files, private folders) that dead processes of this host
+// left. A commit that replaces a file (or a link) keeps what was there as a hard link beside it, under a
+// temporary's name, until the command keeps its outputs or fails. A command that fails calls
+// discardCommittedOutputs(), which undoes the commits since the last keepCommittedOutputs(): a new name
+// is removed, a replaced one gets back what it held (renamed back: the name is never missing); each only
+// while its name still holds the file this process made there (checked by device and inode), so a
+// cleanup never removes a file it did not make, and a failed command never costs a file that was there
+// (its own input, written over in place).
 #pragma once
 
 #include <cstdint>
@@ -130,13 +137,14 @@ inline void writeFileAtomic(const std::filesystem::path& target, const std::stri
 // ignored).
 void installInterruptCleanup();
 
-// discardCommittedOutputs: removes the files committed since the last keepCommittedOutputs() (or since
+// discardCommittedOutputs: undoes the commits since the last keepCommittedOutputs() (or since
 // forgetCommittedOutputs()), each only while its name still holds the file this process made there
-// (a failed command's outputs). keepCommittedOutputs: the files committed so far are finished and stay
-// whatever happens later (a sequence's frames: a failed frame never costs the frames before it), unless
-// a mapped input's page could not be read since the last check: then it keeps none and throws
-// requireMappingsWhole()'s error (mapped_file.h), for what was made from its zeros.
-// forgetCommittedOutputs: forgets every file (a command that succeeded, or one that starts).
+// (a failed command's outputs): a new name is removed, a replaced one gets back what it held.
+// keepCommittedOutputs: the files committed so far are finished and stay whatever happens later (a sequence's
+// frames: a failed frame never costs the frames before it), unless a mapped input's page could not be read
+// since the last check: then it keeps none and throws requireMappingsWhole()'s error (mapped_file.h), for
+// what was made from its zeros. forgetCommittedOutputs: forgets every file (a command that succeeded, or one
+// that starts).
 void discardCommittedOutputs();
 void keepCommittedOutputs();
 void forgetCommittedOutputs();
