@@ -8,7 +8,11 @@
 //
 // A plan is input: farmPlanFromJson checks it by validateFarmPlan's rules, and its data reaches the
 // scripts and the printed dry run only through farm/shell.h.
+#include <sys/stat.h>
+
 #include <algorithm>
+#include <cerrno>
+#include <cstring>
 #include <filesystem>
 #include <iostream>
 #include <memory>
@@ -64,10 +68,74 @@ void requirePlanInItsDirectory(const FarmPlan& plan, const std::string& planFile
                                         "`hairgen farm plan -o DIR` wrote");
 }
 
+// A plan runs the hairgen that submits it: each task's executable must be this very file (by device and
+// inode, however it is named), or a plan from elsewhere could name any program called hairgen (one it
+// put in its own folder). The tasks then run this executable by the name the system gives it, so a file
+// swapped in at the plan's name later runs nothing either. Returns the plan so.
+FarmPlan runningThisHairgen(FarmPlan plan, const std::string& planFile) {
+  const std::string self = executablePath();
+  struct stat mine {};
+  if (::stat(self.c_str(), &mine) != 0)
+    throw IoError("cannot examine the hairgen executable " + self + ": " + std::strerror(errno));
+  for (FarmTask& t : plan.tasks) {
+    struct stat st {};
+    if (::stat(t.command[0].c_str(), &st) != 0 || st.st_dev != mine.st_dev || st.st_ino != mine.st_ino)
+      throw InputError({planFile, 0}, "task \"" + t.id + "\": its executable " + t.command[0] +
+                                          " is not this hairgen (" + self +
+                                          "); a plan runs the hairgen that submits it: make the plan "
+                                          "again with `hairgen farm plan`, or submit it with the "
+                                          "hairgen that made it");
+    t.command[0] = self;
+  }
+  return plan;
+}
+
+// The plan's folder holds its files itself: no symbolic link on the way from the folder to a file it
+// names (an input's own name included), nor at slurm/ and logs/, where submit writes. A link planted in
+// a plan's folder would send a task's writes, or submit's scripts, into any folder, or feed a task a
+// file from anywhere as its input; the paths' text alone (validateFarmPlan) cannot see that.
+void requireNoLinksInPlan(const FarmPlan& plan, const std::string& planFile) {
+  const fs::path dir(plan.directory);
+  auto check = [&](const std::string& path, bool lastToo, const std::string& what) {
+    const fs::path relative = fs::path(path).lexically_relative(dir);
+    fs::path walked = dir;
+    size_t parts = size_t(std::distance(relative.begin(), relative.end()));
+    for (const fs::path& part : relative) {
+      walked /= part;
+      if (--parts == 0 && !lastToo) return;
+      struct stat st {};
+      if (::lstat(walked.c_str(), &st) != 0) return;  // not there yet: the task makes it
+      if (S_ISLNK(st.st_mode))
+        throw InputError({planFile, 0}, what + " " + path + ": " + walked.string() +
+                                            " is a symbolic link; a plan's files lie in its folder "
+                                            "itself, not behind links");
+    }
+  };
+  check(plan.directory + "/slurm", true, "submit's scripts");
+  check(plan.directory + "/logs", true, "submit's logs");
+  const auto inside = [&](const std::string& p) {
+    return p.size() > plan.directory.size() + 1 && p.compare(0, plan.directory.size(), plan.directory) == 0 &&
+           p[plan.directory.size()] == '/';
+  };
+  for (const FarmTask& t : plan.tasks) {
+    const std::string task = "task \"" + t.id + "\":";
+    for (const std::string& o : t.outputs) check(o, false, task + " output");
+    for (const std::string& i : t.inputs)
+      if (inside(i)) check(i, true, task + " input");
+    for (size_t k = 2; k < t.command.size(); ++k)
+      if (inside(t.command[k]))
+        check(t.command[k],
+              t.command[k - 1] != "-o" && t.command[k - 1] != "--preview" && t.command[k - 1] != "--gif",
+              task + " command path");
+  }
+}
+
 // Hands the plan's undone tasks to the scheduler (Slurm, the only one yet) and, with wait, waits.
-void submit(const FarmPlan& plan, const std::string& planFile, bool dryRun, bool wait,
+void submit(const FarmPlan& planAsRead, const std::string& planFile, bool dryRun, bool wait,
             const CommonOptions& common) {
-  requirePlanInItsDirectory(plan, planFile);
+  requirePlanInItsDirectory(planAsRead, planFile);
+  requireNoLinksInPlan(planAsRead, planFile);
+  const FarmPlan plan = runningThisHairgen(planAsRead, planFile);
   requireUnchangedConfig(plan, planFile);
   const std::vector<bool> done = farm::doneTasks(plan);
   note(common, "farm submit: " + std::to_string(plan.tasks.size()) + " tasks, " +
@@ -147,7 +215,7 @@ void registerFarmPlan(CLI::App& farm, int& exitCode) {
       Mesh wick = readWick(config);  // as the stages read it: MeshUnits, MeshUpAxis, WickGroup, roots alone
       const FarmPlanOptions options = farmPlanOptions(o);
       const FarmPlan farmPlan = planFarm(config, wick, options);
-      fs::create_directories(options.directory);
+      createOutputFolder(options.directory);  // never through a link to nothing, nor over a file
       const fs::path file = fs::path(options.directory) / "plan.json";
       writeFileAtomic(file, jsonText(toJson(farmPlan)) + "\n");
       stats.counts()["tasks"] = farmPlan.tasks.size();

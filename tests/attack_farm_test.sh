@@ -212,6 +212,45 @@ scheduler_down)
   expect_err "sbatch for grow failed (exit 1): sbatch: error: Batch job submission failed: Invalid account"
   [ "$(wc -l <"$tmp/err")" -eq 1 ] || fail "the error is not one line: $(cat "$tmp/err")"
   ;;
+planted_files)
+  # A plan from elsewhere may name a program called hairgen that it brought along, or hold links in its
+  # folder that send submit's scripts or a task's outputs anywhere: refused, nothing written or run.
+  fake_slurm
+  expect_rc 0 "$hairgen" farm plan "$setup" -o "$tmp/p" --shards 2 "${small[@]}"
+  cp "$tmp/p/plan.json" "$tmp/good.json"
+  mkdir "$tmp/p/bin"
+  printf '#!/bin/sh\ntouch %q\n' "$tmp/injected" >"$tmp/p/bin/hairgen"
+  chmod +x "$tmp/p/bin/hairgen"
+  edit_plan "$tmp/p/plan.json" "[t['command'].__setitem__(0, '$tmp/p/bin/hairgen') for t in p['tasks']]"
+  for dry in --dry-run ""; do
+    expect_rc 2 "$hairgen" farm submit "$tmp/p/plan.json" --scheduler slurm $dry
+    expect_err "task \"grow.1\": its executable $tmp/p/bin/hairgen is not this hairgen"
+  done
+  [ ! -e "$tmp/injected" ] || fail "a plan ran the program it brought"
+  [ ! -e "$tmp/p/slurm" ] || fail "a refused plan wrote scripts"
+  # This hairgen by another name (a link to it) runs, as this hairgen.
+  mkdir "$tmp/alias"
+  ln -s "$hairgen" "$tmp/alias/hairgen"
+  cp "$tmp/good.json" "$tmp/p/plan.json"
+  edit_plan "$tmp/p/plan.json" "[t['command'].__setitem__(0, '$tmp/alias/hairgen') for t in p['tasks']]"
+  expect_rc 0 "$hairgen" farm submit "$tmp/p/plan.json" --scheduler slurm --dry-run
+  # Links in the plan's folder: slurm/ to a user's folder, shards/ to another.
+  cp "$tmp/good.json" "$tmp/p/plan.json"
+  mkdir "$tmp/victim" "$tmp/victim2"
+  echo "the user's script" >"$tmp/victim/grow.sh"
+  ln -s "$tmp/victim" "$tmp/p/slurm"
+  expect_rc 2 "$hairgen" farm submit "$tmp/p/plan.json" --scheduler slurm
+  expect_err "$tmp/p/slurm is a symbolic link"
+  [ "$(cat "$tmp/victim/grow.sh")" = "the user's script" ] || fail "submit wrote through a link in the plan's folder"
+  rm "$tmp/p/slurm"
+  ln -s "$tmp/victim2" "$tmp/p/shards"
+  expect_rc 2 "$hairgen" farm submit "$tmp/p/plan.json" --scheduler slurm
+  expect_err "$tmp/p/shards is a symbolic link"
+  [ -z "$(ls "$tmp/victim2")" ] || fail "a task wrote through a link in the plan's folder"
+  rm "$tmp/p/shards"
+  expect_rc 0 "$hairgen" farm submit "$tmp/p/plan.json" --scheduler slurm --wait
+  [ -s "$tmp/p/beauty.exr" ] || fail "the plan without links did not run"
+  ;;
 *) fail "unknown case" ;;
 esac
 echo "ok ($case)"
