@@ -16,6 +16,8 @@
 #include "libcore/config/keys.h"
 #include "libcore/io/exr_io.h"
 #include "libcore/io/gltf_io.h"
+#include "libcore/io/hair_cache.h"
+#include "libcore/io/info.h"
 #include "libcore/io/obj_io.h"
 #include "libcore/util/checked.h"
 #include "libcore/util/file_util.h"
@@ -68,6 +70,42 @@ TEST(Hardening, AGltfAccessorCountNear2To62IsRefused) {
   std::string m =
       inputError([&] { decodeGltf(reinterpret_cast<const uint8_t*>(text.data()), text.size(), "x.gltf"); });
   EXPECT_NE(m.find("reaches past the end"), std::string::npos) << m;
+}
+
+// extras nested 20,000 deep (42 KB): tinygltf converts extras by recursion, and overflowed the stack. A
+// glTF is refused past 256 levels; a DCC's extras nested a few deep still read (and quotes and
+// escapes inside strings are not nesting).
+TEST(Hardening, AGltfNestedPastAnyGltfIsRefusedNotACrash) {
+  std::vector<uint8_t> json = encodeGltf(test::sampleStrands(3), false);
+  nlohmann::json doc = nlohmann::json::parse(json.begin(), json.end());
+  doc["extras"] = nlohmann::json::parse(R"({"a": [[{"b": "x[[{\"\\"}]]})");
+  std::string text = doc.dump();
+  EXPECT_EQ(decodeGltf(reinterpret_cast<const uint8_t*>(text.data()), text.size(), "x.gltf").strandCount(),
+            3u);
+  doc.erase("extras");
+  text = doc.dump();
+  text.insert(1, "\"extras\": " + std::string(20000, '[') + std::string(20000, ']') + ", ");
+  std::string m =
+      inputError([&] { decodeGltf(reinterpret_cast<const uint8_t*>(text.data()), text.size(), "x.gltf"); });
+  EXPECT_NE(m.find("nests arrays and objects 20001 deep"), std::string::npos) << m;
+}
+
+// info files a .usda layer's entries by name: 150,000 of them in its hairgen dictionary took a minute.
+// A layer holding more than hairgen ever writes is not hairgen's.
+TEST(Hardening, AUsdaLayerWithThousandsOfEntriesIsRefusedAtOnce) {
+  test::TempDir dir("hardening");
+  const fs::path file = dir.path() / "hair.usda";
+  writeStrands(file, test::sampleStrands(3));
+  EXPECT_TRUE(describeFile(file).contains("strands"));
+  std::string text = slurp(file);
+  const size_t at = text.find("string producer");
+  ASSERT_NE(at, std::string::npos);
+  std::string many;
+  for (int i = 0; i < 100000; ++i) many += "string k" + std::to_string(i) + " = \"v\"\n";
+  text.insert(at, many);
+  spit(file, text);
+  const std::string m = inputError([&] { describeFile(file); });
+  EXPECT_NE(m.find("holds 100"), std::string::npos) << m;
 }
 
 // --------------------------------------------------------------------------------------- glTF's folder

@@ -1,6 +1,7 @@
 // OBJ reading: polygons, normals indexed apart, missing normals, degenerate faces, bad input.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <sstream>
 
 #include "libcore/io/obj_io.h"
@@ -59,6 +60,28 @@ TEST(Obj, EmptyMeshesAreErrors) {
   EXPECT_THROW(parseObj("# nothing\n", "e.obj"), InputError);
   EXPECT_THROW(parseObj("v 0 0 0\nv 1 0 0\nv 0 1 0\n", "p.obj"), InputError);           // points, no faces
   EXPECT_THROW(parseObj("v 0 0 0\nv 1 0 0\nv 2 0 0\nf 1 2 3\n", "l.obj"), InputError);  // all degenerate
+}
+
+// A polygon is triangulated in time that grows with the square of its corners (200,000 corners: minutes):
+// 256 corners read, 257 are refused naming the line.
+TEST(Obj, APolygonOfThousandsOfCornersIsRefused) {
+  auto polygon = [](int corners) {
+    std::ostringstream obj;
+    for (int i = 0; i < corners; ++i)
+      obj << "v " << std::cos(2.0 * M_PI * i / corners) << " " << std::sin(2.0 * M_PI * i / corners)
+          << " 0\n";
+    obj << "f";
+    for (int i = 1; i <= corners; ++i) obj << " " << i;
+    obj << "\n";
+    return obj.str();
+  };
+  EXPECT_EQ(parseObj(polygon(256), "fan.obj").triangleCount(), 254u);
+  try {
+    parseObj(polygon(257), "fan.obj");
+    ADD_FAILURE() << "a face of 257 corners was read";
+  } catch (const InputError& e) {
+    EXPECT_EQ(std::string(e.what()).rfind("fan.obj:258: a face of 257 corners", 0), 0u) << e.what();
+  }
 }
 
 TEST(Obj, BadNumbersAndIndicesNameTheLine) {

@@ -1,5 +1,6 @@
 #include "libcore/io/gltf_io.h"
 
+#include <algorithm>
 #include <cctype>
 #include <cmath>
 #include <cstring>
@@ -173,8 +174,40 @@ std::string refusal(const std::filesystem::path& path, const std::filesystem::pa
   return {};
 }
 
+// The deepest nesting of arrays and objects in JSON text (strings skipped), without parsing it: a glTF
+// is a few levels deep, and its `extras` are any JSON, which tinygltf converts by recursion (20,000
+// levels of [[[...]]] overflowed the stack: a crash, from a 42 KB file).
+size_t jsonDepth(const std::string& json) {
+  size_t depth = 0, deepest = 0;
+  bool inString = false, escaped = false;
+  for (const char c : json) {
+    if (inString) {
+      if (escaped)
+        escaped = false;
+      else if (c == '\\')
+        escaped = true;
+      else if (c == '"')
+        inString = false;
+    } else if (c == '"') {
+      inString = true;
+    } else if (c == '[' || c == '{') {
+      deepest = std::max(deepest, ++depth);
+    } else if ((c == ']' || c == '}') && depth > 0) {
+      --depth;
+    }
+  }
+  return deepest;
+}
+
+// The deepest a glTF's JSON may nest: far past any glTF's own structure and any DCC's extras.
+constexpr size_t kMaxJsonDepth = 256;
+
 void checkExternalUris(const std::string& json, const std::filesystem::path& baseDir,
                        const std::string& name) {
+  if (const size_t depth = jsonDepth(json); depth > kMaxJsonDepth)
+    throw InputError({name, 0}, "its JSON nests arrays and objects " + std::to_string(depth) +
+                                    " deep; hairgen reads a glTF nested at most " +
+                                    std::to_string(kMaxJsonDepth) + " deep");
   const nlohmann::json doc = nlohmann::json::parse(json, nullptr, /*allow_exceptions=*/false);
   if (!doc.is_object()) return;  // tinygltf says what is wrong with it
   for (const char* list : {"buffers", "images"}) {

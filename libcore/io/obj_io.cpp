@@ -20,6 +20,7 @@ namespace hairgen {
 namespace {
 
 constexpr double kMaxCoordinate = 1e30;  // beyond this a float loses the geometry
+constexpr size_t kMaxFaceCorners = 256;  // a polygon's corners: its triangulation costs their square
 
 std::vector<std::string_view> splitWords(std::string_view line) {
   std::vector<std::string_view> words;
@@ -117,6 +118,12 @@ std::string validate(std::string_view text, const std::string& name, const std::
       ++counts[2];
     } else if (tag == "f") {
       if (words.size() < 4) throw InputError(where, "a face needs at least three corners");
+      // tinyobjloader triangulates a polygon by ear clipping, in time that grows with the square of its
+      // corners: one face of 200,000 corners took minutes. Scalps and heads are triangles and quads.
+      if (words.size() - 1 > kMaxFaceCorners)
+        throw InputError(where, "a face of " + std::to_string(words.size() - 1) +
+                                    " corners; hairgen reads faces of at most " +
+                                    std::to_string(kMaxFaceCorners) + " (triangulate the mesh in its DCC)");
       for (size_t i = 1; i < words.size(); ++i) checkCorner(words[i], where, counts);
       if (!group.empty() && !inGroup && !inMaterial) return;
     } else {

@@ -464,6 +464,15 @@ std::vector<std::pair<std::string, std::string>> readUsdaSummary(const std::file
         key == "endTimeCode" || key == "timeCodesPerSecond" || line.rfind("string ", 0) == 0)
       entries.emplace_back(oneLine(key), oneLine(value));
   });
+  // hairgen writes a few dozen entries at most; thousands are no layer of its (and `info` files them by
+  // name: 150,000 took a minute).
+  constexpr size_t kMostEntries = 256;
+  if (entries.size() > kMostEntries)
+    throw InputError({file.string(), 0}, "its layer holds " + std::to_string(entries.size()) +
+                                             " entries; hairgen writes at most " +
+                                             std::to_string(kMostEntries) +
+                                             ", so it is not a USD layer hairgen wrote (usdcat or TinyUSDZ "
+                                             "describe any layer)");
   bool counted = false;
   for (const auto& [key, value] : entries) counted = counted || key == "strands";
   if (!ours || !counted)
