@@ -367,6 +367,13 @@ TEST(Hardening, AbsurdConfigsAreRefusedBeforeTheWork) {
   fine.visualityStep = 1e-9;
   EXPECT_NE(inputError([&] { requireFits(estimateGrow(fine, head, 759, 2), true); }).find("VisualityStep"),
             std::string::npos);
+  // A guide of more points than a .hair cache holds is refused before it is grown, even with --force
+  // (16 cm at 2 µm: 80,001 points; it was grown for seconds, then not written).
+  fine = style;
+  fine.visualityStep = 2e-6;
+  EXPECT_NE(
+      inputError([&] { requireFits(estimateGrow(fine, head, 1, 2), true); }).find("holds at most 65536"),
+      std::string::npos);
   fine = style;
   fine.hairLengths.assign(256, 0.000625);
   EXPECT_NE(inputError([&] { requireFits(estimateGrow(fine, head, 759, 2), false); }).find("--force"),

@@ -230,7 +230,7 @@ Section<Hairstyle> makeHairstyle() {
        unsignedKey<H>({"Seed", "", "keys every random number; --seed overrides it"}, &H::seed),
        rootTiltKey(),
        rootFlowKey(),
-       integerKey<H>({"Segments", "", "cantilever: equal segments per hair"}, &H::segments, 1, 100000),
+       integerKey<H>({"Segments", "", "cantilever: equal segments per hair"}, &H::segments, 1, 65535),
        realKey<H>({"FlexuralRigidity", "N·m²", "cantilever: E·I; 0 = Young × π a b³/4"}, &H::flexuralRigidity,
                   Range::nonNegative()),
        jointLimitKey(),

@@ -80,6 +80,7 @@ uint64_t bytesOf(double b) {
 }  // namespace
 
 void requireFits(const WorkEstimate& e, bool force) {
+  if (!e.impossible.empty()) throw InputError(e.impossible);
   const uint64_t budget = memoryBudget();
   if (e.bytes > budget)
     throw InputError(e.stage + " would need about " + formatBytes(e.bytes) + " of memory (" + e.detail +
@@ -97,6 +98,14 @@ WorkEstimate estimateGrow(const Hairstyle& style, const Collision& collision, si
   e.stage = "grow";
   const double length = style.totalLength();
   const double guides = double(follicles);
+  // A .hair cache counts a strand's segments in 16 bits (cyHair's layout): a guide of more points could
+  // be grown for minutes and then not written.
+  constexpr size_t kMostPoints = 65536;
+  if (const size_t points = pointsPerGuide(style); points > kMostPoints)
+    e.impossible = "Hairstyle.VisualityStep " + formatReal(style.visualityStep) + " m over " +
+                   formatReal(length) + " m of hair gives each guide " + std::to_string(points) +
+                   " points; a .hair cache holds at most " + std::to_string(kMostPoints) +
+                   " a strand: raise Hairstyle.VisualityStep";
   if (style.model == StylingModel::kCantilever) {
     const double nodes = double(style.segments) + 1.0;
     e.bytes = bytesOf(guides * nodes * (24.0 + 48.0));     // the guides, and each hair's nodes in doubles

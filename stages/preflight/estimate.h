@@ -20,16 +20,17 @@
 namespace hairgen {
 
 struct WorkEstimate {
-  std::string stage;      // "grow", "interpolate", "shade", "render"
-  uint64_t bytes = 0;     // peak memory of the work itself
-  double seconds = 0.0;   // rough wall time on this machine's cores
-  std::string memoryKey;  // the key that drives the memory, e.g. "Hairstyle.VisualityStep"
-  std::string timeKey;    // the key that drives the time
-  std::string detail;     // what the figures come from: "759 guides x 65 points"
-  std::string refusal;    // work that is wrong whatever it costs, naming the key; --force overrides it
-  int frames = 0;         // a shot's work: the frames it covers (`seconds` is all of them, `bytes` one's)
-  std::string note;       // what the user should hear that is no refusal (hair that looks to be in other
-                          // units); empty: nothing
+  std::string stage;       // "grow", "interpolate", "shade", "render"
+  uint64_t bytes = 0;      // peak memory of the work itself
+  double seconds = 0.0;    // rough wall time on this machine's cores
+  std::string memoryKey;   // the key that drives the memory, e.g. "Hairstyle.VisualityStep"
+  std::string timeKey;     // the key that drives the time
+  std::string detail;      // what the figures come from: "759 guides x 65 points"
+  std::string refusal;     // work that is wrong whatever it costs, naming the key; --force overrides it
+  std::string impossible;  // work whose output cannot be written, naming the key; whatever --force says
+  int frames = 0;          // a shot's work: the frames it covers (`seconds` is all of them, `bytes` one's)
+  std::string note;        // what the user should hear that is no refusal (hair that looks to be in other
+                           // units); empty: nothing
 };
 
 // No hair grows longer: a strand past it says the file is in other units (a groom in centimetres read as
@@ -40,8 +41,8 @@ inline constexpr double kLongestHairMetres = 3.0;
 // frame hairgen's bundled configs make (the slowest takes seconds).
 inline constexpr double kTimeLimitSeconds = 3600.0;
 
-// Throws InputError when the work needs more memory than is free (memoryBudget()), or when it would
-// take longer than kTimeLimitSeconds and `force` is false.
+// Throws InputError when the work's output cannot be written (`impossible`), needs more memory than is
+// free (memoryBudget()), or when it would take longer than kTimeLimitSeconds and `force` is false.
 void requireFits(const WorkEstimate& estimate, bool force);
 
 // `threads`: the worker threads the stage may use (each holds its own scratch).
