@@ -5,6 +5,7 @@
 #include "cli/common.h"
 #include "libcore/config/setup.h"
 #include "libcore/io/info.h"
+#include "libcore/render/custom_shaders.h"
 #include "libcore/util/json.h"
 #include "stages/preflight/estimate.h"
 #include "stages/preflight/scene.h"
@@ -21,6 +22,7 @@ namespace {
 // refused what run would refuse.
 nlohmann::ordered_json checkReport(const std::string& setup, const Config& config, const Scene& scene,
                                    const CommonOptions& common) {
+  readCustomShaders(config.setup);  // a custom stage the render would refuse (too large for a compiler)
   nlohmann::ordered_json report =
       describeSetup(setup, config, scene.wick ? &*scene.wick : nullptr, scene.head ? &*scene.head : nullptr);
   if (!config.setup.meshConversion.describe().empty())

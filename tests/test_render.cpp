@@ -17,6 +17,7 @@
 #include "libcore/io/exr_io.h"
 #include "libcore/io/obj_io.h"
 #include "libcore/render/camera_fragments.h"
+#include "libcore/render/custom_shaders.h"
 #include "libcore/render/gl_context.h"
 #include "libcore/render/gl_resources.h"
 #include "libcore/render/light_maps.h"
@@ -1020,6 +1021,57 @@ TEST(Render, ABrokenCustomHairFragmentIsAnInputErrorAtItsFileAndLine) {
     EXPECT_NE(what.find("HairFrag, named at setup.txt:9"), std::string::npos) << what;
     EXPECT_EQ(what.find('\n'), std::string::npos) << "one line: " << what;
   }
+}
+
+// A driver's compiler took 6 GB and 20 s for one statement of 5,000 additions and crashed at 20,000;
+// it inlines every function, and a macro used in a macro doubles. What a custom stage asks of it is
+// bounded before it sees it, each refusal at the file's line; every stage of hairgen's own, of any size
+// it has, passes.
+TEST(Render, ACustomStageTooLargeForACompilerIsRefusedAtItsLine) {
+  for (const std::filesystem::directory_entry& f :
+       std::filesystem::directory_iterator(test::sourceDir() / "libcore" / "render" / "glsl"))
+    EXPECT_NO_THROW(requireBoundedStage({readFileText(f.path()), f.path().string(), ""})) << f.path();
+  auto refusal = [](const std::string& text) {
+    try {
+      requireBoundedStage({text, "f.glsl", ""});
+    } catch (const InputError& e) {
+      return std::string(e.what());
+    }
+    return std::string("accepted");
+  };
+  std::string sum = "void main() {\n  float s = 0.0\n";
+  for (int i = 0; i < 600; ++i) sum += "    + 1.0\n";
+  EXPECT_EQ(refusal(sum + "    ;\n}\n").rfind("f.glsl:2: a statement of more than 1024 tokens", 0), 0u);
+  std::string doubling = "float f0(float x) { return x; }\n";
+  for (int i = 1; i <= 20; ++i)
+    doubling += "float f" + std::to_string(i) + "(float x) { return f" + std::to_string(i - 1) + "(x) + f" +
+                std::to_string(i - 1) + "(x); }\n";
+  EXPECT_NE(refusal(doubling).find("with the functions it calls inlined is more than 100000 tokens"),
+            std::string::npos);
+  std::string macros = "#define A0 x\n";
+  for (int i = 1; i <= 20; ++i)
+    macros += "#define A" + std::to_string(i) + " (A" + std::to_string(i - 1) + " + A" +
+              std::to_string(i - 1) + ")\n";
+  EXPECT_EQ(refusal(macros + "float y = A20;\n").rfind("f.glsl:22: a statement of more than 1024 tokens", 0),
+            0u);
+  // Macros as shaders use them pass; a function-like one's use costs its body and each argument as many
+  // times as its parameter appears there, and nested ones (which expand without bound) are refused.
+  const std::string twice = "// a note\n#define TWICE(a) ((a) + (a))\n#define HALF (0.5)\n";
+  EXPECT_EQ(refusal(twice + "float y = TWICE(HALF) * HALF;\n"), "accepted");
+  EXPECT_EQ(
+      refusal(twice + "float y = TWICE(TWICE(HALF));\n").rfind("f.glsl:4: the function-like macro TWICE", 0),
+      0u);
+  EXPECT_EQ(refusal(twice + "#define FOUR(a) TWICE(TWICE(a))\n").rfind("f.glsl:4: #define FOUR(...) uses", 0),
+            0u);
+  std::string many = "#define MANY(a) (a";
+  for (int i = 0; i < 300; ++i) many += " + a";
+  many += ")\n";
+  EXPECT_EQ(refusal(many + "float y = MANY(1.0);\n"), "accepted");
+  EXPECT_EQ(refusal(many + "float y = MANY(1.0 + 2.0 + 3.0);\n").rfind("f.glsl:2: a statement of more", 0),
+            0u);
+  EXPECT_EQ(refusal("float y = " + std::string(65, '(') + "1.0" + std::string(65, ')') + ";\n")
+                .rfind("f.glsl:1: parentheses, brackets and braces nested more than 64 deep", 0),
+            0u);
 }
 
 // Where the rasteriser's fragments are shaded (the atlas), a HairFrag's inputs are globals hairgen sets:

@@ -22,8 +22,14 @@ struct CustomShaders {
   std::optional<CustomStage> hairVert, hairFrag, headVert, headFrag;
 };
 
-// Reads the files the Setup names (its paths are already resolved). A file that cannot be read is an
-// InputError naming it.
+// Throws InputError (naming the file and line) where a stage asks more of the driver's compiler than a
+// shader should: more than 256 KB; a statement of more than 1,024 tokens (macros expanded); nesting
+// deeper than 64; a function-like macro; a function of more than 100,000 tokens with every call in it
+// inlined. A driver's compiler took 6 GB for one statement of 5,000 additions and crashed at 20,000.
+void requireBoundedStage(const CustomStage& stage);
+
+// Reads the files the Setup names (its paths are already resolved), each bounded by
+// requireBoundedStage. A file that cannot be read is an InputError naming it.
 CustomShaders readCustomShaders(const Setup& setup);
 
 }  // namespace hairgen
