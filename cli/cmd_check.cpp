@@ -4,6 +4,7 @@
 #include "cli/commands.h"
 #include "cli/common.h"
 #include "libcore/config/setup.h"
+#include "libcore/io/hair_cache.h"
 #include "libcore/io/info.h"
 #include "libcore/render/custom_shaders.h"
 #include "libcore/util/json.h"
@@ -23,6 +24,7 @@ namespace {
 nlohmann::ordered_json checkReport(const std::string& setup, const Config& config, const Scene& scene,
                                    const CommonOptions& common) {
   readCustomShaders(config.setup);  // a custom stage the render would refuse (too large for a compiler)
+  if (config.setup.load) readStrands(config.setup.loadFile.path);  // a coupe run could not read
   nlohmann::ordered_json report =
       describeSetup(setup, config, scene.wick ? &*scene.wick : nullptr, scene.head ? &*scene.head : nullptr);
   if (!config.setup.meshConversion.describe().empty())

@@ -79,6 +79,14 @@ config_errors)
   printf 'Load true\n' > "$tmp/load.txt"
   expect_rc 2 "$hairgen" check "$tmp/load.txt"
   grep -q "load.txt:1:" "$tmp/err" || fail "Load without LoadFile not located: $(cat "$tmp/err")"
+  # check judges a Setup as run reads it: an empty one is no job, and a LoadFile run cannot read is
+  # refused by check too.
+  : > "$tmp/empty.txt"
+  expect_rc 2 "$hairgen" check "$tmp/empty.txt"
+  expect_err "missing required key 'HairstyleInfo'"
+  printf 'not hair\n' > "$tmp/coupe.hair"
+  expect_rc 2 "$hairgen" check "$src/configs/default/setup.txt" --set Setup.Load=true --set "Setup.LoadFile=$tmp/coupe.hair"
+  expect_err "$tmp/coupe.hair"
   ;;
 no_partial_output)
   head -c 300 "$src/tests/cli_test.sh" > "$tmp/broken.hair"

@@ -31,7 +31,9 @@ Config loadConfig(const std::filesystem::path& setupFile, const std::vector<Over
   Config config;
   config.setup = readSetup(readConfigText(setupFile), overrides);
   const Setup& s = config.setup;
-  bool grows = use == SetupUse::kGrow || use == SetupUse::kInterpolate || (use == SetupUse::kRun && !s.load);
+  // check judges the Setup as run reads it: an empty Setup, or one without a Hairstyle Info, is no job.
+  bool grows = use == SetupUse::kGrow || use == SetupUse::kInterpolate ||
+               ((use == SetupUse::kRun || use == SetupUse::kCheck) && !s.load);
 
   auto need = [&](const PathRef& ref, const char* key, const char* why) {
     if (!ref.given())
