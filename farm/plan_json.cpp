@@ -314,6 +314,7 @@ Json toJson(const FarmPlan& plan) {
 FarmPlan farmPlanFromJson(const Json& j, const std::string& name) {
   const FileLoc where{name, 0};
   FarmPlan plan;
+  std::string field;  // what is being read, for a message
   try {
     if (!j.is_object() || !j.contains("format") || j["format"] != "hairgen-farm-plan")
       throw InputError(where, "is not a hairgen farm plan (no \"format\": \"hairgen-farm-plan\")");
@@ -322,25 +323,37 @@ FarmPlan farmPlanFromJson(const Json& j, const std::string& name) {
                        "is a farm plan of version " +
                            j.value("version", Json()).dump(-1, ' ', false, Json::error_handler_t::replace) +
                            "; this hairgen reads version 1");
+    field = "setup";
     plan.setup = j.at("setup").get<std::string>();
+    field = "directory";
     plan.directory = j.at("directory").get<std::string>();
+    field = "configDigest";
     plan.configDigest = j.at("configDigest").get<std::string>();
+    field = "overrides";
     plan.overrides = j.at("overrides").get<std::vector<std::string>>();
     plan.shards = int(integer(j, "shards", 1, kFarmMaxGroupTasks, where));
     plan.chunk = int(integer(j, "chunk", 1, kFarmMaxFrames, where));
+    field = "frames";
     if (!j.at("frames").is_null()) {
       const Json& f = j["frames"];
+      if (!f.is_object())
+        throw InputError(where, "\"frames\" is neither null nor {\"first\": A, \"last\": B}");
       plan.frames = FrameRange{int(integer(f, "first", INT32_MIN, INT32_MAX, where)),
                                int(integer(f, "last", INT32_MIN, INT32_MAX, where))};
     }
+    field = "tasks";
     const Json& tasks = j.at("tasks");
     if (!tasks.is_array()) throw InputError(where, "\"tasks\" is not an array");
     if (tasks.size() > kFarmMaxTasks)
       throw InputError(where, "it has " + std::to_string(tasks.size()) + " tasks; a plan holds at most " +
                                   std::to_string(kFarmMaxTasks));
-    for (const Json& tj : tasks) plan.tasks.push_back(taskFromJson(tj, where));
+    for (const Json& tj : tasks) {
+      field = "tasks[" + std::to_string(plan.tasks.size()) + "]";
+      plan.tasks.push_back(taskFromJson(tj, where));
+    }
   } catch (const nlohmann::json::exception& e) {
-    throw InputError(where, std::string("is not a valid farm plan: ") + e.what());
+    throw InputError(where, "is not a valid farm plan: " +
+                                (field.empty() ? std::string() : "\"" + field + "\": ") + e.what());
   }
   validateFarmPlan(plan, name);
   return plan;

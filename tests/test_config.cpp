@@ -216,6 +216,9 @@ TEST(ConfigErrors, OutOfRangeSaysTheRange) {
   EXPECT_NE(
       inputError([] { readHairstyle(text("HairLengths 0.1\nHairDensity -1\n"), {}); }).find("out of range"),
       std::string::npos);
+  // Past the ±1e300 every value keeps to, the message says so (it used to say only "> 0 Pa").
+  m = inputError([] { readHairstyle(text("HairLengths 0.1\nYoung 1e308\n"), {}); });
+  EXPECT_NE(m.find("it must be > 0 Pa and within ±1e300"), std::string::npos) << m;
 }
 
 TEST(ConfigErrors, WrongValueCountNamesLine) {

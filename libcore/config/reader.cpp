@@ -241,8 +241,10 @@ double SectionReader::checkReal(const ConfigLine& line, size_t index, Range rang
   if (!range.contains(*value)) {
     const KeySpec* key = section_.find(line.key);
     const std::string unit = key ? key->unit : std::string();
-    throw InputError(line.where, label + " = " + token + " is out of range; it must be " + range.describe() +
-                                     (unit.empty() ? "" : " " + unit));
+    // Past the ±1e300 every range has, which describe() leaves unsaid ("> 0" reads as no upper bound).
+    std::string bound = range.describe() + (unit.empty() ? "" : " " + unit);
+    if (std::abs(*value) > 1e299) bound = (range.describe().empty() ? "" : bound + " and ") + "within ±1e300";
+    throw InputError(line.where, label + " = " + token + " is out of range; it must be " + bound);
   }
   return *value;
 }
