@@ -96,20 +96,22 @@ no_partial_output)
   expect_rc 2 "$hairgen" convert "$tmp/broken.hair" "$tmp/out.xyz"
   ;;
 render_units_head)
-  # render --units/--up-axis convert the hair file alone: a data set's hair (cyHair, cm, z up) sits on
-  # the bundled head, the image the same as of the hair converted to metres first (docs/real-heads.md).
+  # render --units/--up-axis convert the hair file alone: a data set's hair (cyHair, 4 mm a unit, z up)
+  # sits on the bundled head, the image the same as of the hair converted to metres first
+  # (docs/real-heads.md).
   [ -f "$real/luxcore/straight.hair" ] || skip "shared/testdata/real is absent"
   small=(--quiet --set "Render.Resolution=48 48")
-  on_head=(--translate 0 -0.49 -0.02)
-  expect_rc 0 "$hairgen" render "$src/configs/default/setup.txt" --hair "$real/luxcore/straight.hair" --units cm \
-    --up-axis z "${on_head[@]}" -o "$tmp/units.exr" "${small[@]}"
-  expect_rc 0 "$hairgen" convert "$real/luxcore/straight.hair" "$tmp/metres.hair" --units cm --up-axis z -q
+  on_head=(--translate 0 -0.094 -0.01)
+  expect_rc 0 "$hairgen" render "$src/configs/default/setup.txt" --hair "$real/luxcore/straight.hair" \
+    --units 0.004 --up-axis z "${on_head[@]}" -o "$tmp/units.exr" "${small[@]}"
+  expect_rc 0 "$hairgen" convert "$real/luxcore/straight.hair" "$tmp/metres.hair" --units 0.004 --up-axis z -q
   expect_rc 0 "$hairgen" render "$src/configs/default/setup.txt" --hair "$tmp/metres.hair" "${on_head[@]}" \
     -o "$tmp/metres.exr" "${small[@]}"
   cmp "$tmp/units.exr" "$tmp/metres.exr" || fail "render --units converted the head too"
   # A head in the hair's units is asked for in the Setup: then the images differ.
-  expect_rc 0 "$hairgen" render "$src/configs/default/setup.txt" --hair "$real/luxcore/straight.hair" --units cm \
-    --up-axis z "${on_head[@]}" -o "$tmp/both.exr" "${small[@]}" --set Setup.MeshUnits=cm --set Setup.MeshUpAxis=z
+  expect_rc 0 "$hairgen" render "$src/configs/default/setup.txt" --hair "$real/luxcore/straight.hair" \
+    --units 0.004 --up-axis z "${on_head[@]}" -o "$tmp/both.exr" "${small[@]}" --set Setup.MeshUnits=0.004 \
+    --set Setup.MeshUpAxis=z
   expect_rc 4 "$hairgen" diff "$tmp/metres.exr" "$tmp/both.exr"
   ;;
 render_units_note)
