@@ -466,6 +466,13 @@ wick_info)
   expect_rc 0 "$hairgen" check "$tmp/setup.txt"
   expect_err "RootFlow's point (0 2 0) lies"
   expect_err "RootFlow away-from auto"
+  # The bundled head's whorl on a scalp 20 cm higher (another head: nearer the wick's centre than its
+  # size, 20 cm from every follicle): said too.
+  awk '$1 == "v" { $3 += 0.2 } { print }' "$src/configs/assets/wick.obj" > "$tmp/high.obj"
+  printf 'HairLengths 0.05\nRootTilt 30\nRootFlow away-from 0 0.14 -0.04\n' > "$tmp/h.txt"
+  printf 'HairstyleInfo h.txt\nWickModel high.obj\n' > "$tmp/setup.txt"
+  expect_rc 0 "$hairgen" check "$tmp/setup.txt"
+  expect_err "from the nearest follicle, so it is no whorl of this scalp"
   expect_rc 0 "$hairgen" check "$src/configs/default/setup.txt"
   grep -q "RootFlow" "$tmp/err" && fail "the default coupe's RootFlow was warned of: $(cat "$tmp/err")"
   # away-from auto: check prints the line that freezes the whorl, and grow with that line grows what

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include "libcore/model/shape_fit.h"
 #include "libcore/render/views.h"
@@ -178,19 +179,25 @@ std::vector<SceneFinding> checkScene(const Config& config, const Mesh& wick, con
                                         "WickGroup (the scalp's faces) and HeadModel"
                                       : "the shapes fit another head; use Ellipsoid VOLUME PENALTY auto")});
   (void)near;
-  // Follicles lean away from RootFlow's point: one far from this head (the bundled head's whorl, in a
-  // Hairstyle Info made for it) leans them all one way.
+  // Follicles lean away from RootFlow's point, a whorl on the scalp: one far from every follicle (the
+  // bundled head's whorl, in a Hairstyle Info made for it, on another head) leans them all one way, or
+  // the top of the head back. The bundled coupes' lie within a centimetre of a follicle; a point a
+  // quarter of the wick's size away (at least 3 cm) is no whorl of this scalp.
   const Hairstyle& style = config.hairstyle;
+  double nearestFollicle = std::numeric_limits<double>::infinity();
+  for (const glm::vec3& p : wick.positions)
+    nearestFollicle = std::min(nearestFollicle, glm::length(glm::dvec3(p) - style.rootFlow.value));
   if (style.rootTilt > 0.0 && style.rootFlow.kind == RootFlow::Kind::kAwayFrom && !style.rootFlow.fitted &&
-      glm::length(style.rootFlow.value - centre) > std::max(diagonal, 0.05)) {
+      !wick.positions.empty() && nearestFollicle > std::max(0.25 * diagonal, 0.03)) {
     auto point = [](const glm::dvec3& p) {
       auto r = [](double v) { return formatReal(std::round(v * 1000.0) / 1000.0); };
       return r(p.x) + " " + r(p.y) + " " + r(p.z);
     };
     out.push_back({false, "RootFlow's point (" + point(style.rootFlow.value) + ") lies " +
-                              formatReal(std::round(glm::length(style.rootFlow.value - centre) * 100) / 100) +
-                              " m from the wick's centre, so every follicle leans one way; for this head, " +
-                              "RootFlow away-from auto (its whorl; hairgen check prints the point)"});
+                              formatReal(std::round(nearestFollicle * 100) / 100) +
+                              " m from the nearest follicle, so it is no whorl of this scalp and the "
+                              "follicles lean one way; for this head, RootFlow away-from auto (its whorl; "
+                              "hairgen check prints the point)"});
   }
   // The camera: does it see the wick?
   if (!config.render.cameraAuto) {
