@@ -33,6 +33,20 @@ bool refuseUnknownCommand(const CLI::App& app, const std::string& word) {
 
 }  // namespace
 
+// Where a --set's value was split by the shell (`--set Render.Resolution=320 320`: CLI11 sees 320 as an
+// argument it did not expect) or given without '=', what to write instead; empty otherwise.
+std::string setHint(const std::string& error, int argc, char** argv) {
+  for (int k = 1; k + 2 < argc; ++k) {
+    if (std::string(argv[k]) != "--set") continue;
+    const std::string value = argv[k + 1], next = argv[k + 2];
+    if (next.empty() || next[0] == '-' || error.find("not expected: " + next) == std::string::npos) continue;
+    if (value.find('=') == std::string::npos)
+      return " (--set takes KEY=VALUE as one argument: --set '" + value + "=" + next + "')";
+    return " (a --set value with spaces is one argument: quote it, --set '" + value + " " + next + "')";
+  }
+  return "";
+}
+
 int main(int argc, char** argv) {
   using namespace hairgen::cli;
   CLI::App app{
@@ -79,8 +93,10 @@ int main(int argc, char** argv) {
   } catch (const CLI::ParseError& e) {
     std::string where = "hairgen";
     for (const CLI::App* sub : app.get_subcommands()) where += " " + sub->get_name();
-    std::cerr << where << ": error: " << e.what() << "\n"
-              << "Run '" << where << " --help' for usage.\n";
+    // One line, as every error: what is wrong, a hint where a --set value was split by the shell, and
+    // where the usage is.
+    std::cerr << where << ": error: " << e.what() << setHint(e.what(), argc, argv) << "; run '" << where
+              << " --help' for usage\n";
     return 2;
   }
   return exitCode;

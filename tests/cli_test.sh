@@ -54,6 +54,12 @@ help)
   ;;
 usage)
   expect_rc 2 "$hairgen"
+  # A usage error is one line; a --set value the shell split, or one without '=', says how to write it.
+  expect_rc 2 "$hairgen" check "$src/configs/default/setup.txt" --set Render.Resolution=320 320
+  expect_err "quote it, --set 'Render.Resolution=320 320'"
+  [ "$(wc -l <"$tmp/err")" -eq 1 ] || fail "the usage error is not one line: $(cat "$tmp/err")"
+  expect_rc 2 "$hairgen" check "$src/configs/default/setup.txt" --set Hairstyle.HairDensity 20
+  expect_err "--set takes KEY=VALUE as one argument: --set 'Hairstyle.HairDensity=20'"
   expect_rc 2 "$hairgen" frobnicate
   expect_err "unknown command 'frobnicate'; the commands are run, grow,"
   expect_rc 2 "$hairgen" gorw setup.txt -o g.hair
