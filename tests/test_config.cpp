@@ -257,7 +257,14 @@ TEST(ConfigErrors, SetupNamingMissingFileNamesSetupLine) {
   std::ofstream(dir / "hair.txt") << "HairLengths 0.1\n";
   std::string m = inputError([&] { loadConfig(dir / "setup.txt", {}, SetupUse::kGrow); });
   EXPECT_NE(m.find("setup.txt:3:"), std::string::npos) << m;
-  EXPECT_NE(m.find("does not exist"), std::string::npos) << m;
+  EXPECT_NE(m.find("does not exist (paths are relative to the file that names them)"), std::string::npos)
+      << m;
+  // A path given with --set is the command line's: relative to the current folder, and said so.
+  m = inputError([&] {
+    loadConfig(dir / "setup.txt", {parseOverride("Setup.WickModel=also-missing.obj")}, SetupUse::kGrow);
+  });
+  EXPECT_NE(m.find("does not exist (a --set path is relative to the current folder)"), std::string::npos)
+      << m;
 }
 
 TEST(Config, KeysAreCaseInsensitiveCommentsAndQuotesWork) {

@@ -16,9 +16,11 @@ ConfigText emptyText(const std::filesystem::path& setupFile, const char* what) {
 void requireExisting(const PathRef& ref, const char* key) {
   std::error_code ec;
   if (!std::filesystem::exists(ref.path, ec))
-    throw InputError(ref.where,
-                     std::string(key) + " names '" + ref.path.string() +
-                         "', which does not exist (paths are relative to the file that names them)");
+    throw InputError(ref.where, std::string(key) + " names '" + ref.path.string() +
+                                    "', which does not exist (" +
+                                    (ref.where.line == 0 ? "a --set path is relative to the current folder"
+                                                         : "paths are relative to the file that names them") +
+                                    ")");
   if (std::filesystem::is_directory(ref.path, ec))
     throw InputError(ref.where,
                      std::string(key) + " names '" + ref.path.string() + "', which is a directory");
