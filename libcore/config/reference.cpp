@@ -18,7 +18,8 @@ std::string cell(const std::string& text) {
 std::string keyReference(const SectionList& sections) {
   std::string out =
       "# Config keys\n\n"
-      "Every key hairgen reads, generated from its declaration (`libcore/config/keys.cpp`) by `hairgen check "
+      "Every key hairgen reads, generated from its declaration (`libcore/config/keys_SECTION.cpp`) by "
+      "`hairgen check "
       "--keys`;\n`scripts/config-keys.sh` rewrites this file, and the build fails when it is stale. Keys are "
       "case-insensitive,\n`#` starts a comment, paths are relative to the file that names them, and any "
       "value "
