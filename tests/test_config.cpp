@@ -216,6 +216,10 @@ TEST(ConfigErrors, OutOfRangeSaysTheRange) {
   EXPECT_NE(
       inputError([] { readHairstyle(text("HairLengths 0.1\nHairDensity -1\n"), {}); }).find("out of range"),
       std::string::npos);
+  // A --set value with a control character (an escape sequence) is said to be one, not a config file.
+  m = inputError([] { parseOverride("Hairstyle.Seed=\x1b[2J"); });
+  EXPECT_NE(m.find("holds a control character (byte 27); a --set value is printable text"), std::string::npos)
+      << m;
   // Past the ±1e300 every value keeps to, the message says so (it used to say only "> 0 Pa").
   m = inputError([] { readHairstyle(text("HairLengths 0.1\nYoung 1e308\n"), {}); });
   EXPECT_NE(m.find("it must be > 0 Pa and within ±1e300"), std::string::npos) << m;

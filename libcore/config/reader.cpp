@@ -109,6 +109,11 @@ ConfigText readConfigText(const std::filesystem::path& file) {
 
 Override parseOverride(std::string_view argument, const SectionList& sections) {
   FileLoc where{"--set " + std::string(argument), 0};
+  for (const char c : argument)
+    if (static_cast<unsigned char>(c) < 0x20 || c == 0x7f)
+      throw InputError(where, "holds a control character (byte " +
+                                  std::to_string(static_cast<unsigned char>(c)) +
+                                  "); a --set value is printable text");
   size_t dot = argument.find('.');
   size_t eq = argument.find('=');
   if (dot == std::string_view::npos || eq == std::string_view::npos || dot > eq)
