@@ -529,7 +529,8 @@ std::vector<WorkEstimate> estimateRun(const Config& config, const Mesh& wick, bo
   const size_t points = pointsPerGuide(style);
   std::vector<WorkEstimate> out = {estimateGrow(style, config.collision, wick.vertexCount(), threads),
                                    estimateInterpolate(style, area, wick.triangleCount(), points)};
-  const double strands = std::min(area * style.hairDensity + double(wick.triangleCount()), 1e18);
+  // Rounded as interpolate's estimate says it, so the stages name the same count.
+  const double strands = std::round(std::min(area * style.hairDensity + double(wick.triangleCount()), 1e18));
   const double coupePoints = std::min(strands * double(points), 1e18);
   // The hair reaches at most its length beyond the wick.
   const Bounds box = bounds(wick.positions);
