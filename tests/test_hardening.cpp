@@ -282,6 +282,12 @@ TEST(Hardening, AFailedCommandPutsBackWhatItWroteOver) {
   std::set<std::string> left;
   for (const fs::path& p : fs::directory_iterator(dir.path())) left.insert(p.filename().string());
   EXPECT_EQ(left, (std::set<std::string>{"coupe.hair", "link.json", "notes.txt"}));
+  // The same name written twice by one command (an in-place sequence's shared --stats, say): the first
+  // file is put back, then what was there before both.
+  writeFileAtomic(input, std::string("first"));
+  writeFileAtomic(input, std::string("second"));
+  discardCommittedOutputs();
+  EXPECT_EQ(slurp(input), "the user's coupe");
   // Kept: the new file stays and no backup is left beside it.
   writeFileAtomic(input, std::string("kept"));
   keepCommittedOutputs();
@@ -293,30 +299,48 @@ TEST(Hardening, AFailedCommandPutsBackWhatItWroteOver) {
   forgetCommittedOutputs();
 }
 
-// A library opens its file by name: the file lies in a folder of this process's own (mode 0700), so no
-// one else can swap it for a link between its creation and the library's opening it; the folder is gone
+// A library opens its file by name: the file lies in a folder of this process's own (mode 0700), held
+// open and named to the library through its descriptor (/proc/PID/fd/N/NAME), so no one can swap the
+// file, or the folder, for a link between its creation and the library's opening it; the folder is gone
 // after, and a name near the 255-byte limit of a folder entry is written as any other.
 TEST(Hardening, AWriteByNameIsInAPrivateFolder) {
   test::TempDir dir("hardening");
   const fs::path target = dir.path() / (std::string(250, 'x') + ".exr");
-  fs::path seen;
   writeThroughTemporary(target, [&](const fs::path& file) {
-    seen = file;
     struct stat st {};
-    ASSERT_EQ(::lstat(file.parent_path().c_str(), &st), 0);
+    ASSERT_EQ(::stat(file.parent_path().c_str(), &st), 0);
     EXPECT_TRUE(S_ISDIR(st.st_mode));
     EXPECT_EQ(st.st_mode & 0777, 0700u);
-    EXPECT_EQ(st.st_uid, ::getuid());
-    EXPECT_EQ(file.parent_path().parent_path(), dir.path());
+    EXPECT_EQ(st.st_uid, ::geteuid());
+    EXPECT_EQ(fs::read_symlink(file.parent_path()).parent_path(), dir.path());
     EXPECT_EQ(file.filename(), target.filename());  // the extension a library may choose its format by
     spit(file, "pixels");
   });
   EXPECT_EQ(slurp(target), "pixels");
-  EXPECT_FALSE(fs::exists(seen.parent_path()));
   writeFileAtomic(dir.path() / (std::string(248, 'y') + ".hair"), std::string("strands"));
   size_t entries = 0;
   for ([[maybe_unused]] const fs::path& p : fs::directory_iterator(dir.path())) ++entries;
-  EXPECT_EQ(entries, 2u);
+  EXPECT_EQ(entries, 2u);  // no private folder left
+}
+
+// The review's attack: while the library writes, someone renames the private folder away and puts a link
+// to a user's folder at its name. Nothing reaches the user's folder: the write, the rename into place
+// and the cleanup all go through the folder's descriptor.
+TEST(Hardening, AFolderSwappedForALinkDuringAWriteByNameTouchesNothingBehindIt) {
+  test::TempDir dir("hardening");
+  const fs::path victim = dir.path() / "victim", target = dir.path() / "beauty.exr";
+  fs::create_directories(victim);
+  spit(victim / "notes.txt", "notes");
+  spit(victim / "beauty.exr", "the user's");
+  writeThroughTemporary(target, [&](const fs::path& file) {
+    const fs::path folder = fs::read_symlink(file.parent_path());
+    fs::rename(folder, dir.path() / "aside");
+    fs::create_directory_symlink(victim, folder);
+    spit(file, "pixels");
+  });
+  EXPECT_EQ(slurp(target), "pixels");
+  EXPECT_EQ(slurp(victim / "notes.txt"), "notes");
+  EXPECT_EQ(slurp(victim / "beauty.exr"), "the user's");
 }
 
 // ---------------------------------------------------------------------------------------------- inputs

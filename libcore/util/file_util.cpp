@@ -1,5 +1,6 @@
 #include "libcore/util/file_util.h"
 
+#include <dirent.h>
 #include <fcntl.h>
 #include <signal.h>
 #include <sys/stat.h>
@@ -44,21 +45,16 @@ Container readWhole(const fs::path& path) {
 // this process made (signal_slots.h).
 struct TemporaryPath {
   char path[4096];
-  bool inFolder;  // the file lies in a private folder of this process's, removed with it
 };
 SignalSlots<TemporaryPath, 256> gTemporaries;
 
 // Reserves a slot for `path` (being filled: the cleanup leaves it alone until markLive); −1 when every
-// slot is taken (the write still happens, only a signal does not clean it). `inFolder`: the path's folder
-// is a private one (createPrivateTemporary), removed after the file.
-int reserveTemporary(const fs::path& path, bool inFolder = false) {
+// slot is taken (the write still happens, only a signal does not clean it).
+int reserveTemporary(const fs::path& path) {
   const std::string text = path.string();
   if (text.size() >= sizeof(TemporaryPath::path)) return -1;
   const int slot = gTemporaries.claim();
-  if (slot >= 0) {
-    std::memcpy(gTemporaries[slot].path, text.c_str(), text.size() + 1);
-    gTemporaries[slot].inFolder = inFolder;
-  }
+  if (slot >= 0) std::memcpy(gTemporaries[slot].path, text.c_str(), text.size() + 1);
   return slot;
 }
 
@@ -72,16 +68,9 @@ void releaseTemporary(int slot) {
 }
 
 extern "C" void removeTemporariesAndExit(int signal) {
-  gTemporaries.forEachLive([](const TemporaryPath& t) {
-    ::unlink(t.path);
-    if (!t.inFolder) return;
-    char folder[sizeof t.path];
-    std::memcpy(folder, t.path, sizeof folder);
-    char* slash = std::strrchr(folder, '/');
-    if (slash == nullptr) return;
-    *slash = '\0';
-    ::rmdir(folder);  // empty now, unless the library left more there: then a later write sweeps it
-  });
+  // A private temporary's path goes through its folder's descriptor (/proc/PID/fd/N/NAME): its empty
+  // folder stays, for a later write beside it to sweep.
+  gTemporaries.forEachLive([](const TemporaryPath& t) { ::unlink(t.path); });
   ::_exit(128 + signal);
 }
 
@@ -258,6 +247,22 @@ fs::path nextTemporaryName(const fs::path& target, const std::string& prefix) {
   return path;
 }
 
+// Removes what lies in a folder held open as `folderFd` (what a library left there too, through the
+// descriptor: never a name, never a link followed; folders within are left), then closes it.
+void emptyAndClose(int folderFd) {
+  const int listing = ::dup(folderFd);
+  if (DIR* d = listing >= 0 ? ::fdopendir(listing) : nullptr) {
+    while (const dirent* e = ::readdir(d)) {
+      const std::string name = e->d_name;
+      if (name != "." && name != "..") ::unlinkat(folderFd, name.c_str(), 0);  // a folder: EISDIR, left
+    }
+    ::closedir(d);
+  } else if (listing >= 0) {
+    ::close(listing);
+  }
+  ::close(folderFd);
+}
+
 // Removes temporaries beside `target` that a process of this host left when it died (a kill -9, a
 // lost node): regular files, and the private folders of writes by name (createPrivateTemporary), named
 // NAME.tmp-HOST-PID-N whose PID no longer runs.
@@ -269,7 +274,9 @@ void sweepStaleTemporaries(const fs::path& target, const std::string& prefix) {
     if (name.compare(0, prefix.size(), prefix) != 0) continue;
     const std::string rest = name.substr(prefix.size());  // PID-N
     const size_t dash = rest.find('-');
-    if (dash == std::string::npos) continue;
+    if (dash == std::string::npos || dash + 1 == rest.size() ||
+        rest.find_first_not_of("0123456789", dash + 1) != std::string::npos)
+      continue;  // not a name this code makes
     char* parsed = nullptr;
     const long pid = std::strtol(rest.c_str(), &parsed, 10);
     if (parsed != rest.c_str() + dash || pid <= 0) continue;
@@ -278,11 +285,18 @@ void sweepStaleTemporaries(const fs::path& target, const std::string& prefix) {
     const fs::file_status status = it->symlink_status(ignored);
     if (fs::is_regular_file(status)) {
       fs::remove(it->path(), ignored);
-    } else if (fs::is_directory(status)) {  // a private folder: its entries (never followed), then it
-      for (fs::directory_iterator inside(it->path(), ignored), last; !ignored && inside != last;
-           inside.increment(ignored))
-        fs::remove(inside->path(), ignored);
-      fs::remove(it->path(), ignored);
+    } else if (fs::is_directory(status)) {
+      // A private folder: opened without following a link, and emptied through the descriptor, only
+      // where it is this user's and private, as this code makes it.
+      const int folderFd = ::open(it->path().c_str(), O_RDONLY | O_DIRECTORY | O_NOFOLLOW | O_CLOEXEC);
+      struct stat st {};
+      if (folderFd < 0) continue;
+      if (::fstat(folderFd, &st) != 0 || st.st_uid != ::geteuid() || (st.st_mode & 0077) != 0) {
+        ::close(folderFd);
+        continue;
+      }
+      emptyAndClose(folderFd);
+      ::rmdir(it->path().c_str());
     }
   }
 }
@@ -292,6 +306,10 @@ struct Temporary {
   fs::path path;
   int fd = -1;
   int slot = -1;  // its entry in the interrupt cleanup table
+  // A private temporary's (createPrivateTemporary): its folder, held open, its name, the file's name.
+  int folderFd = -1;
+  fs::path folder;
+  std::string leaf;
 };
 
 // Creates a fresh temporary beside `target` (the folders on the way made, never through a dangling
@@ -345,29 +363,46 @@ Temporary createPrivateTemporary(const fs::path& target) {
         throw IoError({target.string(), 0}, std::string("cannot write: ") + std::strerror(error));
       continue;
     }
+    // Held open from now on and reached only through its descriptor: its name may be renamed away and
+    // replaced by a link to someone's folder (a folder others may write in allows that), and nothing
+    // here reads or writes through the name again but an rmdir, which removes only an empty folder and
+    // never follows a link.
     Temporary t;
-    t.path = folder / target.filename();
-    t.slot = reserveTemporary(t.path, true);
-    t.fd = ::open(t.path.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_NOFOLLOW | O_CLOEXEC, 0666);
-    if (t.fd >= 0) {
+    t.folder = folder;
+    t.folderFd = ::open(folder.c_str(), O_RDONLY | O_DIRECTORY | O_NOFOLLOW | O_CLOEXEC);
+    struct stat st {};
+    if (t.folderFd < 0 || ::fstat(t.folderFd, &st) != 0 || st.st_uid != ::geteuid() ||
+        (st.st_mode & 0077) != 0) {
+      const int error = t.folderFd < 0 ? errno : EPERM;
+      if (t.folderFd >= 0) ::close(t.folderFd);
+      throw IoError({target.string(), 0}, "cannot write: the private folder " + folder.string() +
+                                              " was replaced before it was opened (" + std::strerror(error) +
+                                              ")");
+    }
+    t.leaf = target.filename().string();
+    // The library opens the file by a name that goes through the descriptor (this process's, so a child
+    // such as ffmpeg reaches it too).
+    t.path = fs::path("/proc") / std::to_string(::getpid()) / "fd" / std::to_string(t.folderFd) / t.leaf;
+    t.slot = reserveTemporary(t.path);
+    t.fd = ::openat(t.folderFd, t.leaf.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_NOFOLLOW | O_CLOEXEC, 0666);
+    if (t.fd >= 0 && ::access(t.path.c_str(), W_OK) == 0) {
       markLive(t.slot);
       return t;
     }
-    const int error = errno;
+    const int error = t.fd < 0 ? errno : ENOENT;  // no /proc: the descriptor's name cannot be given
+    if (t.fd >= 0) ::close(t.fd);
     releaseTemporary(t.slot);
+    ::unlinkat(t.folderFd, t.leaf.c_str(), 0);
+    ::close(t.folderFd);
     ::rmdir(folder.c_str());
     throw IoError({target.string(), 0}, std::string("cannot write: ") + std::strerror(error));
   }
 }
 
-// Removes a private temporary's file and its folder (what the library left there too, never followed).
+// Removes a private temporary's file and its folder.
 void removePrivateTemporary(const Temporary& t) {
-  ::unlink(t.path.c_str());
-  std::error_code ignored;
-  const fs::path folder = t.path.parent_path();
-  for (fs::directory_iterator it(folder, ignored), end; !ignored && it != end; it.increment(ignored))
-    fs::remove(it->path(), ignored);
-  ::rmdir(folder.c_str());
+  emptyAndClose(t.folderFd);
+  ::rmdir(t.folder.c_str());  // only if empty, and never through a link: at worst one stays
 }
 
 // A committed file named `target` that is the file `st` describes.
@@ -470,13 +505,18 @@ constexpr auto kFifoReaderWait = std::chrono::seconds(10);
 // IoError, not a wait for a reader that may never come; what is open is then written with blocking
 // writes.
 int openDirect(const fs::path& device, const fs::path& name) {
+  struct stat st {};
+  if (::stat(device.c_str(), &st) == 0 && S_ISSOCK(st.st_mode))
+    throw IoError({name.string(), 0},
+                  "cannot write: it is a socket; hairgen writes files, devices and FIFOs");
+  const bool fifo = S_ISFIFO(st.st_mode);
   const auto giveUp = std::chrono::steady_clock::now() + kFifoReaderWait;
   int fd = -1;
-  while ((fd = ::open(device.c_str(), O_WRONLY | O_NONBLOCK | O_CLOEXEC)) < 0 && errno == ENXIO &&
+  while ((fd = ::open(device.c_str(), O_WRONLY | O_NONBLOCK | O_CLOEXEC)) < 0 && errno == ENXIO && fifo &&
          std::chrono::steady_clock::now() < giveUp)
     std::this_thread::sleep_for(std::chrono::milliseconds(10));  // ENXIO: a FIFO with no reader yet
   if (fd < 0) {
-    if (errno == ENXIO)
+    if (errno == ENXIO && fifo)
       throw IoError({name.string(), 0},
                     "cannot write: it is a FIFO (a named pipe) that no process opened to read "
                     "within " +
@@ -806,8 +846,13 @@ void discardCommittedOutputs() {
   for (size_t i = gCommitted.size(); i > gKept; --i) {
     Committed& file = gCommitted[i - 1];
     struct stat st {};
-    const bool ours = ::lstat(file.path.c_str(), &st) == 0 && S_ISREG(st.st_mode) &&
-                      st.st_dev == file.device && st.st_ino == file.inode;
+    // The name holds this commit's file, or a later commit's of this process at the same name (one
+    // that could keep no backup of this one's): either way this commit's backup is what was there.
+    bool ours = false;
+    if (::lstat(file.path.c_str(), &st) == 0 && S_ISREG(st.st_mode))
+      for (size_t k = i - 1; k < gCommitted.size() && !ours; ++k)
+        ours = gCommitted[k].path == file.path && st.st_dev == gCommitted[k].device &&
+               st.st_ino == gCommitted[k].inode;
     if (ours && !file.backup.empty()) {
       // Put back; should the rename fail, the old file stays under the backup's name, never removed.
       ::rename(file.backup.c_str(), file.path.c_str());
