@@ -113,6 +113,16 @@ void requireNoLinksInPlan(const FarmPlan& plan, const std::string& planFile) {
   };
   check(plan.directory + "/slurm", true, "submit's scripts");
   check(plan.directory + "/logs", true, "submit's logs");
+  // What submit (and Slurm, for a task's log, which it opens following links) writes in them: no entry
+  // may be a link either.
+  for (const char* folder : {"/slurm", "/logs"}) {
+    std::error_code ec;
+    for (fs::directory_iterator it(plan.directory + folder, ec), end; !ec && it != end; it.increment(ec))
+      if (it->is_symlink(ec))
+        throw InputError({planFile, 0}, it->path().string() +
+                                            " is a symbolic link; submit and Slurm write there, and a plan's "
+                                            "files lie in its folder itself, not behind links");
+  }
   const auto inside = [&](const std::string& p) {
     return p.size() > plan.directory.size() + 1 && p.compare(0, plan.directory.size(), plan.directory) == 0 &&
            p[plan.directory.size()] == '/';

@@ -248,6 +248,12 @@ planted_files)
   expect_err "$tmp/p/shards is a symbolic link"
   [ -z "$(ls "$tmp/victim2")" ] || fail "a task wrote through a link in the plan's folder"
   rm "$tmp/p/shards"
+  # A task's log named as a link to a user's file (Slurm opens it following links, and truncates it).
+  mkdir "$tmp/p/logs"
+  ln -s "$tmp/victim/grow.sh" "$tmp/p/logs/render.log"
+  expect_rc 2 "$hairgen" farm submit "$tmp/p/plan.json" --scheduler slurm --dry-run
+  expect_err "$tmp/p/logs/render.log is a symbolic link"
+  rm "$tmp/p/logs/render.log"
   expect_rc 0 "$hairgen" farm submit "$tmp/p/plan.json" --scheduler slurm --wait
   [ -s "$tmp/p/beauty.exr" ] || fail "the plan without links did not run"
   ;;
