@@ -90,6 +90,9 @@ config_errors)
   : > "$tmp/empty.txt"
   expect_rc 2 "$hairgen" check "$tmp/empty.txt"
   expect_err "missing required key 'HairstyleInfo'"
+  # A Setup for render --hair alone (a Render Info and a head, no wick) is checked as a render's.
+  printf 'RenderInfo %s\nHeadModel %s\n' "$src/configs/default/render.txt" "$src/configs/assets/head.obj" > "$tmp/render.txt"
+  expect_rc 0 "$hairgen" check "$tmp/render.txt"
   printf 'not hair\n' > "$tmp/coupe.hair"
   expect_rc 2 "$hairgen" check "$src/configs/default/setup.txt" --set Setup.Load=true --set "Setup.LoadFile=$tmp/coupe.hair"
   expect_err "$tmp/coupe.hair"

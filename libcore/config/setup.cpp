@@ -33,9 +33,16 @@ Config loadConfig(const std::filesystem::path& setupFile, const std::vector<Over
   Config config;
   config.setup = readSetup(readConfigText(setupFile), overrides);
   const Setup& s = config.setup;
-  // check judges the Setup as run reads it: an empty Setup, or one without a Hairstyle Info, is no job.
+  // check judges a Setup as run reads it where it grows (it names a wick or a Hairstyle Info) or names
+  // nothing at all (an empty file is no job); one that names neither, but a Render Info or a head, is a
+  // render's (`render --hair`), and check takes it as such.
+  const bool namesAnything = s.hairstyleInfo.given() || s.wickModel.given() || s.renderInfo.given() ||
+                             s.visualityInfo.given() || s.collisionInfo.given() || s.dynamicsInfo.given() ||
+                             s.headModel.given();
+  const bool checkedAsRun = use == SetupUse::kCheck && !s.load &&
+                            (s.hairstyleInfo.given() || s.wickModel.given() || !namesAnything);
   bool grows = use == SetupUse::kGrow || use == SetupUse::kInterpolate ||
-               ((use == SetupUse::kRun || use == SetupUse::kCheck) && !s.load);
+               (use == SetupUse::kRun && !s.load) || checkedAsRun;
 
   auto need = [&](const PathRef& ref, const char* key, const char* why) {
     if (!ref.given())
