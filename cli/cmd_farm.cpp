@@ -117,11 +117,15 @@ void requireNoLinksInPlan(const FarmPlan& plan, const std::string& planFile) {
   // may be a link either.
   for (const char* folder : {"/slurm", "/logs"}) {
     std::error_code ec;
-    for (fs::directory_iterator it(plan.directory + folder, ec), end; !ec && it != end; it.increment(ec))
+    fs::directory_iterator it(plan.directory + folder, ec), end;
+    for (; !ec && it != end; it.increment(ec))
       if (it->is_symlink(ec))
         throw InputError({planFile, 0}, it->path().string() +
                                             " is a symbolic link; submit and Slurm write there, and a plan's "
                                             "files lie in its folder itself, not behind links");
+    if (ec && ec != std::errc::no_such_file_or_directory)  // one it cannot list may hide a link
+      throw InputError({planFile, 0}, plan.directory + folder + " cannot be listed (" + ec.message() +
+                                          "); submit checks what it and Slurm write there");
   }
   const auto inside = [&](const std::string& p) {
     return p.size() > plan.directory.size() + 1 && p.compare(0, plan.directory.size(), plan.directory) == 0 &&

@@ -1082,6 +1082,7 @@ TEST(Render, ACustomStageTooLargeForACompilerIsRefusedAtItsLine) {
   refusedAt(twice + "float y = TWICE(TWICE(HALF));\n", "f.glsl:4: the function-like macro TWICE");
   refusedAt(twice + "#define FOUR(a) TWICE(TWICE(a))\n", "f.glsl:4: #define FOUR(...) uses");
   refusedAt(twice + "#define G TWICE\nfloat y = G(G(1.0));\n", "f.glsl:5: the function-like macro G");
+  refusedAt("#define CAT(a, b) a##b\n", "f.glsl:1: ## (token pasting)");
   std::string many = "#define MANY(a) (a";
   for (int i = 0; i < 600; ++i) many += " + a";
   many += ")\n";

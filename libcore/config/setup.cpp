@@ -38,7 +38,8 @@ Config loadConfig(const std::filesystem::path& setupFile, const std::vector<Over
   // render's (`render --hair`), and check takes it as such.
   const bool namesAnything = s.hairstyleInfo.given() || s.wickModel.given() || s.renderInfo.given() ||
                              s.visualityInfo.given() || s.collisionInfo.given() || s.dynamicsInfo.given() ||
-                             s.headModel.given();
+                             s.headModel.given() || s.hairVert.given() || s.hairFrag.given() ||
+                             s.headVert.given() || s.headFrag.given();
   const bool checkedAsRun = use == SetupUse::kCheck && !s.load &&
                             (s.hairstyleInfo.given() || s.wickModel.given() || !namesAnything);
   bool grows = use == SetupUse::kGrow || use == SetupUse::kInterpolate ||

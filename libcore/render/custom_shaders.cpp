@@ -128,7 +128,15 @@ class Bounds {
     std::vector<Token> code;
     std::vector<std::vector<Token>> directives;
     tokenise(stage_.text, code, directives);
-    for (const std::vector<Token>& d : directives) define(d);
+    for (const std::vector<Token>& d : directives) {
+      // Token pasting makes names the bound cannot see (a call built as CAT(f, 0)): refused.
+      for (size_t k = 0; k + 1 < d.size(); ++k)
+        if (d[k].text == "#" && d[k + 1].text == "#" && d[k + 1].end == d[k].end + 1)
+          fail(d[k].line,
+               "## (token pasting) in a custom stage: it builds names hairgen's bound on the "
+               "compiler's work cannot follow; write the names out");
+      define(d);
+    }
     for (auto& [name, m] : macros_) cost(name, m);
     statements(code);
     functions(code);

@@ -295,7 +295,10 @@ void sweepStaleTemporaries(const fs::path& target, const std::string& prefix) {
         ::close(folderFd);
         continue;
       }
-      emptyAndClose(folderFd);
+      // Only the one file this code makes there (named as the target): a folder of the user's that
+      // someone renamed to this name keeps everything else, and stays.
+      ::unlinkat(folderFd, target.filename().c_str(), 0);
+      ::close(folderFd);
       ::rmdir(it->path().c_str());
     }
   }
@@ -809,12 +812,12 @@ void writeThroughTemporary(const fs::path& target, const std::function<void(cons
       commitInto(temporary.path, destination.path, committedAs(destination.path, st));
     }
   } catch (...) {
+    releaseTemporary(temporary.slot);  // before its descriptor's number can be another's
     removePrivateTemporary(temporary);
-    releaseTemporary(temporary.slot);
     throw;
   }
-  removePrivateTemporary(temporary);  // the folder, now empty (the file was renamed or copied)
   releaseTemporary(temporary.slot);
+  removePrivateTemporary(temporary);  // the folder, now empty (the file was renamed or copied)
 }
 
 void writeFileAtomic(const fs::path& target, const void* data, size_t size) {
