@@ -127,17 +127,13 @@ void requireNoLinksInPlan(const FarmPlan& plan, const std::string& planFile) {
       throw InputError({planFile, 0}, plan.directory + folder + " cannot be listed (" + ec.message() +
                                           "); submit checks what it and Slurm write there");
   }
-  const auto inside = [&](const std::string& p) {
-    return p.size() > plan.directory.size() + 1 && p.compare(0, plan.directory.size(), plan.directory) == 0 &&
-           p[plan.directory.size()] == '/';
-  };
   for (const FarmTask& t : plan.tasks) {
     const std::string task = "task \"" + t.id + "\":";
     for (const std::string& o : t.outputs) check(o, false, task + " output");
     for (const std::string& i : t.inputs)
-      if (inside(i)) check(i, true, task + " input");
+      if (isInsideFolder(i, plan.directory)) check(i, true, task + " input");
     for (size_t k = 2; k < t.command.size(); ++k)
-      if (inside(t.command[k]))
+      if (isInsideFolder(t.command[k], plan.directory))
         check(t.command[k],
               t.command[k - 1] != "-o" && t.command[k - 1] != "--preview" && t.command[k - 1] != "--gif",
               task + " command path");

@@ -105,6 +105,10 @@ void checkFarmFrames(const FrameRange& frames, const std::string& what);
 // Throws InputError naming `name` (the plan file) and the task for anything the rules above refuse.
 void validateFarmPlan(const FarmPlan& plan, const std::string& name);
 
+// Whether `path` (absolute, normal) lies strictly inside the folder `dir` (absolute, normal), by its text:
+// the rule validateFarmPlan applies to a plan's paths.
+bool isInsideFolder(const std::string& path, const std::string& dir);
+
 // A task's job array index, N of an id GROUP.N; 0 for a group's only task (its id the group's name).
 // For a task of a valid plan.
 int farmArrayIndex(const FarmTask& task);

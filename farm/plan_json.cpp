@@ -65,10 +65,6 @@ bool isNormalAbsolute(const std::string& path) {
          std::filesystem::path(path).lexically_normal().string() == path;
 }
 
-bool isInside(const std::string& path, const std::string& dir) {
-  return path.size() > dir.size() + 1 && path.compare(0, dir.size(), dir) == 0 && path[dir.size()] == '/';
-}
-
 // The basename of an executable a plan may run: "hairgen", or "hairgen-" / "hairgen." and a suffix of
 // letters, digits, '.', '_', '-' (a versioned or sanitizer build).
 bool isHairgenName(const std::string& name) {
@@ -141,11 +137,11 @@ class PlanRules {
                   " holds a control character (a newline, CR, NUL or the like)");
     if (mayBeSetup && p == plan_.setup) return;
     const std::string& dir = plan_.directory;
-    if (!isNormalAbsolute(p) || !isInside(p, dir))
+    if (!isNormalAbsolute(p) || !isInsideFolder(p, dir))
       fail(t, std::string(what) + " " + shown(p) +
                   " is not an absolute, normal path inside the plan's directory " + shown(dir) +
                   (mayBeSetup ? " (nor the plan's Setup)" : ""));
-    if (p == dir + "/plan.json" || isInside(p, dir + "/slurm") || isInside(p, dir + "/logs") ||
+    if (p == dir + "/plan.json" || isInsideFolder(p, dir + "/slurm") || isInsideFolder(p, dir + "/logs") ||
         p == dir + "/slurm" || p == dir + "/logs")
       fail(t, std::string(what) + " " + shown(p) +
                   " is the plan file or in slurm/ or logs/, which farm submit writes");
@@ -275,6 +271,10 @@ void checkFarmFrames(const FrameRange& frames, const std::string& what) {
     throw InputError(what + " " + range + ": " + std::to_string(count) +
                      " frames; a farm plan holds at most " + std::to_string(kFarmMaxFrames) +
                      " (plan the shot in parts)");
+}
+
+bool isInsideFolder(const std::string& path, const std::string& dir) {
+  return path.size() > dir.size() + 1 && path.compare(0, dir.size(), dir) == 0 && path[dir.size()] == '/';
 }
 
 void validateFarmPlan(const FarmPlan& plan, const std::string& name) {
