@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <complex>
 #include <vector>
 
 #include "libcore/physics/head_motion.h"
@@ -160,12 +161,13 @@ TEST(SpringsMechanics, AHangingChainAtTheShotsSubstepsNeverFolds) {
       }
 }
 
-// With Damping 0 nothing takes energy out of a free vibration: a hanging hair (10 cm, its own bending
-// stiffness) started in its first mode keeps at least 0.98 of its amplitude per period at the shots'
-// 4 substeps (before: backward Euler kept 0.754), and gains none at 1-4 (the step's high-frequency
-// damping, SpringHair::kAhead, takes exp(−π · 0.03 · ωΔt) a period: 0.94 at 1 substep). The
-// amplitude is the mode's coordinate (the displacement projected on its shape in the mass inner
-// product, which filters the faster modes the bending stiffness adds), its largest value each period.
+// With Damping 0 nothing takes energy out of a free vibration but the step: a hanging hair (10 cm, its
+// own bending stiffness) started in its first mode keeps 0.99 of its amplitude a period at the shots' 4
+// substeps, and gains none at 1-4. BDF2 (SpringHair's step) loses (ωΔt)⁴/4 a step to second order: 0.993
+// a period at 4 substeps as measured, 0.957 at 2 and 0.80 at 1, where its ωΔt = 0.5 is far from small
+// (before BDF2 the step kept 0.98 at 4 substeps and folded under large loads). The amplitude is the
+// mode's coordinate (the displacement projected on its shape in the mass inner product, which filters
+// the faster modes the bending stiffness adds), its largest value each period.
 TEST(SpringsMechanics, WithoutDampingTheFirstModeKeepsItsAmplitude) {
   const double length = 0.1;
   const int segments = 32;
@@ -190,7 +192,7 @@ TEST(SpringsMechanics, WithoutDampingTheFirstModeKeepsItsAmplitude) {
       amplitude[size_t(n / perPeriod)] = std::max(amplitude[size_t(n / perPeriod)], std::abs(q / norm));
     }
     const double kept = std::pow(amplitude.back() / amplitude.front(), 1.0 / double(periods - 1));
-    EXPECT_GE(kept, substeps == 4 ? 0.98 : 0.9) << substeps << " substeps";
+    EXPECT_GE(kept, substeps == 4 ? 0.99 : substeps == 2 ? 0.95 : 0.78) << substeps << " substeps";
     EXPECT_LE(kept, 1.0 + 1e-3) << substeps << " substeps: energy must not grow";
     RecordProperty("amplitude_per_period_" + std::to_string(substeps), std::to_string(kept));
   }
@@ -198,7 +200,16 @@ TEST(SpringsMechanics, WithoutDampingTheFirstModeKeepsItsAmplitude) {
 
 // A hanging chain of point masses (no bending) has exact discrete modes: the eigenpairs of K u = ω² M u
 // for the tension of the weight below each segment. Started in its first and second mode shapes, at 4
-// substeps (a frame at 24 frames/s), it rings at their periods within 0.5%.
+// substeps (a frame at 24 frames/s), it rings at their periods within 1%, and at the period BDF2 itself
+// gives a mode of that ω within 0.05%: the phase of the larger root ρ of (1 − ⅔iωΔt) ρ² − 4/3 ρ + 1/3
+// (the step's lag, 0.17% and 0.87% for these two modes), so the step is the scheme it says it is.
+double bdf2PeriodRatio(double omegaDt) {
+  const std::complex<double> a(1.0, -2.0 / 3.0 * omegaDt), b(-4.0 / 3.0), c(1.0 / 3.0);
+  const std::complex<double> root = std::sqrt(b * b - 4.0 * a * c);
+  const std::complex<double> r1 = (-b + root) / (2.0 * a), r2 = (-b - root) / (2.0 * a);
+  return omegaDt / std::arg(std::abs(r1) > std::abs(r2) ? r1 : r2);
+}
+
 TEST(SpringsMechanics, AHangingChainRingsAtItsExactDiscreteModes) {
   const double length = 0.3, dt = 1.0 / (kFrameRate * 4);
   const int segments = 32;
@@ -211,9 +222,50 @@ TEST(SpringsMechanics, AHangingChainRingsAtItsExactDiscreteModes) {
         test::downCrossings(tipTrace(hair, dt, int(10.5 * period / dt)), dt);
     ASSERT_GE(crossings.size(), 9u) << "mode " << m;
     const double measured = (crossings.back() - crossings.front()) / double(crossings.size() - 1);
-    EXPECT_NEAR(measured / period, 1.0, 0.005) << "mode " << m << ": " << measured << " s, exact " << period;
+    EXPECT_NEAR(measured / period, 1.0, 0.01) << "mode " << m << ": " << measured << " s, exact " << period;
+    EXPECT_NEAR(measured / period, bdf2PeriodRatio(mode.omega * dt), 5e-4)
+        << "mode " << m << ": " << measured << " s, BDF2's " << period * bdf2PeriodRatio(mode.omega * dt);
     RecordProperty("period_ratio_mode_" + std::to_string(m + 1), std::to_string(measured / period));
   }
+}
+
+// A load of the order of gravity across the hair: a 16 cm hair of 64 segments (its own bending
+// stiffness, Damping 4) hanging still is pushed sideways by (−12, 4, 3) m/s² (the bundled wind's) and
+// settles (3 s: the shapes below do not change from 3 s to 12 s). At the shots' 4 substeps it settles
+// to the shape it takes at 64 within 1.5 mm at every point (measured 0.99 mm), its largest joint turn
+// within 6° of that one's (12.9° and 8.8°). What remains is the splitting's: the stretch projection
+// comes after the implicit solve, so the equilibrium balances the constraint forces against
+// M (M + (4/9)Δt²K)⁻¹ f rather than f. Before BDF2 the step folded a joint 146° at 4 substeps and
+// stopped: its fast bending modes rang at the step's own frequency and the projection fed them.
+TEST(SpringsMechanics, AHairInASideLoadSettlesToTheSameShapeAtAnySubsteps) {
+  const double length = 0.16;
+  const int segments = 64;
+  auto settled = [&](int substeps, double& largestTurn) {
+    Dynamics d = springs(-1.0);
+    d.damping = 4.0;
+    SpringHair hair(hanging(length, segments), style(), d, Collision{}, nullptr);
+    const double dt = 1.0 / (kFrameRate * substeps);
+    tipTrace(hair, dt, 3 * 24 * substeps, {-12.0, 4.0, 3.0});
+    EXPECT_FALSE(hair.fault()) << substeps << " substeps";
+    const std::vector<glm::dvec3>& x = hair.positions();
+    largestTurn = 0.0;
+    for (size_t i = 1; i + 1 < x.size(); ++i)
+      largestTurn = std::max(
+          largestTurn,
+          std::acos(std::clamp(glm::dot(glm::normalize(x[i] - x[i - 1]), glm::normalize(x[i + 1] - x[i])),
+                               -1.0, 1.0)));
+    return x;
+  };
+  double fine = 0.0, coarse = 0.0;
+  const std::vector<glm::dvec3> reference = settled(64, fine), shots = settled(4, coarse);
+  double apart = 0.0;
+  for (size_t i = 0; i < reference.size(); ++i) apart = std::max(apart, glm::length(shots[i] - reference[i]));
+  EXPECT_LT(apart, 1.5e-3) << "the tip " << glm::length(shots.back() - reference.back()) * 1e3 << " mm apart";
+  EXPECT_LT(coarse, fine + glm::radians(6.0))
+      << glm::degrees(coarse) << "° at 4 substeps, " << glm::degrees(fine) << "° at 64";
+  RecordProperty("largest_turn_4", std::to_string(glm::degrees(coarse)));
+  RecordProperty("largest_turn_64", std::to_string(glm::degrees(fine)));
+  RecordProperty("apart_mm", std::to_string(apart * 1e3));
 }
 
 }  // namespace

@@ -23,6 +23,12 @@ std::optional<SpringSegmentFault> springSegmentFault(const glm::dvec3& start, co
   const double stretch = glm::length(end - start) / restLength - 1.0;
   if (!(std::abs(stretch) <= kMaxSpringStretch))
     return SpringSegmentFault{SpringSegmentFault::kStretch, stretch};
+  return springSpeedFault(velocity);
+}
+
+std::optional<SpringSegmentFault> springSpeedFault(const glm::dvec3& velocity) {
+  if (!std::isfinite(velocity.x) || !std::isfinite(velocity.y) || !std::isfinite(velocity.z))
+    return SpringSegmentFault{};
   const double speed = glm::length(velocity);
   if (!(speed <= kMaxSpringSpeed)) return SpringSegmentFault{SpringSegmentFault::kSpeed, speed};
   return std::nullopt;
@@ -32,6 +38,11 @@ namespace {
 
 void checkSpringState(const Strands& rest, const std::vector<double>& state, const std::string& source) {
   const size_t segments = rest.pointCount() - rest.strandCount();
+  if (segments > 0 && state.size() == segments * 6)
+    throw InputError({source, 0},
+                     "its simulation state is in the layout of an earlier hairgen (6 values a "
+                     "segment, before the BDF2 step; this one keeps " +
+                         std::to_string(kSpringStateValues) + "); simulate from the first frame");
   if (state.size() != segments * kSpringStateValues)
     throw InputError({source, 0}, "its simulation state has " + std::to_string(state.size()) +
                                       " values, and Model springs on these guides keeps " +
@@ -53,7 +64,13 @@ void checkSpringState(const Strands& rest, const std::vector<double>& state, con
       };
       const double restLength =
           glm::length(glm::dvec3(rest.points[p0 + j]) - glm::dvec3(rest.points[p0 + j - 1]));
-      const std::optional<SpringSegmentFault> fault = springSegmentFault(previous, x, velocity, restLength);
+      std::optional<SpringSegmentFault> fault = springSegmentFault(previous, x, velocity, restLength);
+      // The history's velocities (a substep before, the last move) under the velocity's bounds; the
+      // position's fault first.
+      for (int k = 2; k <= 3 && (!fault || fault->kind == SpringSegmentFault::kSpeed); ++k)
+        if (const std::optional<SpringSegmentFault> f =
+                springSpeedFault(glm::dvec3(v[3 * k], v[3 * k + 1], v[3 * k + 2])))
+          if (!fault || f->kind == SpringSegmentFault::kNotFinite) fault = f;
       if (fault && fault->kind == SpringSegmentFault::kNotFinite) refuse("holds a value that is not finite");
       if (!(restLength > 0.0)) refuse("follows a rest segment of no length");  // the guides', not the state's
       if (fault && fault->kind == SpringSegmentFault::kStretch)

@@ -8,7 +8,8 @@
 //
 // The layouts, per model:
 // - springs: per segment (a strand's points after its root, strand by strand), its end point's
-//   position (m) and velocity (m/s) in the head's frame, kSpringStateValues doubles.
+//   position (m), velocity (m/s), velocity a substep before (m/s) and last substep's move over the
+//   substep (m/s: the step's history, spring_dynamics.h) in the head's frame, kSpringStateValues doubles.
 // - anjyo: a header of kAnjyoStateHeader doubles (kAnjyoStateTag, kAnjyoLanes, kAnjyoStateValues, then
 //   zeros), then per block of kAnjyoLanes strands, per segment of the block's longest strand, per value
 //   (θ, φ, their turns over the last substep), the block's lanes as floats, two to a double.
@@ -37,7 +38,9 @@ namespace hairgen {
 // - a point moves at most kMaxSpringSpeed: three times the speed of sound, far past a whip's crack.
 inline constexpr double kMaxSpringStretch = 0.01;
 inline constexpr double kMaxSpringSpeed = 1000.0;  // m/s
-inline constexpr size_t kSpringStateValues = 6;    // per segment: position, velocity
+// Per segment: position, velocity, the velocity before, the last move (12 since the BDF2 step; 6 before,
+// which checkStateValues names as an older hairgen's).
+inline constexpr size_t kSpringStateValues = 12;
 
 // How a springs segment leaves the bounds above: a position or velocity that is not finite, a stretch
 // `value` = length / rest length − 1 past kMaxSpringStretch, or a speed `value` (m/s) past
@@ -53,6 +56,9 @@ struct SpringSegmentFault {
 // of `end` and `velocity`, then the stretch, then the speed; returns the first that fails, or nullopt.
 std::optional<SpringSegmentFault> springSegmentFault(const glm::dvec3& start, const glm::dvec3& end,
                                                      const glm::dvec3& velocity, double restLength);
+// The bounds above on a velocity alone (the state's history: a velocity a substep before, a move over a
+// substep): not finite, or a speed past kMaxSpringSpeed.
+std::optional<SpringSegmentFault> springSpeedFault(const glm::dvec3& velocity);
 
 // Anjyo's layout (anjyo_dynamics.h keeps its state in it) and its bounds: each segment's rotation from
 // its rest direction is at most half a turn, and a turn of more than kMaxAnjyoTurn in a substep is no

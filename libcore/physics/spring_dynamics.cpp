@@ -118,6 +118,8 @@ SpringHair::SpringHair(const Strands& rest, const Hairstyle& style, const Dynami
     for (uint32_t p = rest.firstPoint[st]; p + 1 < rest.firstPoint[st] + rest.pointsOf(st); ++p)
       restUnit_[p] = glm::normalize(xRest_[p + 1] - xRest_[p]);
   v_.assign(points, glm::dvec3(0.0));
+  previousV_.assign(points, glm::dvec3(0.0));
+  lastMove_.assign(points, glm::dvec3(0.0));
   mass_.assign(points, 0.0);
   inverseMass_.assign(points, 0.0);
   length_.assign(points, 0.0);
@@ -300,7 +302,7 @@ double SpringHair::maxStretch() const {
 }
 
 void SpringHair::factor(double dt) {
-  // Per strand, over its free points 1..n: A = M(1 + cΔt/2) + kAhead Δt² K, K = Σ_j k_j B_jᵀ B_j + the
+  // Per strand, over its free points 1..n: A = M(1 + ⅔cΔt) + (4/9) Δt² K, K = Σ_j k_j B_jᵀ B_j + the
   // rest tension's stiffness, pentadiagonal, where row j of B (joint j) has 1/l_{j+1} at point j + 1,
   // −1/l_{j+1} − 1/l_j at j and 1/l_j at j − 1.
   dt_ = dt;
@@ -313,9 +315,9 @@ void SpringHair::factor(double dt) {
     if (count < 2) return;
     const uint32_t n = count - 1;
     std::vector<double> diag(n + 1, 0.0), off1(n + 1, 0.0), off2(n + 1, 0.0);  // (i,i), (i,i+1), (i,i+2)
-    for (uint32_t i = 1; i <= n; ++i) diag[i] = mass_[p0 + i] * (1.0 + 0.5 * damping_ * dt);
-    // kAhead Δt² (¼ would be the trapezoidal rule): stable at any step for the linear forces it carries.
-    const double dt2 = kAhead * dt * dt;
+    for (uint32_t i = 1; i <= n; ++i) diag[i] = mass_[p0 + i] * (1.0 + kTwoThirds * damping_ * dt);
+    // BDF2's (⅔Δt)²: the linear forces at x⁺ = x̂ + ⅔Δt v⁺ over ⅔Δt.
+    const double dt2 = (kTwoThirds * dt) * (kTwoThirds * dt);
     // The rest tension's force −T_j e_j / l_j is linear in the points too: stiffness T_j / l_j between
     // the segment's two ends (the root drops out). Implicit, so a long hanging chain's fast string modes
     // (ω up to 2n √(g/L)) stay stable at any substep.
@@ -526,21 +528,21 @@ void SpringHair::predict(size_t s, const AccelerationField& field, double dt, gl
   thread_local std::vector<double> inverseLength;
   unit.resize(n + 2);
   inverseLength.resize(n + 2);
-  // The linear forces (bending, rest tension) at y = x − kBehind Δt v: f(y) = f(x) + kBehind Δt K v, so
-  // the right-hand side M v + Δt f(x) + kBehind Δt² K v takes one evaluation.
+  // The linear forces (bending, rest tension) at x̂ = x + (Δt/3) w, where BDF2 takes them with
+  // −(2/3) Δt K v⁺ on the left.
   unit[0] = rootDirection_[s];
   inverseLength[n + 1] = 0.0;
-  const double back = kBehind * dt;
+  const double third = dt / 3.0;
   for (uint32_t j = 1; j <= n; ++j) {
     inverseLength[j] = 1.0 / length_[p0 + j];
-    const glm::dvec3 e =
-        (x_[p0 + j] - x_[p0 + j - 1]) - back * (v_[p0 + j] - (j > 1 ? v_[p0 + j - 1] : glm::dvec3(0.0)));
+    const glm::dvec3 e = (x_[p0 + j] - x_[p0 + j - 1]) +
+                         third * (lastMove_[p0 + j] - (j > 1 ? lastMove_[p0 + j - 1] : glm::dvec3(0.0)));
     unit[j] = e * inverseLength[j];
   }
   unit[n + 1] = glm::dvec3(0.0);
   for (uint32_t j = 0; j < n; ++j) turn[j] = bend_[p0 + j] * (target_[p0 + j] - (unit[j + 1] - unit[j]));
   turn[n] = turn[n + 1] = glm::dvec3(0.0);  // no joint at the tip
-  const double keep = 1.0 - 0.5 * damping_ * dt;
+  const double twoThirdsDt = kTwoThirds * dt;
   for (uint32_t i = 1; i <= n; ++i) {
     const uint32_t p = p0 + i;
     // Row i of Bᵀ: joints i − 1, i and i + 1 (turn[n] is 0, and 1/l_{n+1} is 0).
@@ -561,10 +563,10 @@ void SpringHair::predict(size_t s, const AccelerationField& field, double dt, gl
       if (size > 1.0) push /= size;
       f += mass_[p] * densityStrength_ * push;
     }
-    force[i] = (mass_[p] * keep) * v_[p] + dt * f;
+    force[i] = mass_[p] * (kFourThirds * v_[p] - kOneThird * previousV_[p]) + twoThirdsDt * f;
   }
-  // The linear forces at x + kAhead Δt v⁺ − kBehind Δt v, the damping at the mean of v and v⁺:
-  // A v⁺ = M (1 − cΔt/2) v + Δt f(y), A = M (1 + cΔt/2) + kAhead Δt² K = L D Lᵀ.
+  // A v⁺ = M (4/3 v − 1/3 v⁻) + (2/3) Δt f(x̂), A = M (1 + ⅔cΔt) + (4/9) Δt² K = L D Lᵀ (the damping −c M v⁺
+  // and the linear forces at x⁺ implicit).
   for (uint32_t i = 1; i <= n; ++i) {
     const uint32_t p = p0 + i;
     if (i >= 2) force[i] -= lower1_[p] * force[i - 1];
@@ -577,7 +579,7 @@ void SpringHair::predict(size_t s, const AccelerationField& field, double dt, gl
   }
   for (uint32_t i = 1; i <= n; ++i) {
     before[i] = x_[p0 + i];
-    x_[p0 + i] += dt * force[i];
+    x_[p0 + i] += third * lastMove_[p0 + i] + twoThirdsDt * force[i];
   }
 }
 
@@ -613,7 +615,14 @@ bool SpringHair::collide(size_t c, uint32_t p, glm::dvec3& x) const {
 
 void SpringHair::finish(size_t s, double dt, const glm::dvec3* before) {
   const uint32_t p0 = rest_.firstPoint[s], n = rest_.pointsOf(s) - 1;
-  for (uint32_t i = 1; i <= n; ++i) v_[p0 + i] = (x_[p0 + i] - before[i]) / dt;
+  // v⁺ = (3x⁺ − 4x + x⁻)/(2Δt) = 3/2 w⁺ − 1/2 w, from the projected points.
+  for (uint32_t i = 1; i <= n; ++i) {
+    const uint32_t p = p0 + i;
+    const glm::dvec3 move = (x_[p] - before[i]) / dt;
+    previousV_[p] = v_[p];
+    v_[p] = kThreeHalves * move - 0.5 * lastMove_[p];
+    lastMove_[p] = move;
+  }
 }
 
 void SpringHair::stepStrand(size_t s, const AccelerationField& field, double dt) {
@@ -700,8 +709,19 @@ void SpringHair::smoothVelocities(double fraction) {
   tbb::parallel_for(size_t(0), which.size(), [&](size_t k) {
     const size_t p = which[k];
     const glm::dvec3 target(grid.sample(where[k]));
-    v_[p] += fraction * (target - v_[p]);
+    // BDF2's history takes the same change, as if the hair had always moved with it: the extrapolations
+    // of the next step (4/3 v − 1/3 v⁻, x + (Δt/3) w) then see exactly the smoothed velocity.
+    const glm::dvec3 change = fraction * (target - v_[p]);
+    v_[p] += change;
+    previousV_[p] += change;
+    lastMove_[p] += change;
   });
+}
+
+void SpringHair::setMotion(const std::vector<glm::dvec3>& v) {
+  v_ = v;
+  previousV_ = v;
+  lastMove_ = v;
 }
 
 Strands SpringHair::posed(const Pose& pose) const {
@@ -766,6 +786,8 @@ void SpringHair::stateInto(std::vector<double>& out) const {
                           for (int c = 0; c < 3; ++c) {
                             v[c] = x_[p][c];
                             v[3 + c] = v_[p][c];
+                            v[6 + c] = previousV_[p][c];
+                            v[9 + c] = lastMove_[p][c];
                           }
                       }
                     });
@@ -781,24 +803,35 @@ void SpringHair::restore(const std::vector<double>& state, const std::string& so
   for (size_t p = 0; p < x_.size(); ++p) {
     if (length_[p] == 0.0) {
       x_[p] = xRest_[p];
-      v_[p] = glm::dvec3(0.0);
+      v_[p] = previousV_[p] = lastMove_[p] = glm::dvec3(0.0);
       continue;
     }
     const double* v = &state[kStateValues * k++];
     x_[p] = glm::dvec3(v[0], v[1], v[2]);
     v_[p] = glm::dvec3(v[3], v[4], v[5]);
+    previousV_[p] = glm::dvec3(v[6], v[7], v[8]);
+    lastMove_[p] = glm::dvec3(v[9], v[10], v[11]);
   }
-  // The bounds every step keeps (and checkRestartState checks, with the rest guides' points).
+  // The bounds every step keeps (and checkRestartState checks, with the rest guides' points); the
+  // history's velocities are the velocities of earlier substeps, under the same bound.
   fault_.reset();
-  for (size_t s = 0; s < rest_.strandCount(); ++s)
-    if (const std::optional<Fault> f = checkStrand(s)) {
+  for (size_t s = 0; s < rest_.strandCount(); ++s) {
+    std::optional<Fault> f = checkStrand(s);
+    for (uint32_t p = rest_.firstPoint[s] + 1; !f && p < rest_.firstPoint[s] + rest_.pointsOf(s); ++p)
+      for (const glm::dvec3& earlier : {previousV_[p], lastMove_[p]})
+        if (const std::optional<SpringSegmentFault> speed = springSpeedFault(earlier); speed && !f)
+          f = Fault{*speed, s, p - rest_.firstPoint[s]};
+    if (f) {
       x_ = xRest_;
       v_.assign(v_.size(), glm::dvec3(0.0));
+      previousV_.assign(v_.size(), glm::dvec3(0.0));
+      lastMove_.assign(v_.size(), glm::dvec3(0.0));
       throw InputError({source, 0}, "its simulation state's strand " + std::to_string(s) + ", point " +
                                         std::to_string(f->point) +
                                         " is not a state a simulation writes (not finite, stretched past " +
                                         "its bound, or too fast); simulate from the first frame");
     }
+  }
 }
 
 }  // namespace hairgen

@@ -17,11 +17,10 @@
 // - Bending: a spring per joint on its turn vector b_j = e_{j+1}/l_{j+1} − e_j/l_j (the root joint turns
 //   the first segment against the head-fixed root direction: a clamp), energy ½ k_j |b_j − b̄_j|² with
 //   k_j = E·I / l̄_j (l̄ the joint's share of length), which is the rod's ½ E·I κ² l̄ for small turns.
-//   Linear in the positions, as is the rest tension's force −T_j e_j / l_j: both act at
-//   x + kAhead·Δt·v⁺ − kBehind·Δt·v (nearly the trapezoidal rule: stable at any substep, and a mode
-//   keeps its amplitude but for a slight loss of the fastest), which needs one constant pentadiagonal
-//   matrix M(1 + c·Δt/2) + kAhead·Δt²·K per strand, factored once. Gravity, wind and the frame's terms
-//   are explicit, stretch and twist projections (the velocity is the change of position over Δt).
+//   Linear in the positions, as is the rest tension's force −T_j e_j / l_j: both are implicit in a step of
+//   the second-order backward difference (BDF2, below), which needs one constant pentadiagonal matrix
+//   M(1 + ⅔c·Δt) + (4/9)·Δt²·K per strand, factored once. Gravity, wind and the frame's terms are
+//   explicit, stretch and twist projections.
 // - Twist: a spring between points i and i + 3 (the classic torsion spring of mass-spring hair), whose
 //   length changes with the twist of the middle segment; its stiffness makes the rod's ½ G·J ψ²/l for a
 //   twist ψ, so it acts only where the rest shape bends out of a plane (a straight or planar hair has no
@@ -50,9 +49,9 @@
 //   coarser ones have fallen to DensityRefine of their starting energy (a rule of the present state,
 //   so a restart needs nothing more).
 //
-// Guarantees: a step depends only on the state (positions and velocities, in doubles) and the inputs;
-// strands step in parallel and every grid sums in a fixed order, so the result is the same bits for any
-// thread count, and a run resumed from state() is the same bits as one that never stopped.
+// Guarantees: a step depends only on the state (positions, velocities and the step's history, in doubles) and
+// the inputs; strands step in parallel and every grid sums in a fixed order, so the result is the same bits
+// for any thread count, and a run resumed from state() is the same bits as one that never stopped.
 #pragma once
 
 #include <atomic>
@@ -126,11 +125,12 @@ class SpringHair {
   // (kLanes: each strand's points eight at a time in vectors, the same bits.)
   void posedInto(const Pose& pose, Strands& out, Kernel kernel = Kernel::kFastest) const;
 
-  // What a restart needs: per segment, its end point's position and velocity in the head's frame
-  // (kStateValues doubles; the roots are the head's); and the inverse.
+  // What a restart needs: per segment, its end point's position, velocity, velocity a substep before
+  // and last move (the step's w) in the head's frame (kStateValues doubles; the roots are the head's);
+  // and the inverse.
   // restore() throws InputError naming `source` for a state of another size, or one whose values leave
   // the bounds step() keeps (fault()).
-  static constexpr size_t kStateValues = 6;
+  static constexpr size_t kStateValues = kSpringStateValues;
   std::vector<double> state() const;
   void stateInto(std::vector<double>& out) const;
   void restore(const std::vector<double>& state, const std::string& source);
@@ -138,7 +138,9 @@ class SpringHair {
   // Diagnostics (head frame): per point.
   const std::vector<glm::dvec3>& positions() const { return x_; }
   const std::vector<glm::dvec3>& velocities() const { return v_; }
-  std::vector<glm::dvec3>& velocities() { return v_; }  // for tests that set a motion
+  std::vector<glm::dvec3>& velocities() { return v_; }  // for tests of smoothVelocities
+  // Sets every point's velocity as a motion that has gone on for a while (v⁻ and w the same), for tests.
+  void setMotion(const std::vector<glm::dvec3>& v);
   void setPositions(const std::vector<glm::dvec3>& x) { x_ = x; }
   const std::vector<double>& masses() const { return mass_; }
   double kineticEnergy() const;  // joules, summed in point order
@@ -181,15 +183,17 @@ class SpringHair {
                            const bool* take);
   // posedInto's points j0 .. j0 + 7 of strand s, each of which starts a segment (j0 + 8 < its count).
   void poseEightLanes(size_t s, uint32_t j0, const Pose& pose, Strands& out) const;
-  // The implicit step's weights for the linear forces (bending, rest tension): they act at
-  // x + kAhead·Δt·v⁺ − kBehind·Δt·v, which in the two-step form x⁺ − 2x + x⁻ = Δt² M⁻¹ f weighs
-  // (x⁺, x, x⁻) by (kAhead, 1 − kAhead − kBehind, kBehind). Equal weights of ¼ are the trapezoidal rule:
-  // no loss at all, but a mode faster than the step rings for ever at the step's own frequency once a
-  // projection (stretch, collision) has excited it; a little more ahead than behind damps those (a mode
-  // far faster than the step keeps √(kBehind/kAhead) of its amplitude a step) while a mode of angular
-  // frequency ω keeps exp(−π (kAhead − kBehind) ω Δt) a period: 0.988 for a 10 cm hair's first mode at
-  // 4 substeps of 24 frames/s. Stable for every ω Δt (kAhead ≥ kBehind, kAhead + kBehind ≥ ½).
-  static constexpr double kAhead = 0.28, kBehind = 0.25;
+  // The step is the second-order backward difference (BDF2) in positions and velocities,
+  //   x⁺ = x + (Δt/3)·w + (2/3)·Δt·v⁺,
+  //   (M(1 + ⅔cΔt) + (4/9)Δt²K) v⁺ = M(4/3·v − 1/3·v⁻) + (2/3)Δt f(x + (Δt/3)·w),
+  // with w = (x − x⁻)/Δt, the last substep's move (so x⁺ = 4/3·x − 1/3·x⁻ + (2/3)Δt·v⁺), then the
+  // projections, and v⁺ = (3x⁺ − 4x + x⁻)/(2Δt) from the projected points. L-stable: a mode far faster
+  // than the step (the bending of millimetre segments, the string modes of a long chain) is gone within a
+  // step instead of ringing at the step's own frequency, where a projection's nonlinearity would feed it
+  // into a fold; a slow mode keeps its amplitude to second order (a 10 cm hair's swing at 4 substeps of 24
+  // frames/s: 0.994 a period). docs/dynamics-springs.md has the measurements.
+  static constexpr double kOneThird = 1.0 / 3.0, kTwoThirds = 2.0 / 3.0, kFourThirds = 4.0 / 3.0,
+                          kThreeHalves = 1.5;
   struct Lanes;
   // What the vector kernel reads of every point, lane by lane, so it loads a vector where the strands'
   // own arrays would need eight loads: block by block (laneFirst_), points 0..n of the block's lanes; a
@@ -210,6 +214,8 @@ class SpringHair {
 
   Strands rest_;  // every attribute of the rest guides but their points and tangents
   std::vector<glm::dvec3> xRest_, x_, v_;
+  // BDF2's history, per point: the velocity a substep before (v⁻) and the last substep's move over Δt (w).
+  std::vector<glm::dvec3> previousV_, lastMove_;
   std::vector<double> mass_, inverseMass_;
   // Per segment, indexed by its end point: rest length, stretch compliance l/(E·A) (m/N), rest tension
   // (N, the load below it along its length).
@@ -224,8 +230,8 @@ class SpringHair {
   std::vector<double> twistLength_, twistCompliance_;
   PointArray restTangents_;
   std::vector<glm::dvec3> restUnit_;  // per point but each strand's last, its segment's rest direction
-  // The implicit solve, per free point: 1/D and the two sub-diagonals of L in M(1 + cΔt) + Δt²K = L D Lᵀ,
-  // for the step dt_.
+  // The implicit solve, per free point: 1/D and the two sub-diagonals of L in M(1 + ⅔cΔt) + (4/9)Δt²K = L D
+  // Lᵀ, for the step dt_.
   std::vector<double> inverseD_, lower1_, lower2_;
   double dt_ = 0.0;
   // Collisions: the shapes that collide and per shape the depth every point sat at (at least 0).

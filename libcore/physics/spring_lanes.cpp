@@ -93,10 +93,19 @@ struct SpringHair::Lanes {
     b.done = splat(0.0);
     for (size_t l = count; l < kLaneWidth; ++l) b.done[l] = 1.0;
     scatter(hair, count, n, b);
-    // finish
+    // finish: v⁺ = 3/2 w⁺ − 1/2 w, the history moved on.
     for (uint32_t j = 1; j <= n; ++j) {
-      const V3 v = (b.x[j] - was[j]) / splat(dt);
-      for (size_t l = 0; l < count; ++l) hair.v_[b.p0[l] + j] = lane(v, l);
+      const V3 move = (b.x[j] - was[j]) / splat(dt);
+      V3 lastMove;
+      for (size_t l = 0; l < count; ++l) setLane(lastMove, l, hair.lastMove_[b.p0[l] + j]);
+      for (size_t l = count; l < kLaneWidth; ++l) setLane(lastMove, l, glm::dvec3(0.0));
+      const V3 v = splat(kThreeHalves) * move - splat(0.5) * lastMove;
+      for (size_t l = 0; l < count; ++l) {
+        const uint32_t p = b.p0[l] + j;
+        hair.previousV_[p] = hair.v_[p];
+        hair.v_[p] = lane(v, l);
+        hair.lastMove_[p] = lane(move, l);
+      }
     }
   }
   [[gnu::target("avx512f,avx512dq")]] static void projectStretchAvx512(SpringHair& hair, size_t block,
@@ -180,18 +189,24 @@ void SpringHair::projectStretchLanes(size_t block, const size_t* strands, size_t
                                                                     const AccelerationField& field, double dt,
                                                                     Block& b, V3* before) {
   const LanePoint* at = &hair.lanePoints_[hair.laneFirst_[block]];
-  V3 v[kMost], unit[kMost], turn[kMost], force[kMost];
+  V3 v[kMost], previousV[kMost], lastMove[kMost], unit[kMost], turn[kMost], force[kMost];
   Vd inverseLength[kMost];
   for (size_t l = 0; l < kLaneWidth; ++l) {
     setLane(unit[0], l, hair.rootDirection_[strands[l < count ? l : 0]]);
-    for (uint32_t j = 1; j <= n; ++j) setLane(v[j], l, hair.v_[b.p0[l] + j]);
+    for (uint32_t j = 1; j <= n; ++j) {
+      const uint32_t p = b.p0[l] + j;
+      setLane(v[j], l, hair.v_[p]);
+      setLane(previousV[j], l, hair.previousV_[p]);
+      setLane(lastMove[j], l, hair.lastMove_[p]);
+    }
   }
   inverseLength[n + 1] = splat(0.0);
-  v[0] = splat(glm::dvec3(0.0));  // the root's (predict reads none)
-  const Vd back = splat(kBehind * dt);
+  lastMove[0] = splat(glm::dvec3(0.0));  // the root's
+  const double thirdDt = dt / 3.0;
+  const Vd third = splat(thirdDt);
   for (uint32_t j = 1; j <= n; ++j) {
     inverseLength[j] = 1.0 / b.length[j];
-    unit[j] = inverseLength[j] * ((b.x[j] - b.x[j - 1]) - back * (v[j] - v[j - 1]));
+    unit[j] = inverseLength[j] * ((b.x[j] - b.x[j - 1]) + third * (lastMove[j] - lastMove[j - 1]));
   }
   unit[n + 1] = splat(glm::dvec3(0.0));
   for (uint32_t j = 0; j < n; ++j)
@@ -199,7 +214,7 @@ void SpringHair::projectStretchLanes(size_t block, const size_t* strands, size_t
   turn[n] = turn[n + 1] = splat(glm::dvec3(0.0));
   const V3 base = splat(field.base), centre = splat(field.centre), alpha = splat(field.alpha),
            omega = splat(field.omega);
-  const Vd keep = splat(1.0 - 0.5 * hair.damping_ * dt);
+  const Vd twoThirdsDt = splat(kTwoThirds * dt);
   for (uint32_t i = 1; i <= n; ++i) {
     V3 f = inverseLength[i] * turn[i - 1] + inverseLength[i + 1] * turn[i + 1] -
            (inverseLength[i] + inverseLength[i + 1]) * turn[i];
@@ -212,7 +227,7 @@ void SpringHair::projectStretchLanes(size_t block, const size_t* strands, size_t
     }
     const Vd mass = load(at[i].mass);
     f = f + mass * a;
-    force[i] = (mass * keep) * v[i] + splat(dt) * f;
+    force[i] = mass * (splat(kFourThirds) * v[i] - splat(kOneThird) * previousV[i]) + twoThirdsDt * f;
   }
   for (uint32_t i = 1; i <= n; ++i) {
     if (i >= 2) force[i] = force[i] - load(at[i].lower1) * force[i - 1];
@@ -225,7 +240,7 @@ void SpringHair::projectStretchLanes(size_t block, const size_t* strands, size_t
   }
   for (uint32_t i = 1; i <= n; ++i) {
     before[i] = b.x[i];
-    b.x[i] = b.x[i] + splat(dt) * force[i];
+    b.x[i] = b.x[i] + (third * lastMove[i] + twoThirdsDt * force[i]);
   }
 }
 
