@@ -10,11 +10,11 @@
 //   chunk block       "HGEN", uint32 block version (1), uint32 chunk count, then per chunk:
 //                     char tag[4], uint64 payload bytes, payload, uint32 CRC-32 of tag+length+payload
 // Chunks: TANG/NORM float[3] per point; SIDS/RTRI uint32 per strand; RBAR float[3] per strand;
-// RUVS float[2] per strand; GIDS uint32[3] per strand; GWTS float[3] per strand; DYNS float64 × 8
-// per segment (a simulated frame's restart state); PROV "key=value\n" text (provenanceText below:
-// producer, stage, seed, config, frame and time for a frame of a sequence, and what a conversion did).
-// cyHair readers stop after the arrays and never see the block. Unknown chunks are skipped (after
-// their CRC is checked), so newer files stay readable.
+// RUVS float[2] per strand; GIDS uint32[3] per strand; GWTS float[3] per strand; DYNS float64s (a
+// simulated frame's restart state, each model's layout in restart_state.h); PROV "key=value\n" text
+// (provenanceText below: producer, stage, seed, config, frame and time for a frame of a sequence, and what a
+// conversion did). cyHair readers stop after the arrays and never see the block. Unknown chunks are skipped
+// (after their CRC is checked), so newer files stay readable.
 #pragma once
 
 #include <cstdint>
