@@ -194,7 +194,8 @@ void run(Hair& hair, double gravity, const Strands& restGuides, const Config& co
     const Pose pose = head.pose(frame);
     bool posed = false;
     for (int s = 0; s < d.substeps; ++s) {
-      // The forces of the substep's start (Störmer-Verlet), in frames since the shot began.
+      // The forces of the substep's start (Anjyo's step is Störmer-Verlet; the springs' BDF2 takes these
+      // explicitly, first order), in frames since the shot began.
       const double t = double(frame - 1) + double(s) / double(d.substeps);
       const AccelerationField field = headFrameField(head.at(t), windAt(d.wind, t), gravity);
       const bool last = s == d.substeps - 1;

@@ -169,14 +169,17 @@ TEST(Springs, EveryKernelGivesTheSameBits) {
     Strands still, posed;
     hair.posedInto(Pose{}, still, kernel);
     hair.posedInto(turned, posed, kernel);
-    return std::tuple(hair.positions(), hair.velocities(), still, posed);
+    return std::tuple(hair.positions(), hair.velocities(), still, posed, hair.state());
   };
-  const auto [x, v, still, posed] = run(Kernel::kStrands);
+  const auto [x, v, still, posed, state] = run(Kernel::kStrands);
   double deepest = -1.0;
   for (const glm::dvec3& p : x) deepest = std::max(deepest, penetration(shapes.shapes[0], p));
   EXPECT_GT(deepest, -1e-3) << "the hair must reach the head";
   for (Kernel kernel : {Kernel::kLanes, Kernel::kFastest}) {  // the strands' again without AVX-512
-    const auto [xk, vk, stillk, posedk] = run(kernel);
+    const auto [xk, vk, stillk, posedk, statek] = run(kernel);
+    // The whole restart state: the step's history (v⁻, the last move) too.
+    ASSERT_EQ(statek.size(), state.size());
+    ASSERT_EQ(0, std::memcmp(statek.data(), state.data(), state.size() * sizeof(double)));
     ASSERT_EQ(xk.size(), x.size());
     for (size_t p = 0; p < x.size(); ++p) {
       ASSERT_EQ(0, std::memcmp(&xk[p], &x[p], sizeof(glm::dvec3))) << "position of point " << p;
@@ -231,12 +234,15 @@ TEST(Springs, EveryKernelGivesTheSameBitsOnCurls) {
       const std::vector<glm::dvec3> start = hair.positions();
       for (int n = 0; n < 40; ++n) hair.step(field, 1.0 / 96.0, n % 2 == 0, n % 2 == 1, kernel);
       if (twisted) *twisted = hair.positions() != start;
-      return std::pair(hair.positions(), hair.velocities());
+      return std::tuple(hair.positions(), hair.velocities(), hair.state());
     };
     bool moved = false;
-    const auto [x, v] = run(Kernel::kStrands, &moved);
+    const auto [x, v, state] = run(Kernel::kStrands, &moved);
     EXPECT_TRUE(moved);
-    const auto [xk, vk] = run(Kernel::kLanes, nullptr);
+    const auto [xk, vk, statek] = run(Kernel::kLanes, nullptr);
+    ASSERT_EQ(statek.size(), state.size());
+    ASSERT_EQ(0, std::memcmp(statek.data(), state.data(), state.size() * sizeof(double)))
+        << "the restart state" << (density ? " (density)" : "");
     ASSERT_EQ(xk.size(), x.size());
     for (size_t p = 0; p < x.size(); ++p) {
       ASSERT_EQ(0, std::memcmp(&xk[p], &x[p], sizeof(glm::dvec3)))
@@ -392,12 +398,14 @@ TEST(Springs, VelocitySmoothingNeverAddsKineticEnergy) {
     SpringHair hair(locks.rest, style, d, Collision{}, nullptr);
     std::mt19937_64 random(3);
     std::uniform_real_distribution<double> u(-0.2, 0.2);
+    std::vector<glm::dvec3> motion(hair.velocities().size(), glm::dvec3(0.0));
     for (size_t strand = 0; strand < locks.rest.strandCount(); ++strand) {
       const glm::dvec3 v(strand < locks.perLock ? 1.0 : -1.0, 0.0, 0.0);
       const glm::dvec3 own = v + glm::dvec3(u(random), 0.0, u(random));
       for (uint32_t p = locks.rest.firstPoint[strand] + 1; p < locks.rest.firstPoint[strand + 1]; ++p)
-        hair.velocities()[p] = own;
+        motion[p] = own;
     }
+    hair.setMotion(motion);  // a motion that has gone on: BDF2's history the same
     int raised = 0;
     for (int n = 0; n < 60; ++n) {
       hair.step(AccelerationField{}, 1.0 / 240.0, true, false);
@@ -513,6 +521,18 @@ TEST(Springs, ASegmentsBoundsAreItsStretchSpeedAndFiniteness) {
   EXPECT_EQ(nan->kind, SpringSegmentFault::kNotFinite);  // before the stretch
 }
 
+// The step's history (a velocity a substep before, a move over a substep) is bounded as a velocity is.
+TEST(Springs, TheHistorysBoundsAreTheVelocitys) {
+  EXPECT_FALSE(springSpeedFault(glm::dvec3(0.0, 999.0, 0.0)));
+  const auto fast = springSpeedFault(glm::dvec3(600.0, 0.0, -800.1));
+  ASSERT_TRUE(fast);
+  EXPECT_EQ(fast->kind, SpringSegmentFault::kSpeed);
+  EXPECT_NEAR(fast->value, 1000.08, 1e-2);
+  const auto infinite = springSpeedFault(glm::dvec3(0.0, 0.0, INFINITY));
+  ASSERT_TRUE(infinite);
+  EXPECT_EQ(infinite->kind, SpringSegmentFault::kNotFinite);
+}
+
 TEST(Springs, ARestartStateNoSimulationWritesIsRefused) {
   HeadKey start, turned;
   turned.frame = 6;
@@ -542,11 +562,19 @@ TEST(Springs, ARestartStateNoSimulationWritesIsRefused) {
            [&](Strands& c) { c.simulationState[last + 11] = -1e5; },  // or past any hair's speed
            [&](Strands& c) { c.simulationState[last] += 1e-2; },      // the last tip 1 cm off
            [&](Strands& c) { c.simulationState.resize(n - kSpringStateValues); },  // a segment short
-           [&](Strands& c) { c.simulationState.resize(n / 2); },    // an older hairgen's 6 values a segment
-           [](Strands& c) { c.provenance.restDigest.clear(); }}) {  // an older hairgen's
+           [](Strands& c) { c.provenance.restDigest.clear(); }}) {                 // an older hairgen's
     Strands spoiled = frame4;
     spoil(spoiled);
     EXPECT_THROW(resume(rest, spoiled), InputError);
+  }
+  // An older hairgen's 6 values a segment (before the BDF2 step) is named as such.
+  Strands older = frame4;
+  older.simulationState.resize(n / 2);
+  try {
+    resume(rest, older);
+    ADD_FAILURE() << "resumed from a 6-value state";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("layout of an earlier hairgen"), std::string::npos) << e.what();
   }
   // Other rest guides with the same strand layout: one point moved by a tenth of a millimetre.
   Strands other = rest;

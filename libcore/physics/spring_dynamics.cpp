@@ -444,7 +444,15 @@ void SpringHair::step(const AccelerationField& field, double dt, bool firstSubst
     fault_ = checkStrand(first);
     return;
   }
-  if (lastSubstep && smoothing_ > 0.0) smoothVelocities(smoothing_);
+  if (lastSubstep && smoothing_ > 0.0) {
+    smoothVelocities(smoothing_);
+    // Smoothing moves the history too, so the state a frame writes is checked once more.
+    std::atomic<size_t> smoothed{strands};
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, strands, 256), [&](const tbb::blocked_range<size_t>& r) {
+      checkStrands(r.begin(), r.end(), smoothed);
+    });
+    if (smoothed < strands) fault_ = checkStrand(smoothed);
+  }
 }
 
 std::optional<SpringHair::Fault> SpringHair::checkStrand(size_t s) const {
@@ -458,7 +466,9 @@ std::optional<SpringHair::Fault> SpringHair::checkStrand(size_t s) const {
   for (uint32_t p = p0 + 1; p < p0 + count; ++p) {
     const glm::dvec3 e = x_[p] - x_[p - 1];
     const double length2 = glm::dot(e, e), rest2 = length_[p] * length_[p];
-    within &= length2 >= kLow * rest2 && length2 <= kHigh * rest2 && glm::dot(v_[p], v_[p]) <= kSpeed2;
+    within &= length2 >= kLow * rest2 && length2 <= kHigh * rest2 && glm::dot(v_[p], v_[p]) <= kSpeed2 &&
+              glm::dot(previousV_[p], previousV_[p]) <= kSpeed2 &&
+              glm::dot(lastMove_[p], lastMove_[p]) <= kSpeed2;
   }
   if (within) return std::nullopt;
   // restart_state.h's bounds, by the function checkRestartState uses (the rest lengths are the same
@@ -467,6 +477,9 @@ std::optional<SpringHair::Fault> SpringHair::checkStrand(size_t s) const {
     const uint32_t p = p0 + j;
     if (const std::optional<SpringSegmentFault> f = springSegmentFault(x_[p - 1], x_[p], v_[p], length_[p]))
       return Fault{*f, s, j};
+    // The step's history (the velocity a substep before, the last move) under the velocity's bounds.
+    for (const glm::dvec3& earlier : {previousV_[p], lastMove_[p]})
+      if (const std::optional<SpringSegmentFault> f = springSpeedFault(earlier)) return Fault{*f, s, j};
   }
   return std::nullopt;
 }
@@ -795,6 +808,10 @@ void SpringHair::stateInto(std::vector<double>& out) const {
 
 void SpringHair::restore(const std::vector<double>& state, const std::string& source) {
   const size_t segments = x_.size() - rest_.strandCount();
+  if (segments > 0 && state.size() == segments * 6)
+    throw InputError({source, 0},
+                     "its simulation state is in the layout of an earlier hairgen (6 values a "
+                     "segment, before the BDF2 step); simulate from the first frame");
   if (state.size() != segments * kStateValues)
     throw InputError({source, 0}, "its simulation state has " + std::to_string(state.size() / kStateValues) +
                                       " segments, the guides " + std::to_string(segments) +
@@ -812,16 +829,10 @@ void SpringHair::restore(const std::vector<double>& state, const std::string& so
     previousV_[p] = glm::dvec3(v[6], v[7], v[8]);
     lastMove_[p] = glm::dvec3(v[9], v[10], v[11]);
   }
-  // The bounds every step keeps (and checkRestartState checks, with the rest guides' points); the
-  // history's velocities are the velocities of earlier substeps, under the same bound.
+  // The bounds every step keeps (and checkRestartState checks, with the rest guides' points).
   fault_.reset();
   for (size_t s = 0; s < rest_.strandCount(); ++s) {
-    std::optional<Fault> f = checkStrand(s);
-    for (uint32_t p = rest_.firstPoint[s] + 1; !f && p < rest_.firstPoint[s] + rest_.pointsOf(s); ++p)
-      for (const glm::dvec3& earlier : {previousV_[p], lastMove_[p]})
-        if (const std::optional<SpringSegmentFault> speed = springSpeedFault(earlier); speed && !f)
-          f = Fault{*speed, s, p - rest_.firstPoint[s]};
-    if (f) {
+    if (const std::optional<Fault> f = checkStrand(s)) {
       x_ = xRest_;
       v_.assign(v_.size(), glm::dvec3(0.0));
       previousV_.assign(v_.size(), glm::dvec3(0.0));

@@ -100,7 +100,8 @@ class SpringHair {
   static constexpr uint32_t kMaxLaneSegments = 128;  // longer strands step on their own
   // After the substep every strand's state is checked against the bounds of a valid state
   // (libcore/io/restart_state.h: finite, every segment within kMaxSpringStretch of its rest length,
-  // every point slower than kMaxSpringSpeed); the first strand that left them is kept as fault(), and
+  // every point slower than kMaxSpringSpeed, and so is the step's history), and again after a frame's
+  // velocity smoothing; the first strand that left them is kept as fault(), and
   // from then on step() does nothing (nothing computes on nonsense) until restore().
   void step(const AccelerationField& field, double dt, bool firstSubstep, bool lastSubstep,
             Kernel kernel = Kernel::kFastest);
@@ -190,8 +191,10 @@ class SpringHair {
   // projections, and v⁺ = (3x⁺ − 4x + x⁻)/(2Δt) from the projected points. L-stable: a mode far faster
   // than the step (the bending of millimetre segments, the string modes of a long chain) is gone within a
   // step instead of ringing at the step's own frequency, where a projection's nonlinearity would feed it
-  // into a fold; a slow mode keeps its amplitude to second order (a 10 cm hair's swing at 4 substeps of 24
-  // frames/s: 0.994 a period). docs/dynamics-springs.md has the measurements.
+  // into a fold; a slow mode keeps its amplitude to second order in the forces taken implicitly (a 10 cm
+  // hair's swing at 4 substeps of 24 frames/s: 0.993 a period). Gravity, wind, the frame's terms and the
+  // density force are taken at the substep's start and the current state: first order in how they change
+  // in time, as before. docs/dynamics-springs.md has the measurements.
   static constexpr double kOneThird = 1.0 / 3.0, kTwoThirds = 2.0 / 3.0, kFourThirds = 4.0 / 3.0,
                           kThreeHalves = 1.5;
   struct Lanes;

@@ -27,8 +27,9 @@ using namespace lanes;
 static_assert(SpringHair::kLanes == kLaneWidth);
 
 struct SpringHair::Lanes {
-  // A block's arrays live on the stack, sized for the longest lane strand: about 210 KB for a step
-  // (-fstack-usage), well inside TBB's 4 MB worker stacks; a strand of n segments touches n + 2 of each.
+  // A block's arrays live on the stack, sized for the longest lane strand: about 260 KB for a step
+  // (210 KB by -fstack-usage before the BDF2 history's two more arrays in predict), well inside TBB's
+  // 4 MB worker stacks; a strand of n segments touches n + 2 of each.
   static constexpr size_t kMost = kMaxLaneSegments + 2;
   static constexpr uint32_t kAhead = 4;  // points
   // A block's lanes: the points and what the stretch solve reads of them.
