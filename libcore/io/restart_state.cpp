@@ -34,21 +34,24 @@ std::optional<SpringSegmentFault> springSpeedFault(const glm::dvec3& velocity) {
   return std::nullopt;
 }
 
-namespace {
-
-void checkSpringState(const Strands& rest, const std::vector<double>& state, const std::string& source) {
-  const size_t segments = rest.pointCount() - rest.strandCount();
-  if (segments > 0 && state.size() == segments * 6)
+void requireSpringStateSize(size_t segments, size_t values, const std::string& source) {
+  if (segments > 0 && values == segments * 6)
     throw InputError({source, 0},
                      "its simulation state is in the layout of an earlier hairgen (6 values a "
                      "segment, before the BDF2 step; this one keeps " +
                          std::to_string(kSpringStateValues) + "); simulate from the first frame");
-  if (state.size() != segments * kSpringStateValues)
-    throw InputError({source, 0}, "its simulation state has " + std::to_string(state.size()) +
+  if (values != segments * kSpringStateValues)
+    throw InputError({source, 0}, "its simulation state has " + std::to_string(values) +
                                       " values, and Model springs on these guides keeps " +
                                       std::to_string(segments * kSpringStateValues) + " (" +
                                       std::to_string(kSpringStateValues) + " per segment); restart from a " +
                                       "frame of the same guides and the same Model");
+}
+
+namespace {
+
+void checkSpringState(const Strands& rest, const std::vector<double>& state, const std::string& source) {
+  requireSpringStateSize(rest.pointCount() - rest.strandCount(), state.size(), source);
   // Segment by segment from each root (which the state does not hold: the head's, at rest), the
   // positions' distances against the rest lengths, and the velocities.
   for (size_t s = 0; s < rest.strandCount(); ++s) {
@@ -67,10 +70,11 @@ void checkSpringState(const Strands& rest, const std::vector<double>& state, con
       std::optional<SpringSegmentFault> fault = springSegmentFault(previous, x, velocity, restLength);
       // The history's velocities (a substep before, the last move) under the velocity's bounds; the
       // position's fault first.
-      for (int k = 2; k <= 3 && (!fault || fault->kind == SpringSegmentFault::kSpeed); ++k)
+      for (const double* earlier : {v + 6, v + 9})
         if (const std::optional<SpringSegmentFault> f =
-                springSpeedFault(glm::dvec3(v[3 * k], v[3 * k + 1], v[3 * k + 2])))
-          if (!fault || f->kind == SpringSegmentFault::kNotFinite) fault = f;
+                springSpeedFault(glm::dvec3(earlier[0], earlier[1], earlier[2]));
+            f && (!fault || f->kind == SpringSegmentFault::kNotFinite))
+          fault = f;
       if (fault && fault->kind == SpringSegmentFault::kNotFinite) refuse("holds a value that is not finite");
       if (!(restLength > 0.0)) refuse("follows a rest segment of no length");  // the guides', not the state's
       if (fault && fault->kind == SpringSegmentFault::kStretch)

@@ -56,6 +56,9 @@ struct SpringSegmentFault {
 // of `end` and `velocity`, then the stretch, then the speed; returns the first that fails, or nullopt.
 std::optional<SpringSegmentFault> springSegmentFault(const glm::dvec3& start, const glm::dvec3& end,
                                                      const glm::dvec3& velocity, double restLength);
+// Throws InputError naming `source` unless a springs state of `values` doubles is for guides of
+// `segments` segments (kSpringStateValues a segment); an older hairgen's 6 a segment is named as such.
+void requireSpringStateSize(size_t segments, size_t values, const std::string& source);
 // The bounds above on a velocity alone (the state's history: a velocity a substep before, a move over a
 // substep): not finite, or a speed past kMaxSpringSpeed.
 std::optional<SpringSegmentFault> springSpeedFault(const glm::dvec3& velocity);

@@ -447,11 +447,7 @@ void SpringHair::step(const AccelerationField& field, double dt, bool firstSubst
   if (lastSubstep && smoothing_ > 0.0) {
     smoothVelocities(smoothing_);
     // Smoothing moves the history too, so the state a frame writes is checked once more.
-    std::atomic<size_t> smoothed{strands};
-    tbb::parallel_for(tbb::blocked_range<size_t>(0, strands, 256), [&](const tbb::blocked_range<size_t>& r) {
-      checkStrands(r.begin(), r.end(), smoothed);
-    });
-    if (smoothed < strands) fault_ = checkStrand(smoothed);
+    fault_ = firstFault();
   }
 }
 
@@ -482,6 +478,14 @@ std::optional<SpringHair::Fault> SpringHair::checkStrand(size_t s) const {
       if (const std::optional<SpringSegmentFault> f = springSpeedFault(earlier)) return Fault{*f, s, j};
   }
   return std::nullopt;
+}
+
+std::optional<SpringHair::Fault> SpringHair::firstFault() const {
+  const size_t strands = rest_.strandCount();
+  std::atomic<size_t> first{strands};
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, strands, 256),
+                    [&](const tbb::blocked_range<size_t>& r) { checkStrands(r.begin(), r.end(), first); });
+  return first < strands ? checkStrand(first) : std::nullopt;
 }
 
 void SpringHair::checkStrands(size_t s0, size_t s1, std::atomic<size_t>& first) const {
@@ -807,15 +811,7 @@ void SpringHair::stateInto(std::vector<double>& out) const {
 }
 
 void SpringHair::restore(const std::vector<double>& state, const std::string& source) {
-  const size_t segments = x_.size() - rest_.strandCount();
-  if (segments > 0 && state.size() == segments * 6)
-    throw InputError({source, 0},
-                     "its simulation state is in the layout of an earlier hairgen (6 values a "
-                     "segment, before the BDF2 step); simulate from the first frame");
-  if (state.size() != segments * kStateValues)
-    throw InputError({source, 0}, "its simulation state has " + std::to_string(state.size() / kStateValues) +
-                                      " segments, the guides " + std::to_string(segments) +
-                                      "; restart from a frame of the same guides (and the same Model)");
+  requireSpringStateSize(x_.size() - rest_.strandCount(), state.size(), source);
   size_t k = 0;
   for (size_t p = 0; p < x_.size(); ++p) {
     if (length_[p] == 0.0) {
@@ -831,17 +827,15 @@ void SpringHair::restore(const std::vector<double>& state, const std::string& so
   }
   // The bounds every step keeps (and checkRestartState checks, with the rest guides' points).
   fault_.reset();
-  for (size_t s = 0; s < rest_.strandCount(); ++s) {
-    if (const std::optional<Fault> f = checkStrand(s)) {
-      x_ = xRest_;
-      v_.assign(v_.size(), glm::dvec3(0.0));
-      previousV_.assign(v_.size(), glm::dvec3(0.0));
-      lastMove_.assign(v_.size(), glm::dvec3(0.0));
-      throw InputError({source, 0}, "its simulation state's strand " + std::to_string(s) + ", point " +
-                                        std::to_string(f->point) +
-                                        " is not a state a simulation writes (not finite, stretched past " +
-                                        "its bound, or too fast); simulate from the first frame");
-    }
+  if (const std::optional<Fault> f = firstFault()) {
+    x_ = xRest_;
+    v_.assign(v_.size(), glm::dvec3(0.0));
+    previousV_.assign(v_.size(), glm::dvec3(0.0));
+    lastMove_.assign(v_.size(), glm::dvec3(0.0));
+    throw InputError({source, 0}, "its simulation state's strand " + std::to_string(f->strand) + ", point " +
+                                      std::to_string(f->point) +
+                                      " is not a state a simulation writes (not finite, stretched past " +
+                                      "its bound, or too fast); simulate from the first frame");
   }
 }
 

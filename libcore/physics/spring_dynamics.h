@@ -163,6 +163,8 @@ class SpringHair {
   std::optional<Fault> checkStrand(size_t strand) const;
   // The first strand of [s0, s1) whose checkStrand fails, into `first` (the lowest of all callers).
   void checkStrands(size_t s0, size_t s1, std::atomic<size_t>& first) const;
+  // checkStrand's fault of the first strand that fails it (in strand order), on every thread.
+  std::optional<Fault> firstFault() const;
   void predict(size_t strand, const AccelerationField& field, double dt, glm::dvec3* before);
   bool constrain(size_t strand, double dt);
   // Point p at `x` out of collision shape c to the depth it sat at in the rest shape; whether it moved.

@@ -35,6 +35,7 @@ struct SpringHair::Lanes {
   // A block's lanes: the points and what the stretch solve reads of them.
   struct Block {
     V3 x[kMost];
+    V3 lastMove[kMost];  // BDF2's w, read by predict and by the finish that replaces it
     Vd inverseMass[kMost], length[kMost], compliance[kMost];
     uint32_t p0[kLaneWidth];
     // 1 in lanes whose strand is not solved (past `count`, or not taken). (A double: GCC 12 fails on a
@@ -97,10 +98,7 @@ struct SpringHair::Lanes {
     // finish: v⁺ = 3/2 w⁺ − 1/2 w, the history moved on.
     for (uint32_t j = 1; j <= n; ++j) {
       const V3 move = (b.x[j] - was[j]) / splat(dt);
-      V3 lastMove;
-      for (size_t l = 0; l < count; ++l) setLane(lastMove, l, hair.lastMove_[b.p0[l] + j]);
-      for (size_t l = count; l < kLaneWidth; ++l) setLane(lastMove, l, glm::dvec3(0.0));
-      const V3 v = splat(kThreeHalves) * move - splat(0.5) * lastMove;
+      const V3 v = splat(kThreeHalves) * move - splat(0.5) * b.lastMove[j];
       for (size_t l = 0; l < count; ++l) {
         const uint32_t p = b.p0[l] + j;
         hair.previousV_[p] = hair.v_[p];
@@ -190,7 +188,8 @@ void SpringHair::projectStretchLanes(size_t block, const size_t* strands, size_t
                                                                     const AccelerationField& field, double dt,
                                                                     Block& b, V3* before) {
   const LanePoint* at = &hair.lanePoints_[hair.laneFirst_[block]];
-  V3 v[kMost], previousV[kMost], lastMove[kMost], unit[kMost], turn[kMost], force[kMost];
+  V3 v[kMost], previousV[kMost], unit[kMost], turn[kMost], force[kMost];
+  V3* lastMove = b.lastMove;
   Vd inverseLength[kMost];
   for (size_t l = 0; l < kLaneWidth; ++l) {
     setLane(unit[0], l, hair.rootDirection_[strands[l < count ? l : 0]]);
