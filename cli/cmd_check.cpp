@@ -24,7 +24,8 @@ namespace {
 nlohmann::ordered_json checkReport(const std::string& setup, const Config& config, const Scene& scene,
                                    const CommonOptions& common) {
   readCustomShaders(config.setup);  // a custom stage the render would refuse (too large for a compiler)
-  if (config.setup.load) readStrands(config.setup.loadFile.path);  // a coupe run could not read
+  // A coupe run could not read: read where the file lies (its checks, not a copy of its arrays).
+  if (config.setup.load) readStrands(config.setup.loadFile.path, {}, ArrayStorage::kMapped);
   nlohmann::ordered_json report =
       describeSetup(setup, config, scene.wick ? &*scene.wick : nullptr, scene.head ? &*scene.head : nullptr);
   if (!config.setup.meshConversion.describe().empty())

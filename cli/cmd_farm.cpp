@@ -111,11 +111,11 @@ void requireNoLinksInPlan(const FarmPlan& plan, const std::string& planFile) {
                                             "itself, not behind links");
     }
   };
-  check(plan.directory + "/slurm", true, "submit's scripts");
-  check(plan.directory + "/logs", true, "submit's logs");
-  // What submit (and Slurm, for a task's log, which it opens following links) writes in them: no entry
-  // may be a link either.
-  for (const char* folder : {"/slurm", "/logs"}) {
+  // submit's folders, and what submit (and Slurm, for a task's log, which it opens following links)
+  // writes in them: no entry may be a link either.
+  for (const auto& [folder, what] :
+       {std::pair{"/slurm", "submit's scripts"}, std::pair{"/logs", "submit's logs"}}) {
+    check(plan.directory + folder, true, what);
     std::error_code ec;
     fs::directory_iterator it(plan.directory + folder, ec), end;
     for (; !ec && it != end; it.increment(ec))

@@ -11,6 +11,7 @@
 
 #include "farm/plan.h"
 #include "libcore/util/error.h"
+#include "libcore/util/text.h"
 
 namespace hairgen {
 namespace {
@@ -24,11 +25,6 @@ using Json = nlohmann::ordered_json;
 // message shows what a field holds on one line.
 std::string shown(const std::string& text) {
   return Json(text).dump(-1, ' ', false, Json::error_handler_t::replace);
-}
-
-bool isControl(char c) {
-  const auto u = static_cast<unsigned char>(c);
-  return u < 0x20 || u == 0x7f;
 }
 
 bool isLowerOrDigit(char c) {

@@ -28,7 +28,7 @@ ShellWord literal(std::string text) {
 std::string shellQuote(const std::string& s) {
   std::string out = "'";
   for (char c : s) {
-    if (static_cast<unsigned char>(c) < 0x20 || c == 0x7f)
+    if (isControl(c))
       throw InputError("a control character in '" + oneLine(s) + "' cannot go into a shell script");
     out += c == '\'' ? std::string("'\\''") : std::string(1, c);
   }

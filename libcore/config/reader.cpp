@@ -89,7 +89,7 @@ ConfigText parseConfigText(std::string_view text, const std::string& name,
         inToken = false;
         continue;
       }
-      if (static_cast<unsigned char>(c) < 0x20 || c == 0x7f)
+      if (isControl(c))
         throw InputError(where, "control character (byte " + std::to_string(static_cast<unsigned char>(c)) +
                                     ") in a config file; is this a text file?");
       token += c;
@@ -110,7 +110,7 @@ ConfigText readConfigText(const std::filesystem::path& file) {
 Override parseOverride(std::string_view argument, const SectionList& sections) {
   FileLoc where{"--set " + std::string(argument), 0};
   for (const char c : argument)
-    if (static_cast<unsigned char>(c) < 0x20 || c == 0x7f)
+    if (isControl(c))
       throw InputError(where, "holds a control character (byte " +
                                   std::to_string(static_cast<unsigned char>(c)) +
                                   "); a --set value is printable text");

@@ -33,27 +33,6 @@ Config loadConfig(const std::filesystem::path& setupFile, const std::vector<Over
   Config config;
   config.setup = readSetup(readConfigText(setupFile), overrides);
   const Setup& s = config.setup;
-  // check judges a Setup as run reads it where it grows (it names a wick or a Hairstyle Info) or names
-  // nothing at all (an empty file is no job); one that names neither, but a Render Info or a head, is a
-  // render's (`render --hair`), and check takes it as such.
-  const bool namesAnything = s.hairstyleInfo.given() || s.wickModel.given() || s.renderInfo.given() ||
-                             s.visualityInfo.given() || s.collisionInfo.given() || s.dynamicsInfo.given() ||
-                             s.headModel.given() || s.hairVert.given() || s.hairFrag.given() ||
-                             s.headVert.given() || s.headFrag.given();
-  const bool checkedAsRun = use == SetupUse::kCheck && !s.load &&
-                            (s.hairstyleInfo.given() || s.wickModel.given() || !namesAnything);
-  bool grows = use == SetupUse::kGrow || use == SetupUse::kInterpolate ||
-               (use == SetupUse::kRun && !s.load) || checkedAsRun;
-
-  auto need = [&](const PathRef& ref, const char* key, const char* why) {
-    if (!ref.given())
-      throw InputError({setupFile.string(), 0},
-                       std::string("missing required key '") + key + "' (" + why + ")");
-  };
-  if (grows) {
-    need(s.hairstyleInfo, "HairstyleInfo", "path of the Hairstyle Info file");
-    need(s.wickModel, "WickModel", "path of the wick OBJ");
-  }
   // Every file the Setup names must exist. The Info files enter the digest by their values; the
   // others (`byContent`), whose bytes shape the output, by their content (below).
   struct Named {
@@ -72,6 +51,25 @@ Config loadConfig(const std::filesystem::path& setupFile, const std::vector<Over
                          {&s.hairFrag, "HairFrag", true},
                          {&s.headVert, "HeadVert", true},
                          {&s.headFrag, "HeadFrag", true}};
+  // check judges a Setup as run reads it where it grows (it names a wick or a Hairstyle Info) or names
+  // nothing at all (an empty file is no job); one that names neither, but a Render Info or a head, is a
+  // render's (`render --hair`), and check takes it as such.
+  const bool namesAnything =
+      std::any_of(std::begin(named), std::end(named), [](const Named& n) { return n.ref->given(); });
+  const bool checkedAsRun = use == SetupUse::kCheck && !s.load &&
+                            (s.hairstyleInfo.given() || s.wickModel.given() || !namesAnything);
+  bool grows = use == SetupUse::kGrow || use == SetupUse::kInterpolate ||
+               (use == SetupUse::kRun && !s.load) || checkedAsRun;
+
+  auto need = [&](const PathRef& ref, const char* key, const char* why) {
+    if (!ref.given())
+      throw InputError({setupFile.string(), 0},
+                       std::string("missing required key '") + key + "' (" + why + ")");
+  };
+  if (grows) {
+    need(s.hairstyleInfo, "HairstyleInfo", "path of the Hairstyle Info file");
+    need(s.wickModel, "WickModel", "path of the wick OBJ");
+  }
   for (const Named& n : named)
     if (n.ref->given()) requireExisting(*n.ref, n.key);
   if (s.load && (use == SetupUse::kRun || use == SetupUse::kCheck)) requireExisting(s.loadFile, "LoadFile");

@@ -202,12 +202,16 @@ size_t jsonDepth(const std::string& json) {
 // The deepest a glTF's JSON may nest: far past any glTF's own structure and any DCC's extras.
 constexpr size_t kMaxJsonDepth = 256;
 
-void checkExternalUris(const std::string& json, const std::filesystem::path& baseDir,
-                       const std::string& name) {
+// Throws InputError naming `name` for JSON nested deeper than kMaxJsonDepth, before any parser recurses.
+void requireShallowJson(const std::string& json, const std::string& name) {
   if (const size_t depth = jsonDepth(json); depth > kMaxJsonDepth)
     throw InputError({name, 0}, "its JSON nests arrays and objects " + std::to_string(depth) +
                                     " deep; hairgen reads a glTF nested at most " +
                                     std::to_string(kMaxJsonDepth) + " deep");
+}
+
+void checkExternalUris(const std::string& json, const std::filesystem::path& baseDir,
+                       const std::string& name) {
   const nlohmann::json doc = nlohmann::json::parse(json, nullptr, /*allow_exceptions=*/false);
   if (!doc.is_object()) return;  // tinygltf says what is wrong with it
   for (const char* list : {"buffers", "images"}) {
@@ -614,7 +618,9 @@ Strands decodeGltf(const uint8_t* data, size_t size, const std::string& name,
                    const std::filesystem::path& baseDir) {
   if (size > UINT32_MAX) throw InputError({name, 0}, "file larger than 4 GiB; glTF cannot address it");
   const bool binary = size >= 4 && std::memcmp(data, "glTF", 4) == 0;
-  checkExternalUris(jsonOf(data, size, binary), baseDir, name);
+  const std::string json = jsonOf(data, size, binary);
+  requireShallowJson(json, name);
+  checkExternalUris(json, baseDir, name);
   ExternalFiles external{baseDir, name};
   tinygltf::TinyGLTF loader;
   loader.SetFsCallbacks(external.callbacks());

@@ -351,6 +351,12 @@ Temporary createTemporaryBeside(const fs::path& target) {
   }
 }
 
+// Removes a private temporary's file and its folder.
+void removePrivateTemporary(const Temporary& t) {
+  emptyAndClose(t.folderFd);
+  ::rmdir(t.folder.c_str());  // only if empty, and never through a link: at worst one stays
+}
+
 // For a library that opens the file by name (writeThroughTemporary): a private folder beside `target`
 // (mode 0700, a fresh name made by mkdir, which never follows or reuses a name someone put there) and a
 // new file in it named as the target (the library may choose its format by the name's extension). No
@@ -395,17 +401,9 @@ Temporary createPrivateTemporary(const fs::path& target) {
     const int error = t.fd < 0 ? errno : ENOENT;  // no /proc: the descriptor's name cannot be given
     if (t.fd >= 0) ::close(t.fd);
     releaseTemporary(t.slot);
-    ::unlinkat(t.folderFd, t.leaf.c_str(), 0);
-    ::close(t.folderFd);
-    ::rmdir(folder.c_str());
+    removePrivateTemporary(t);
     throw IoError({target.string(), 0}, std::string("cannot write: ") + std::strerror(error));
   }
-}
-
-// Removes a private temporary's file and its folder.
-void removePrivateTemporary(const Temporary& t) {
-  emptyAndClose(t.folderFd);
-  ::rmdir(t.folder.c_str());  // only if empty, and never through a link: at worst one stays
 }
 
 // A committed file named `target` that is the file `st` describes.

@@ -45,6 +45,12 @@ std::string oneLine(std::string text);
 // characters \u00NN, so NUL, line ends and terminal controls never reach a format's syntax.
 std::string printableText(std::string_view text);
 
+// Whether `c` is one of the ASCII control characters printableText escapes (U+0000-U+001F, U+007F).
+inline bool isControl(char c) {
+  const auto u = static_cast<unsigned char>(c);
+  return u < 0x20 || u == 0x7f;
+}
+
 // `text` without a leading UTF-8 byte-order mark (editors on Windows write one).
 std::string_view withoutBom(std::string_view text);
 

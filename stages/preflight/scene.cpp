@@ -184,11 +184,16 @@ std::vector<SceneFinding> checkScene(const Config& config, const Mesh& wick, con
   // the top of the head back. The bundled coupes' lie within a centimetre of a follicle; a point a
   // quarter of the wick's size away (at least 3 cm) is no whorl of this scalp.
   const Hairstyle& style = config.hairstyle;
-  double nearestFollicle = std::numeric_limits<double>::infinity();
-  for (const glm::vec3& p : wick.positions)
-    nearestFollicle = std::min(nearestFollicle, glm::length(glm::dvec3(p) - style.rootFlow.value));
+  // The nearest follicle, asked for only where the follicles lean away from the point.
+  auto nearestToFlow = [&] {
+    double nearest = std::numeric_limits<double>::infinity();
+    for (const glm::vec3& p : wick.positions)
+      nearest = std::min(nearest, glm::length(glm::dvec3(p) - style.rootFlow.value));
+    return nearest;
+  };
+  double nearestFollicle = 0.0;
   if (style.rootTilt > 0.0 && style.rootFlow.kind == RootFlow::Kind::kAwayFrom && !style.rootFlow.fitted &&
-      !wick.positions.empty() && nearestFollicle > std::max(0.25 * diagonal, 0.03)) {
+      !wick.positions.empty() && (nearestFollicle = nearestToFlow()) > std::max(0.25 * diagonal, 0.03)) {
     auto point = [](const glm::dvec3& p) {
       auto r = [](double v) { return formatReal(std::round(v * 1000.0) / 1000.0); };
       return r(p.x) + " " + r(p.y) + " " + r(p.z);
