@@ -327,7 +327,9 @@ FarmPlan farmPlanFromJson(const Json& j, const std::string& name) {
     plan.configDigest = j.at("configDigest").get<std::string>();
     field = "overrides";
     plan.overrides = j.at("overrides").get<std::vector<std::string>>();
+    field = "shards";
     plan.shards = int(integer(j, "shards", 1, kFarmMaxGroupTasks, where));
+    field = "chunk";
     plan.chunk = int(integer(j, "chunk", 1, kFarmMaxFrames, where));
     field = "frames";
     if (!j.at("frames").is_null()) {

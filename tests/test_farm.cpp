@@ -263,6 +263,7 @@ TEST(FarmPlan, ReadingRefusesWhatCouldReachAShellOrLeaveTheFolder) {
       {[](auto& j) { j["version"] = 1e300; }, "version"},
       {[](auto& j) { j["format"] = 7; }, "not a hairgen farm plan"},
       {[](auto& j) { j["shards"] = 100000; }, "\"shards\""},
+      {[](auto& j) { j.erase("chunk"); }, "\"chunk\": "},  // named as itself, not as the field before
       {[](auto& j) {
          j["frames"] = {{"first", INT_MIN}, {"last", INT_MAX}};
        },
